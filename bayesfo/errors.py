@@ -1,0 +1,27 @@
+"""Exceptions and warnings raised by bayesfo.
+
+Every exception subclasses a built-in one, so ``except ValueError`` keeps working for callers
+that do not know about bayesfo. The command line maps :class:`InputError` to exit status 2 with a
+single message line, and any other exception to exit status 1.
+"""
+
+from __future__ import annotations
+
+
+class BayesfoError(Exception):
+    """Base class of all bayesfo exceptions."""
+
+
+class InputError(BayesfoError, ValueError):
+    """Bad input from the user: a file, a column, a row or an argument that cannot be used.
+
+    The message names what is wrong and where (file, column, row or argument name).
+    """
+
+
+class StructureError(InputError):
+    """A structure card or structure name that cannot be used."""
+
+
+class NonlinearityWarning(UserWarning):
+    """A sine record whose harmonics show that the system is not linear at that amplitude."""

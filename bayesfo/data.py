@@ -468,10 +468,8 @@ def read_csv(
             try:
                 v = float(cell)
             except ValueError:
-                shown = cell if cell else "(empty)"
-                raise InputError(
-                    f"{where}, line {lineno}, column '{col}': '{shown}' is not a number"
-                ) from None
+                problem = f"'{cell}' is not a number" if cell else "the cell is empty"
+                raise InputError(f"{where}, line {lineno}, column '{col}': {problem}") from None
             if not math.isfinite(v):
                 raise InputError(f"{where}, line {lineno}, column '{col}': value is {cell}, "
                                  "not a finite number")

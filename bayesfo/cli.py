@@ -1,0 +1,196 @@
+"""The ``bayesfo`` command line.
+
+Exit status 0 on success, 2 on bad input (one line on stderr naming the file, column, row or
+argument), 1 on an internal error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from . import __version__
+from .errors import InputError
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message):
+        raise InputError(f"{message} (see '{self.prog} --help')")
+
+
+def _add_data_options(p):
+    p.add_argument("data", metavar="DATA", help="CSV file with omega|freq and the response columns")
+    p.add_argument("--kind", choices=("compliance", "modulus", "generic"),
+                   help="what the response is (default: the file's '# kind:' line, else generic)")
+    p.add_argument("--reciprocal", action="store_true",
+                   help="use 1/G of the data (sigma propagated)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="bayesfo",
+        description="Uncertainty-aware model choice for fractional-order transfer functions.",
+    )
+    parser.add_argument("--version", action="version", version=f"bayesfo {__version__}")
+    parser.add_argument("--models", action="append", default=[], metavar="PATH",
+                        help="extra structure card (.toml) or directory of cards; repeatable")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("inspect", help="read and check a data file; show what it holds")
+    _add_data_options(p)
+    p.add_argument("--structures", default=None,
+                   help="comma list of structures to check the data against (e.g. voigt,zener,max3)")
+    p.add_argument("--holdout", default=None, metavar="W1,W2",
+                   help="angular frequencies [rad/s] to hold out for validation")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+    p = sub.add_parser("structures", help="list the available structures with priors")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+    p = sub.add_parser("extract", help="sine records (one per frequency) -> frequency response CSV")
+    p.add_argument("records", nargs="+", metavar="RECORD",
+                   help="CSV with time,input,output[,series] and '# omega:' or '# freq:'")
+    p.add_argument("--out", required=True, metavar="FILE.csv", help="output CSV")
+    p.add_argument("--kind", choices=("compliance", "modulus", "generic"), default="generic")
+    p.add_argument("--harmonics", type=int, default=5, help="highest harmonic reported (default 5)")
+    p.add_argument("--threshold", type=float, default=0.05,
+                   help="harmonic ratio above which a record is flagged as nonlinear (default 0.05)")
+    return parser
+
+
+def _read(args):
+    from .data import read_csv
+
+    data = read_csv(args.data, kind=args.kind)
+    if args.reciprocal:
+        data = data.reciprocal()
+    return data
+
+
+def _library(args):
+    from .structures import default_library, load_library
+
+    return load_library(extra=args.models) if args.models else default_library()
+
+
+def _parse_floats(text: str, option: str) -> list[float]:
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"{option} takes comma-separated numbers, got {text!r}") from None
+
+
+def cmd_inspect(args) -> int:
+    from .structures import resolve_structures
+
+    data = _read(args)
+    info = data.to_dict()
+    info.update(
+        omega_ref=data.omega_ref,
+        g_ref=data.g_ref,
+        magnitude_min=float(data.magnitude.min()),
+        magnitude_max=float(data.magnitude.max()),
+    )
+    if args.holdout:
+        train, test = data.split(_parse_floats(args.holdout, "--holdout"))
+        info["holdout"] = test.omega.tolist()
+        data = train
+    if args.structures:
+        structures = resolve_structures(args.structures, _library(args))
+        for s in structures:
+            s.check_data(data)
+        info["structures"] = {s.name: s.n_params for s in structures}
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    print(f"{info['name']}: {info['n_frequencies']} frequencies, "
+          f"{info['omega_min']:.4g} to {info['omega_max']:.4g} rad/s, kind {info['kind']}"
+          + (f", units {info['units']}" if info["units"] else ""))
+    print(f"|G| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}; "
+          f"scaling omega_ref = {info['omega_ref']:.4g} rad/s, g_ref = {info['g_ref']:.4g}")
+    print("sigma: " + ("given per point" if info["has_sigma"] else "not given (estimated when fitting)"))
+    for note in info["notes"]:
+        print(f"note: {note}")
+    if "holdout" in info:
+        print("held out: " + ", ".join(f"{w:.4g}" for w in info["holdout"]) + " rad/s")
+    if "structures" in info:
+        print("structures (parameters): "
+              + ", ".join(f"{k} ({v})" for k, v in info["structures"].items()))
+    return 0
+
+
+def cmd_structures(args) -> int:
+    library = _library(args)
+    if args.json:
+        print(json.dumps([s.describe() for s in library.values()], indent=2))
+        return 0
+    width = max(len(n) for n in library)
+    for s in library.values():
+        priors = ", ".join(f"{p.name}~{p.prior.describe()}" for p in s.parameters)
+        print(f"{s.name:<{width}}  {s.formula}")
+        print(f"{'':<{width}}  priors: {priors}")
+    return 0
+
+
+def cmd_extract(args) -> int:
+    from .timeseries import extract_frequency_response, write_extraction
+
+    if args.harmonics < 2:
+        raise InputError(f"--harmonics must be at least 2, got {args.harmonics}")
+    if not args.threshold > 0:
+        raise InputError(f"--threshold must be positive, got {args.threshold}")
+    fr, analyses = extract_frequency_response(
+        args.records, kind=args.kind, n_harmonics=args.harmonics,
+        nonlinearity_threshold=args.threshold,
+    )
+    write_extraction(args.out, fr, analyses)
+    print(f"{'omega [rad/s]':>14} {'gain':>12} {'phase [deg]':>12} {'THD':>8}  linear")
+    for a in analyses:
+        print(f"{a.omega:14.6g} {a.gain:12.6g} {a.phase_deg:12.4f} {a.thd_output:8.4f}  "
+              + ("no" if a.nonlinear else "yes"))
+    print(f"wrote {args.out}")
+    return 0
+
+
+COMMANDS = {"inspect": cmd_inspect, "structures": cmd_structures, "extract": cmd_extract}
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None):
+    print(f"bayesfo: warning: {message}", file=sys.stderr)
+
+
+def main(argv=None) -> int:
+    """Run the command line; returns the exit status."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return 2
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            np.seterr(all="ignore")
+            return COMMANDS[args.command](args)
+    except InputError as exc:
+        print(f"bayesfo: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("bayesfo: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # the contract: exit 1 on internal errors, no traceback by default
+        if os.environ.get("BAYESFO_DEBUG"):
+            raise
+        print(f"bayesfo: internal error: {type(exc).__name__}: {exc} "
+              "(set BAYESFO_DEBUG=1 for a traceback)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

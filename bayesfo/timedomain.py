@@ -1,0 +1,423 @@
+"""Time-domain validation of fractional-order transfer functions (thesis §4.3.3).
+
+A fractional-order model identified in the frequency domain is validated in the time domain by
+driving it with a measured input and comparing its output with the measured output. The model
+is simulated through a rational (integer-order) approximation valid on a frequency band
+``[omega_low, omega_high]``: every power ``s**alpha`` is replaced by Oustaloup's recursive
+filter, after which the ordinary machinery of :mod:`scipy.signal` applies.
+
+Three layers, each usable on its own:
+
+* :func:`oustaloup` -- zeros, poles and gain approximating ``s**alpha`` on a band;
+* :func:`rational_approximation` -- a ratio of sums of power terms as a
+  :class:`scipy.signal.TransferFunction`;
+* :func:`simulate` -- the response to a sampled input, with a default band derived from the time
+  grid.
+
+References
+----------
+A. Oustaloup, F. Levron, B. Mathieu, F. M. Nanot, "Frequency-band complex noninteger
+differentiator: characterization and synthesis", IEEE Trans. Circuits Syst. I 47 (2000) 25-39.
+Thesis §4.3.3 (model validation in the time domain), eq. for G_f(s) and omega_k^±.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import polynomial as P
+from scipy import signal
+
+from bayesfo.errors import InputError
+
+__all__ = [
+    "oustaloup",
+    "rational_approximation",
+    "simulate",
+    "default_band",
+]
+
+# Exponents closer than this to an integer are treated as that integer, so that values such as
+# 1.0000000000000002 produced by arithmetic do not create a spurious Oustaloup filter of order ~0.
+_INTEGER_TOL = 1e-12
+
+# Relative tolerance on the spacing of the time grid; lsim needs an equally spaced grid.
+_SAMPLING_RTOL = 1e-6
+
+
+# --------------------------------------------------------------------------------------------
+# argument checks
+# --------------------------------------------------------------------------------------------
+def _check_real(name: str, value) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"argument {name!r} must be a real number, got {value!r}") from None
+    if isinstance(value, complex) or not math.isfinite(out):
+        raise InputError(f"argument {name!r} must be a finite real number, got {value!r}")
+    return out
+
+
+def _check_band(omega_low, omega_high) -> tuple[float, float]:
+    lo = _check_real("omega_low", omega_low)
+    hi = _check_real("omega_high", omega_high)
+    if lo <= 0.0:
+        raise InputError(f"argument 'omega_low' must be > 0 rad/s, got {lo!r}")
+    if hi <= lo:
+        raise InputError(
+            f"argument 'omega_high' ({hi!r} rad/s) must be larger than 'omega_low' ({lo!r} rad/s)"
+        )
+    return lo, hi
+
+
+def _check_order(order) -> int:
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)):
+        raise InputError(f"argument 'order' must be an integer >= 1, got {order!r}")
+    if order < 1:
+        raise InputError(f"argument 'order' must be an integer >= 1, got {order!r}")
+    return int(order)
+
+
+def _split_exponent(alpha: float) -> tuple[int, float]:
+    """Integer part (towards zero) and fractional part in (-1, 1) of an exponent."""
+    nearest = round(alpha)
+    if abs(alpha - nearest) <= _INTEGER_TOL * max(1.0, abs(alpha)):
+        return int(nearest), 0.0
+    n = math.trunc(alpha)
+    return n, alpha - n
+
+
+# --------------------------------------------------------------------------------------------
+# Oustaloup filter
+# --------------------------------------------------------------------------------------------
+def _oustaloup_fraction(
+    frac: float, omega_low: float, omega_high: float, order: int
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Oustaloup filter for ``s**frac`` with ``0 < |frac| < 1`` (thesis §4.3.3)."""
+    k = np.arange(-order, order + 1, dtype=float)
+    ratio = omega_high / omega_low
+    width = 2 * order + 1
+    omega_zero = omega_low * ratio ** ((k + order + 0.5 * (1.0 - frac)) / width)
+    omega_pole = omega_low * ratio ** ((k + order + 0.5 * (1.0 + frac)) / width)
+    return -omega_zero, -omega_pole, omega_high**frac
+
+
+def oustaloup(alpha, omega_low, omega_high, order=5):
+    r"""Oustaloup's rational approximation of :math:`s^\alpha` on a frequency band.
+
+    The fractional part :math:`\nu` of ``alpha`` (split towards zero, so ``alpha = n + nu`` with
+    integer ``n`` and :math:`-1 < \nu < 1`) is approximated by
+
+    .. math::
+        s^\nu \approx \omega_h^\nu \prod_{k=-N}^{N} \frac{s + \omega_k^-}{s + \omega_k^+},\qquad
+        \omega_k^\pm = \omega_l \left(\frac{\omega_h}{\omega_l}\right)^
+        {\frac{k + N + (1 \pm \nu)/2}{2N + 1}},
+
+    and the integer part :math:`s^n` is represented exactly by ``n`` zeros (``n > 0``) or ``-n``
+    poles (``n < 0``) at the origin. An integer ``alpha`` is therefore reproduced exactly.
+    Splitting towards zero keeps a negative fractional order such as ``-0.5`` free of a pole at
+    the origin, which a simulation would turn into an integrator.
+
+    Inside the band the approximation is accurate away from its edges: with ``order >= 5``,
+    measured over ``0.05 <= nu <= 0.95`` and a band of six decades, the magnitude error is below
+    1e-3 (relative) and the phase error below 0.6 degree for
+    ``100 * omega_low <= omega <= omega_high / 100``; within a decade of the edges the phase error
+    reaches about 5 degrees whatever the order, because the phase at one frequency depends on the
+    slope of the magnitude over the whole axis.
+
+    Parameters
+    ----------
+    alpha : float
+        Exponent of ``s``; any finite real number.
+    omega_low, omega_high : float
+        Band of the approximation in rad/s, ``0 < omega_low < omega_high``.
+    order : int, optional
+        Filter order ``N >= 1``; the fractional part uses ``2 N + 1`` zero/pole pairs.
+
+    Returns
+    -------
+    zeros : numpy.ndarray
+        Zeros in rad/s (real, non-positive).
+    poles : numpy.ndarray
+        Poles in rad/s (real, non-positive).
+    gain : float
+        Gain ``k`` such that the approximation is ``k * prod(s - zeros) / prod(s - poles)``; the
+        triple can be passed to :class:`scipy.signal.ZerosPolesGain`.
+
+    Raises
+    ------
+    InputError
+        If ``alpha`` is not a finite real number, the band is empty or not positive, or ``order``
+        is not an integer >= 1.
+
+    References
+    ----------
+    Thesis §4.3.3, Oustaloup filter G_f(s); A. Oustaloup et al., IEEE Trans. Circuits Syst. I 47
+    (2000) 25-39.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> z, p, k = oustaloup(0.5, 1e-3, 1e3, order=5)
+    >>> w = 1.0
+    >>> approx = k * np.prod(1j * w - z) / np.prod(1j * w - p)
+    >>> bool(abs(approx / (1j * w) ** 0.5 - 1) < 2e-3)
+    True
+    """
+    a = _check_real("alpha", alpha)
+    lo, hi = _check_band(omega_low, omega_high)
+    n_order = _check_order(order)
+    n, frac = _split_exponent(a)
+    if frac == 0.0:
+        zeros, poles, gain = np.empty(0), np.empty(0), 1.0
+    else:
+        zeros, poles, gain = _oustaloup_fraction(frac, lo, hi, n_order)
+    if n > 0:
+        zeros = np.concatenate([zeros, np.zeros(n)])
+    elif n < 0:
+        poles = np.concatenate([poles, np.zeros(-n)])
+    return zeros, poles, float(gain)
+
+
+# --------------------------------------------------------------------------------------------
+# sums of power terms as rational functions
+# --------------------------------------------------------------------------------------------
+def _check_terms(name: str, terms) -> list[tuple[float, float]]:
+    """Validate a sequence of ``(coefficient, exponent)`` pairs."""
+    if isinstance(terms, (str, bytes)) or not isinstance(terms, Sequence | np.ndarray):
+        raise InputError(
+            f"argument {name!r} must be a sequence of (coefficient, exponent) pairs, "
+            f"got {type(terms).__name__}"
+        )
+    out = []
+    for i, term in enumerate(terms):
+        try:
+            c, e = term
+        except (TypeError, ValueError):
+            raise InputError(
+                f"argument {name!r}: term {i} must be a (coefficient, exponent) pair, got {term!r}"
+            ) from None
+        c = _check_real(f"{name}[{i}] coefficient", c)
+        e = _check_real(f"{name}[{i}] exponent", e)
+        if e < 0.0:
+            raise InputError(f"argument {name!r}: term {i} has exponent {e!r}; exponents must be >= 0")
+        if c != 0.0:
+            out.append((c, e))
+    if not out:
+        raise InputError(f"argument {name!r} has no nonzero term")
+    return out
+
+
+@dataclass(frozen=True)
+class _Scaled:
+    """``H(s) = num(s / omega_c) / den(s / omega_c)``, coefficients ascending in ``x = s/omega_c``.
+
+    Working in the scaled variable puts the Oustaloup corner frequencies symmetrically around 1,
+    which keeps the polynomial coefficients within a few orders of magnitude of each other.
+    """
+
+    num: np.ndarray
+    den: np.ndarray
+    omega_c: float
+
+
+def _sum_of_powers(terms, lo_x: float, hi_x: float, order: int, omega_c: float):
+    """Numerator (ascending in x) and Oustaloup denominators of ``sum c s**e``.
+
+    Terms sharing a fractional part share one Oustaloup denominator, so the common denominator
+    only grows with the number of distinct fractional parts.
+    """
+    groups: dict[float, list[tuple[float, int]]] = {}
+    for c, e in terms:
+        n, frac = _split_exponent(e)
+        # s**e = omega_c**e * x**e in the scaled variable
+        groups.setdefault(round(frac, 12), []).append((c * omega_c**e, n))
+    fracs = sorted(groups)
+    filters = {}
+    for f in fracs:
+        if f == 0.0:
+            filters[f] = (np.ones(1), np.ones(1), 1.0)
+        else:
+            z, p, g = _oustaloup_fraction(f, lo_x, hi_x, order)
+            filters[f] = (P.polyfromroots(z).real, P.polyfromroots(p).real, g)
+    numerator = np.zeros(1)
+    for f in fracs:
+        pz, _, g = filters[f]
+        inner = np.zeros(1)
+        for c, n in groups[f]:
+            inner = P.polyadd(inner, np.concatenate([np.zeros(n), c * g * pz]))
+        for other in fracs:
+            if other != f:
+                inner = P.polymul(inner, filters[other][1])
+        numerator = P.polyadd(numerator, inner)
+    denominators = {f: filters[f][1] for f in fracs if f != 0.0}
+    return numerator, denominators
+
+
+def _scaled_rational(numerator, denominator, omega_low, omega_high, order) -> _Scaled:
+    num_terms = _check_terms("numerator", numerator)
+    den_terms = _check_terms("denominator", denominator)
+    lo, hi = _check_band(omega_low, omega_high)
+    n_order = _check_order(order)
+    omega_c = math.sqrt(lo * hi)
+    lo_x, hi_x = lo / omega_c, hi / omega_c
+    pn, qn = _sum_of_powers(num_terms, lo_x, hi_x, n_order, omega_c)
+    pd, qd = _sum_of_powers(den_terms, lo_x, hi_x, n_order, omega_c)
+    # (pn / qn) / (pd / qd) = pn * qd / (qn * pd); Oustaloup denominators common to both sides
+    # cancel exactly, which keeps the order down (e.g. s**0.5 / (1 + s**0.5)).
+    num = pn
+    for f, q in qd.items():
+        if f not in qn:
+            num = P.polymul(num, q)
+    den = pd
+    for f, q in qn.items():
+        if f not in qd:
+            den = P.polymul(den, q)
+    num = _trim(num)
+    den = _trim(den)
+    if not np.any(den):
+        raise InputError("argument 'denominator' sums to the zero polynomial")
+    # common factors x**k (zeros and poles at the origin) cancel exactly
+    k = min(_lowest_power(num), _lowest_power(den))
+    num, den = num[k:], den[k:]
+    scale = np.max(np.abs(den))
+    return _Scaled(num / scale, den / scale, omega_c)
+
+
+def _trim(c: np.ndarray) -> np.ndarray:
+    c = np.asarray(c, dtype=float)
+    nz = np.flatnonzero(c)
+    if nz.size == 0:
+        return np.zeros(1)
+    return c[: nz[-1] + 1]
+
+
+def _lowest_power(c: np.ndarray) -> int:
+    nz = np.flatnonzero(c)
+    return int(nz[0]) if nz.size else 0
+
+
+def _unscale(c: np.ndarray, omega_c: float) -> np.ndarray:
+    """Ascending coefficients in x = s/omega_c -> descending coefficients in s."""
+    powers = np.arange(c.size, dtype=float)
+    return (c * omega_c ** (-powers))[::-1]
+
+
+def rational_approximation(numerator, denominator, omega_low, omega_high, order=5):
+    r"""Rational approximation of a ratio of sums of power terms of ``s``.
+
+    The transfer function
+
+    .. math::
+        G(s) = \frac{\sum_i b_i s^{\beta_i}}{\sum_j a_j s^{\alpha_j}}
+
+    is approximated by replacing every non-integer power with its Oustaloup filter
+    (:func:`oustaloup`) on ``[omega_low, omega_high]``; integer powers are kept exact. Terms with
+    the same fractional part of the exponent share one filter, Oustaloup denominators common to
+    numerator and denominator cancel, and the sums are formed with polynomial arithmetic on a
+    common denominator. The polynomial order is ``(2 N + 1)`` times the number of distinct
+    fractional parts, plus the integer parts.
+
+    The polynomials are formed in the scaled variable ``s / sqrt(omega_low * omega_high)``, where
+    the corner frequencies are symmetric about 1, and converted to ``s`` only at the end.
+
+    Parameters
+    ----------
+    numerator, denominator : sequence of (float, float)
+        Power terms ``(coefficient, exponent)`` meaning ``sum(c * s**e)``; exponents are real
+        and >= 0, coefficients real. Zero coefficients are ignored.
+    omega_low, omega_high : float
+        Band of the approximation in rad/s.
+    order : int, optional
+        Oustaloup order ``N`` (``2 N + 1`` zero/pole pairs per fractional part).
+
+    Returns
+    -------
+    scipy.signal.TransferFunction
+        The rational approximation in ``s``. Its coefficients can span many orders of magnitude
+        for wide bands (they are powers of the corner frequencies); :func:`simulate` therefore
+        works on the scaled form instead of this object.
+
+    Raises
+    ------
+    InputError
+        If a term is not a pair of finite reals, an exponent is negative, a side has no nonzero
+        term, or the band or order is invalid.
+
+    References
+    ----------
+    Thesis §4.3.3 (time-domain validation with the Oustaloup filter, MATLAB ``oustapp``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tf = rational_approximation([(1.0, 0.0)], [(1.0, 0.0), (1.0, 0.5)], 1e-4, 1e4)
+    >>> _, h = tf.freqresp([1.0])
+    >>> bool(abs(h[0] * (1 + (1j) ** 0.5) - 1) < 1e-3)
+    True
+    """
+    scaled = _scaled_rational(numerator, denominator, omega_low, omega_high, order)
+    return signal.TransferFunction(
+        _unscale(scaled.num, scaled.omega_c), _unscale(scaled.den, scaled.omega_c)
+    )
+
+
+def evaluate_power_terms(numerator, denominator, omega) -> np.ndarray:
+    """Exact ``G(j omega)`` of a ratio of sums of power terms (no approximation).
+
+    Parameters
+    ----------
+    numerator, denominator : sequence of (float, float)
+        Power terms ``(coefficient, exponent)`` as in :func:`rational_approximation`.
+    omega : array_like
+        Angular frequencies in rad/s, > 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex ``G(j omega)``, principal branch ``(j omega)**e = omega**e exp(j e pi / 2)``.
+
+    Raises
+    ------
+    InputError
+        If a term is invalid or ``omega`` has non-positive or non-finite values.
+
+    References
+    ----------
+    Thesis §2.3 (fractional-order LTI systems, transfer function with s = j omega).
+    """
+    num_terms = _check_terms("numerator", numerator)
+    den_terms = _check_terms("denominator", denominator)
+    w = np.asarray(omega, dtype=float)
+    if not np.all(np.isfinite(w)) or np.any(w <= 0):
+        raise InputError("argument 'omega' must hold finite values > 0 rad/s")
+    jw = 1j * w
+
+    def total(terms):
+        return sum(c * jw**e for c, e in terms)
+
+    return total(num_terms) / total(den_terms)
+
+
+# --------------------------------------------------------------------------------------------
+# simulation
+# --------------------------------------------------------------------------------------------
+def default_band(t) -> tuple[float, float]:
+    """Default Oustaloup band for a simulation on the time grid ``t``.
+
+    Placeholder; set below after measurement.
+    """
+    raise NotImplementedError
+
+
+def _state_space(scaled: _Scaled):
+    """Realisation of the scaled rational function as a cascade of low-order sections."""
+    raise NotImplementedError
+
+
+def simulate(numerator, denominator, t, u, *, omega_low=None, omega_high=None, order=5):
+    """Placeholder."""
+    raise NotImplementedError

@@ -1,0 +1,1 @@
+"""Structure cards shipped with bayesfo (one TOML file per structure family)."""

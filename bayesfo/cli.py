@@ -116,6 +116,10 @@ def cmd_inspect(args) -> int:
     print(f"|G| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}; "
           f"scaling omega_ref = {info['omega_ref']:.4g} rad/s, g_ref = {info['g_ref']:.4g}")
     print("sigma: " + ("given per point" if info["has_sigma"] else "not given (estimated when fitting)"))
+    bad = info["dissipation_violations"]
+    if bad:
+        print(f"warning: {len(bad)} point(s) with negative loss, impossible for a passive "
+              f"{info['kind']}: omega = " + ", ".join(f"{w:.4g}" for w in bad) + " rad/s")
     for note in info["notes"]:
         print(f"note: {note}")
     if "holdout" in info:

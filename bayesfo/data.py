@@ -178,6 +178,17 @@ class FrequencyResponse:
         """Text naming the data for error messages ("file 'x.csv'" or "data 'name'")."""
         return f"file '{self.source}'" if self.source else f"data '{self.label}'"
 
+    def dissipation_violations(self) -> np.ndarray:
+        """Indices of points whose loss has the wrong sign for the kind (none for generic).
+
+        A compliance must have Im J ≤ 0 and a modulus Im G ≥ 0; a measured point that violates
+        this is an instrument artefact or noise that no passive structure can fit.
+        """
+        sign = {"compliance": -1.0, "modulus": 1.0}.get(self.kind)
+        if sign is None:
+            return np.array([], dtype=int)
+        return np.flatnonzero(sign * self.response.imag < 0)
+
     # ------------------------------------------------------------------ derived responses
     def sorted(self) -> FrequencyResponse:
         """The same response with frequencies in increasing order."""
@@ -341,6 +352,7 @@ class FrequencyResponse:
             "omega_min": float(self.omega.min()),
             "omega_max": float(self.omega.max()),
             "has_sigma": self.sigma is not None,
+            "dissipation_violations": self.omega[self.dissipation_violations()].tolist(),
             "notes": list(self.notes),
         }
 

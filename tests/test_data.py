@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -233,3 +236,19 @@ def test_cli_too_few_points_and_zero_reciprocal(write_csv, run_cli):
     assert status == 2 and "zero at omega = 2 rad/s" in err
     status, out, _ = run_cli("inspect", path, "--structures", "voigt", "--json")
     assert status == 0 and '"voigt": 3' in out
+
+
+def test_dissipation_violations_follow_kind():
+    fr = FrequencyResponse([1.0, 2.0, 3.0], [1 + 0.1j, 1 - 0.2j, 1 + 0j], kind="modulus")
+    np.testing.assert_array_equal(fr.dissipation_violations(), [1])
+    np.testing.assert_array_equal(fr.with_kind("compliance").dissipation_violations(), [0])
+    assert fr.with_kind("generic").dissipation_violations().size == 0
+
+
+def test_cli_inspect_reports_negative_loss_of_bundled_glassy_isotherm(run_cli):
+    # The -40 °C isotherm of the 3M 468MP data has one negative G'' (a known artefact).
+    path = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tm040C.csv"
+    status, out, _ = run_cli("inspect", path, "--json")
+    info = json.loads(out)
+    assert status == 0 and info["n_frequencies"] == 17 and info["kind"] == "modulus"
+    assert len(info["dissipation_violations"]) == 1

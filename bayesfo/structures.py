@@ -36,8 +36,9 @@ Constraints
 -----------
 ``stable``
     Matignon's theorem (thesis Theorem 3) on the denominator, which must be a polynomial in
-    λ = s^p for one exponent parameter p. A root at λ = 0 is an integrator (Maxwell compliance,
-    dashpot), not an instability, and is accepted.
+    λ = s^p for one exponent parameter p, and for compliance and modulus data also on the
+    numerator (the reciprocal of a passive material response is a stable response too). A root
+    at λ = 0 is an integrator (Maxwell compliance, dashpot), not an instability, and is accepted.
 ``passive``
     Dissipation ≥ 0 of the response compared with the data (Im J ≤ 0 for a compliance,
     Im G ≥ 0 for a modulus; nothing for generic data), on a dense grid reaching decades beyond
@@ -447,18 +448,24 @@ class Structure:
             ok &= p.prior.contains(theta2[:, i])
         return ok if np.ndim(theta) == 2 else ok[0]
 
-    def stable(self, theta) -> np.ndarray:
-        """Matignon stability of the denominator (integrators accepted); True if not declared."""
+    def stable(self, theta, kind: str = "generic") -> np.ndarray:
+        """Matignon stability (thesis Theorem 3) of the poles, and for materials of the zeros.
+
+        The poles (roots of the denominator) are always tested. For compliance and modulus data
+        the zeros are tested too: a passive material has a compliance whose reciprocal, the
+        modulus, is again a stable response, so a root of the numerator in the unstable region
+        is as unphysical as a pole there. Roots at λ = 0 (integrators) are accepted. A side
+        that is not a polynomial in one s^p is not tested.
+        """
         vals, single = self.values(theta)
         n_sets = np.atleast_2d(np.asarray(theta, float)).shape[0]
-        p = _polynomial_order(self.denominator)
-        if p is None:
-            ok = np.ones(n_sets, dtype=bool)
-        elif p == "":
-            ok = np.ones(n_sets, dtype=bool)  # constant denominator: no poles
-        else:
-            a = self._polynomial(self.denominator, vals, n_sets)
-            ok = matignon_stable(a, vals[p], allow_integrator=True)
+        ok = np.ones(n_sets, dtype=bool)
+        sides = [self.denominator] + ([self.numerator] if kind in ("compliance", "modulus") else [])
+        for terms in sides:
+            p = _polynomial_order(terms)
+            if p:  # None: not a polynomial; "": a constant, without roots
+                poly = self._polynomial(terms, vals, n_sets)
+                ok &= matignon_stable(poly, vals[p], allow_integrator=True)
         return ok[0] if single else ok
 
     def passive(self, theta, kind: str, omega_grid) -> np.ndarray:
@@ -488,7 +495,7 @@ class Structure:
                 ok &= c.holds(vals)
         names = {c for c in self.constraints if isinstance(c, str)}
         if "stable" in names and ok.any():
-            ok &= np.atleast_1d(self.stable(np.atleast_2d(theta)))
+            ok &= np.atleast_1d(self.stable(np.atleast_2d(theta), kind))
         if "passive" in names and kind != "generic" and ok.any():
             grid = dissipation_grid(1.0, 1.0) if omega_grid is None else omega_grid
             rows = np.flatnonzero(ok)

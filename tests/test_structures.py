@@ -149,6 +149,12 @@ def test_admissible_rejects_each_constraint():
     # An unstable max-order member: 1 - 0.5 λ has a root on the positive real axis.
     assert not LIB["max-n1m0"].admissible([-0.5, 1.0, 0.5], "generic")
     assert LIB["max-n1m0"].admissible([0.5, 1.0, 0.5], "generic")
+    # For material data the zeros must be stable too: b0 + b1 λ with b1 < 0 has a zero at
+    # λ = -b0/b1 > 0, so the modulus 1/J would have an unstable pole. Generic data allow it.
+    theta = [0.5, 1.0, -0.2, 0.5]
+    assert LIB["max-n1m1"].stable(theta, "generic") and not LIB["max-n1m1"].stable(theta, "modulus")
+    assert not LIB["max-n1m1"].admissible(theta, "compliance")
+    assert LIB["max-n1m1"].admissible(theta, "generic")
     # Inverted structures keep stability (integrators allowed) and passivity.
     inv = LIB["voigt-inv"]
     assert inv.admissible([1.0, 1.0, 0.5], "compliance") == bool(

@@ -1,0 +1,250 @@
+"""Multi-start nonlinear least squares of a structure on a frequency response (thesis §3.3).
+
+The complex residual between data and structure is formed on the scaled data (ω/ω_ref,
+G/g_ref), real and imaginary parts stacked once, and minimised with scipy's trust-region
+reflective least squares from several starts drawn from the prior. Coefficients with
+log-uniform priors are optimised in log space, so positivity holds by construction and the
+prior bounds become box bounds. Optima outside the support of the posterior (unstable, not
+dissipative, or violating a card inequality) are rejected; the best admissible optimum is
+returned, and how many starts reached it is reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from ..data import FrequencyResponse
+from ..errors import InputError
+from ..priors import LogUniform
+from ..response import dissipation_grid
+from ..structures import Scaling, Structure
+
+WEIGHTINGS = ("auto", "sigma", "relative", "none")
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """The outcome of :func:`fit_structure`.
+
+    Attributes
+    ----------
+    structure : str
+        Structure name.
+    param_names : tuple of str
+    theta : ndarray
+        Best admissible parameters in physical units (NaN if no start reached an admissible
+        optimum; see ``admissible``).
+    theta_scaled : ndarray
+        The same parameters of the scaled problem.
+    rmse : float
+        (1/N)·sqrt(Σ|G_k − Ĝ_k|²) in physical units (thesis eq. (3.23)).
+    chi2 : float
+        Minimised weighted sum of squares (real and imaginary parts).
+    weighting : str
+        ``"sigma"`` (1/σ_k), ``"relative"`` (1/|G_k|) or ``"none"``.
+    admissible : bool
+        Whether the returned optimum satisfies every constraint of the structure.
+    n_starts, n_admissible, n_at_best : int
+        Starts run, starts that ended admissible, and admissible starts within 1e-6 (relative)
+        of the best cost: a measure of how reliably the optimum is found.
+    optima : ndarray, shape (k, n_params)
+        Distinct admissible local optima (scaled), best first: the modes that seed the sampler.
+    """
+
+    structure: str
+    param_names: tuple[str, ...]
+    theta: np.ndarray
+    theta_scaled: np.ndarray
+    rmse: float
+    chi2: float
+    weighting: str
+    admissible: bool
+    n_starts: int
+    n_admissible: int
+    n_at_best: int
+    optima: np.ndarray = field(repr=False)
+
+    def to_dict(self) -> dict:
+        return {
+            "structure": self.structure,
+            "parameters": dict(zip(self.param_names, map(float, self.theta))),
+            "rmse": self.rmse,
+            "chi2": self.chi2,
+            "weighting": self.weighting,
+            "admissible": self.admissible,
+            "n_starts": self.n_starts,
+            "n_admissible": self.n_admissible,
+            "n_at_best": self.n_at_best,
+        }
+
+
+def choose_weighting(data: FrequencyResponse, weighting: str = "auto") -> str:
+    """Resolve ``"auto"``: 1/σ if the data carry σ, else relative (1/|G|) when |G| spans more
+    than a decade, else unweighted."""
+    if weighting not in WEIGHTINGS:
+        raise InputError(f"argument 'weighting' must be one of {', '.join(WEIGHTINGS)}, got {weighting!r}")
+    if weighting == "sigma" and data.sigma is None:
+        raise InputError(f"weighting 'sigma' needs sigma in {data.where()}")
+    if weighting != "auto":
+        return weighting
+    if data.sigma is not None:
+        return "sigma"
+    mag = data.magnitude
+    return "relative" if mag.max() > 10 * mag.min() else "none"
+
+
+class _Problem:
+    """Scaled least-squares problem in optimiser coordinates u (log for log-uniform priors)."""
+
+    def __init__(self, structure: Structure, data: FrequencyResponse, weighting: str):
+        self.s = structure
+        self.kind = data.kind
+        self.scaling = Scaling.from_data(data)
+        self.w = data.omega / self.scaling.omega_ref
+        self.g = data.response / self.scaling.g_ref
+        if weighting == "sigma":
+            wt = self.scaling.g_ref / data.sigma
+        elif weighting == "relative":
+            wt = 1.0 / np.abs(self.g)
+        else:
+            wt = np.ones_like(self.w)
+        self.wt = wt
+        self.log = np.array([isinstance(p.prior, LogUniform) for p in structure.parameters])
+        lo, hi = np.array([p.prior.bounds for p in structure.parameters], dtype=float).T
+        self.lo = np.where(self.log, np.log(lo, where=self.log, out=np.ones_like(lo)), lo)
+        self.hi = np.where(self.log, np.log(hi, where=self.log, out=np.ones_like(hi)), hi)
+        self.grid = dissipation_grid(self.w.min(), self.w.max())
+
+    def theta(self, u):
+        return np.where(self.log, np.exp(u), u)
+
+    def residuals_many(self, u):
+        """Stacked weighted residuals for many points u, shape (n_sets, 2N)."""
+        model = self.s.response(self.theta(u), self.w, self.kind)
+        r = (model - self.g) * self.wt
+        return np.concatenate([r.real, r.imag], axis=-1)
+
+    def fun(self, u):
+        r = self.residuals_many(u[None, :])[0]
+        return np.where(np.isfinite(r), r, 1e10)
+
+    def jac(self, u):
+        # Forward differences evaluated as one vectorised batch of n+1 parameter sets.
+        h = 1e-7 * np.maximum(1.0, np.abs(u))
+        pts = np.vstack([u, u + np.diag(h)])
+        r = self.residuals_many(pts)
+        r = np.where(np.isfinite(r), r, 1e10)
+        return ((r[1:] - r[0]) / h[:, None]).T
+
+
+def fit_structure(
+    structure: Structure,
+    data: FrequencyResponse,
+    *,
+    n_starts: int = 24,
+    rng: np.random.Generator | int | None = 0,
+    weighting: str = "auto",
+    starts=None,
+) -> FitResult:
+    """Fit ``structure`` to ``data`` by multi-start bounded least squares.
+
+    Parameters
+    ----------
+    structure : Structure
+    data : FrequencyResponse
+    n_starts : int
+        Random starts: uniform over the central 90 % of each prior range in optimiser
+        coordinates (log for log-uniform priors), except coefficients with uniform priors,
+        which start at positive magnitudes 10^U(-1.5, 1.5) on the scaled data.
+    rng : numpy.random.Generator or int or None
+        Source of the random starts (reproducible for a given seed).
+    weighting : {"auto", "sigma", "relative", "none"}
+        Residual weights; see :func:`choose_weighting`.
+    starts : array_like, shape (k, n_params), optional
+        Extra starts in physical units (e.g. from linear methods).
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    InputError
+        If the data have fewer points than the structure has parameters, or an argument is bad.
+
+    References
+    ----------
+    Thesis §3.3 (Problem 5) and §3.4.2.
+    """
+    structure.check_data(data)
+    if n_starts < 1:
+        raise InputError(f"argument 'n_starts' must be at least 1, got {n_starts}")
+    rng = np.random.default_rng(rng)
+    weighting = choose_weighting(data, weighting)
+    prob = _Problem(structure, data, weighting)
+    span = prob.hi - prob.lo
+    u0 = prob.lo + span * (0.05 + 0.9 * rng.uniform(size=(n_starts, structure.n_params)))
+    # Coefficients with a uniform prior: on the scaled data they are of order one, so start
+    # them at magnitudes 10^U(-1.5, 1.5), positive (the physical sign of the material models),
+    # inside the bounds, rather than spread over the whole, mostly unphysical, prior range.
+    coef = np.array([p.role == "coefficient" for p in structure.parameters]) & ~prob.log
+    if coef.any():
+        mags = 10.0 ** rng.uniform(-1.5, 1.5, size=(n_starts, int(coef.sum())))
+        u0[:, coef] = np.clip(mags, prob.lo[coef] + 1e-9 * span[coef], prob.hi[coef] - 1e-9 * span[coef])
+    if starts is not None:
+        extra = structure.to_scaled(np.atleast_2d(np.asarray(starts, float)), prob.scaling)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            extra_u = np.where(prob.log, np.log(np.abs(extra)), extra)
+        extra_u = np.clip(extra_u, prob.lo + 1e-9 * span, prob.hi - 1e-9 * span)
+        u0 = np.vstack([extra_u[np.all(np.isfinite(extra_u), axis=1)], u0])
+
+    sols, costs = [], []
+    for u in u0:
+        res = optimize.least_squares(
+            prob.fun, u, jac=prob.jac, bounds=(prob.lo, prob.hi), method="trf",
+            x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400,
+        )
+        sols.append(res.x)
+        costs.append(2 * res.cost)
+    sols, costs = np.array(sols), np.array(costs)
+    thetas = prob.theta(sols)
+    ok = structure.admissible(thetas, data.kind, prob.grid) & np.isfinite(costs)
+    n_adm = int(ok.sum())
+    if n_adm:
+        idx = np.flatnonzero(ok)[np.argsort(costs[ok])]
+    else:
+        idx = np.argsort(costs)
+    best = idx[0]
+    # Scaled residuals are of order one, so 1e-12 is an absolute floor below any noise.
+    at_best = int(np.sum(ok & (costs <= costs[best] * (1 + 1e-6) + 1e-12)))
+    optima = _distinct(thetas[idx] if n_adm else thetas[:0])
+    theta_s = thetas[best]
+    theta_p = structure.to_physical(theta_s, prob.scaling)
+    model = structure.response(theta_p, data.omega, data.kind)
+    rmse = float(np.sqrt(np.sum(np.abs(data.response - model) ** 2)) / data.n_frequencies)
+    return FitResult(
+        structure=structure.name,
+        param_names=structure.param_names,
+        theta=theta_p,
+        theta_scaled=theta_s,
+        rmse=rmse,
+        chi2=float(costs[best]),
+        weighting=weighting,
+        admissible=bool(n_adm),
+        n_starts=len(u0),
+        n_admissible=n_adm,
+        n_at_best=at_best,
+        optima=optima,
+    )
+
+
+def _distinct(thetas: np.ndarray, rtol: float = 1e-3) -> np.ndarray:
+    """Keep the first of parameter vectors that agree within ``rtol`` (relative)."""
+    kept: list[np.ndarray] = []
+    for t in thetas:
+        if not any(np.allclose(t, k, rtol=rtol, atol=1e-8) for k in kept):
+            kept.append(t)
+    return np.array(kept).reshape(-1, thetas.shape[1] if thetas.ndim == 2 else 0)

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import polynomial as P
 from scipy import signal
+from scipy.linalg import lapack
 
 from bayesfo.errors import InputError
 
@@ -365,7 +366,7 @@ def rational_approximation(numerator, denominator, omega_low, omega_high, order=
     )
 
 
-def evaluate_power_terms(numerator, denominator, omega) -> np.ndarray:
+def _exact_response(numerator, denominator, omega) -> np.ndarray:
     """Exact ``G(j omega)`` of a ratio of sums of power terms (no approximation).
 
     Parameters
@@ -405,19 +406,215 @@ def evaluate_power_terms(numerator, denominator, omega) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 # simulation
 # --------------------------------------------------------------------------------------------
+# Default band relative to what the time grid resolves, [2 pi / duration, pi / dt]. Measured on
+# unit step responses of 1/(1 + s**q) (q = 0.2, 0.5, 0.8), a three-term fractional model and a
+# mixed integer/fractional one, each against a numerical Laplace inversion, for grids
+# (duration, dt) = (1 s, 1e-4 s), (10 s, 1e-2 s), (100 s, 0.1 s): the error grows linearly with
+# omega_low (a margin of 1e4 below 2 pi / duration gives up to 9e-5, 1e5 gives up to 2.5e-5) and
+# stops improving once omega_high is 1e3 above pi / dt. A step has the most low-frequency
+# content of the usual validation inputs, so these margins are conservative for sine or chirp
+# records.
+_LOW_MARGIN = 1e5
+_HIGH_MARGIN = 1e3
+# Two zero/pole pairs per decade: a third pair per decade changed the errors above by < 1e-5.
+_PAIRS_PER_DECADE = 2.0
+_MIN_ORDER = 5
+
+
 def default_band(t) -> tuple[float, float]:
     """Default Oustaloup band for a simulation on the time grid ``t``.
 
-    Placeholder; set below after measurement.
+    The grid resolves angular frequencies from ``2 pi / duration`` to the Nyquist frequency
+    ``pi / dt``. The band reaches five decades below the first and three decades above the
+    second, because an Oustaloup filter is inaccurate for about a decade next to each edge and the
+    slow tail of a fractional response depends on frequencies far below ``1 / duration``.
+
+    Parameters
+    ----------
+    t : array_like
+        Equally spaced sample times in seconds (at least two).
+
+    Returns
+    -------
+    omega_low, omega_high : float
+        Band in rad/s.
+
+    Raises
+    ------
+    InputError
+        If ``t`` is not a strictly increasing, equally spaced, finite 1-D grid of two or more
+        samples.
+
+    References
+    ----------
+    Thesis §4.3.3 (frequency set Omega of the Oustaloup filter).
     """
-    raise NotImplementedError
+    t = _check_grid(t)
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    duration = t[-1] - t[0] + dt
+    return 2.0 * np.pi / duration / _LOW_MARGIN, np.pi / dt * _HIGH_MARGIN
 
 
-def _state_space(scaled: _Scaled):
-    """Realisation of the scaled rational function as a cascade of low-order sections."""
-    raise NotImplementedError
+def _auto_order(omega_low: float, omega_high: float) -> int:
+    decades = math.log10(omega_high / omega_low)
+    return max(_MIN_ORDER, math.ceil((_PAIRS_PER_DECADE * decades - 1.0) / 2.0))
 
 
-def simulate(numerator, denominator, t, u, *, omega_low=None, omega_high=None, order=5):
-    """Placeholder."""
-    raise NotImplementedError
+def _check_grid(t) -> np.ndarray:
+    try:
+        t = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("argument 't' must be a 1-D array of real sample times") from None
+    if t.ndim != 1 or t.size < 2:
+        raise InputError(f"argument 't' must be a 1-D array of >= 2 sample times, got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        i = int(np.flatnonzero(~np.isfinite(t))[0])
+        raise InputError(f"argument 't' has a non-finite value at index {i}")
+    d = np.diff(t)
+    if np.any(d <= 0):
+        i = int(np.flatnonzero(d <= 0)[0])
+        raise InputError(f"argument 't' must be strictly increasing; t[{i + 1}] <= t[{i}]")
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    dev = np.max(np.abs(d - dt)) / dt
+    if dev > _SAMPLING_RTOL:
+        raise InputError(
+            f"argument 't' must be equally spaced; the steps deviate from the mean step {dt:g} s "
+            f"by up to {dev:.2g} of it (tolerance {_SAMPLING_RTOL:g})"
+        )
+    return t
+
+
+def _realisation(scaled: _Scaled) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Balanced controllable-canonical state space of ``num(x) / den(x)``.
+
+    The companion matrix of a wide-band Oustaloup approximation has entries spanning dozens of
+    orders of magnitude; diagonal balancing (LAPACK gebal, an exact similarity by powers of two)
+    brings them together. Measured on a three-term fractional model with a 16-decade band (degree
+    100): the unbalanced form overflows inside lsim, the balanced one stays within 2e-5 of a
+    numerical Laplace inversion. Building a cascade from polynomial roots instead was worse
+    (roots of such polynomials are inaccurate).
+    """
+    den = scaled.den[::-1] / scaled.den[-1]
+    num = np.zeros(den.size)
+    num[den.size - scaled.num.size :] = scaled.num[::-1] / scaled.den[-1]
+    n = den.size - 1
+    d = float(num[0])
+    if n == 0:
+        return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), d
+    a = np.zeros((n, n))
+    a[0, :] = -den[1:]
+    a[1:, :-1] = np.eye(n - 1)
+    b = np.zeros((n, 1))
+    b[0, 0] = 1.0
+    c = (num[1:] - d * den[1:]).reshape(1, n)
+    ab, _, _, scale, info = lapack.dgebal(a, scale=1, permute=0)
+    if info != 0:  # pragma: no cover - LAPACK argument error, cannot happen with these inputs
+        raise RuntimeError(f"LAPACK dgebal failed with info={info}")
+    return ab, b / scale[:, None], c * scale[None, :], d
+
+
+def _check_realisation(scaled: _Scaled, a, b, c, d) -> None:
+    """Compare the state space with the polynomials on the band; fail rather than return junk."""
+    n = a.shape[0]
+    x = 1j * np.logspace(-2, 2, 5)
+    with np.errstate(all="ignore"):
+        ref = P.polyval(x, scaled.num) / P.polyval(x, scaled.den)
+        got = np.array([(c @ np.linalg.solve(xi * np.eye(n) - a, b))[0, 0] + d for xi in x])
+    err = np.max(np.abs(got - ref) / np.maximum(np.abs(ref), np.finfo(float).tiny))
+    if not np.isfinite(err) or err > 1e-6:
+        raise InputError(
+            "the rational approximation cannot be realised accurately in double precision "
+            f"(relative error {err:.2g}); narrow the band 'omega_low'..'omega_high' or lower 'order'"
+        )
+
+
+def simulate(numerator, denominator, t, u, *, omega_low=None, omega_high=None, order=None):
+    r"""Response of a fractional-order transfer function to a sampled input.
+
+    The transfer function :math:`\sum_i b_i s^{\beta_i} / \sum_j a_j s^{\alpha_j}` is replaced
+    by its rational approximation (:func:`rational_approximation`) and simulated with
+    :func:`scipy.signal.lsim`, with the input interpolated linearly between samples and the
+    system at rest before ``t[0]``. The simulation runs in the time scale
+    ``tau = omega_c * (t - t[0])``, ``omega_c = sqrt(omega_low * omega_high)``, on a balanced
+    state-space realisation, which keeps bands of ten or more decades numerically sound.
+
+    With the defaults (:func:`default_band`, ``order`` chosen for two zero/pole pairs per
+    decade) the unit step responses of ``1/(1 + s**q)`` for ``q`` in 0.2..0.8 and of a
+    three-term fractional model are reproduced to within 2.5e-5 (measured against a numerical
+    Laplace inversion on three grids from 1e4 to 1e3 samples).
+
+    Parameters
+    ----------
+    numerator, denominator : sequence of (float, float)
+        Power terms ``(coefficient, exponent)`` as in :func:`rational_approximation`.
+    t : array_like
+        Equally spaced sample times in seconds, shape ``(n,)``, ``n >= 2``.
+    u : array_like
+        Input samples, shape ``(n,)``. Any nonzero ``u[0]`` acts as a step at ``t[0]``; remove a
+        measured offset first if the system was not at rest.
+    omega_low, omega_high : float, optional
+        Band of the Oustaloup approximation in rad/s; each defaults to the value of
+        :func:`default_band`.
+    order : int, optional
+        Oustaloup order ``N``. Default: ``max(5, ceil(decades - 1/2))``, two zero/pole pairs per
+        decade of the band.
+
+    Returns
+    -------
+    numpy.ndarray
+        Output samples, shape ``(n,)``.
+
+    Raises
+    ------
+    InputError
+        If a term, the band or the order is invalid; if ``t`` is not an equally spaced,
+        increasing, finite grid; if ``u`` does not match ``t`` or is not finite; if the
+        approximation is improper (the numerator's integer order exceeds the denominator's), or
+        if it cannot be realised accurately in double precision.
+
+    References
+    ----------
+    Thesis §4.3.3 (validation in the time domain, error e_abs(k) = eps_m(k) - G_f sigma_m(k)).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 5.0, 0.01)
+    >>> y = simulate([(1.0, 0.0)], [(1.0, 0.0), (1.0, 1.0)], t, np.ones_like(t))
+    >>> bool(np.max(np.abs(y - (1.0 - np.exp(-t)))) < 1e-6)
+    True
+    """
+    t = _check_grid(t)
+    try:
+        u = np.asarray(u, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("argument 'u' must be a 1-D array of real input samples") from None
+    if u.shape != t.shape:
+        raise InputError(f"argument 'u' must have the shape of 't' {t.shape}, got {u.shape}")
+    if not np.all(np.isfinite(u)):
+        i = int(np.flatnonzero(~np.isfinite(u))[0])
+        raise InputError(f"argument 'u' has a non-finite value at index {i}")
+    lo_default, hi_default = default_band(t)
+    lo = lo_default if omega_low is None else omega_low
+    hi = hi_default if omega_high is None else omega_high
+    lo, hi = _check_band(lo, hi)
+    n_order = _auto_order(lo, hi) if order is None else _check_order(order)
+    scaled = _scaled_rational(numerator, denominator, lo, hi, n_order)
+    if not (np.all(np.isfinite(scaled.num)) and np.all(np.isfinite(scaled.den))):
+        raise InputError(
+            "the rational approximation overflows; narrow the band 'omega_low'..'omega_high'"
+        )
+    if scaled.num.size > scaled.den.size:
+        raise InputError(
+            "the transfer function is improper (the numerator grows faster with s than the "
+            "denominator) and cannot be simulated; check 'numerator' and 'denominator'"
+        )
+    a, b, c, d = _realisation(scaled)
+    if a.shape[0] == 0:
+        return d * u
+    _check_realisation(scaled, a, b, c, d)
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    # equally spaced by construction, so lsim's own spacing check cannot trip on rounding
+    tau = scaled.omega_c * dt * np.arange(t.size)
+    _, y, _ = signal.lsim((a, b, c, np.array([[d]])), u, tau)
+    return np.asarray(y, dtype=float).reshape(t.shape)

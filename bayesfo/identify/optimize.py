@@ -19,7 +19,7 @@ from scipy import optimize
 from ..data import FrequencyResponse
 from ..errors import InputError
 from ..priors import LogUniform
-from ..response import dissipation_grid
+from ..response import commensurate_response, dissipation_grid
 from ..structures import Scaling, Structure
 
 WEIGHTINGS = ("auto", "sigma", "relative", "none")
@@ -148,6 +148,7 @@ def fit_structure(
     rng: np.random.Generator | int | None = 0,
     weighting: str = "auto",
     starts=None,
+    seed_methods: bool = False,
 ) -> FitResult:
     """Fit ``structure`` to ``data`` by multi-start bounded least squares.
 
@@ -164,7 +165,10 @@ def fit_structure(
     weighting : {"auto", "sigma", "relative", "none"}
         Residual weights; see :func:`choose_weighting`.
     starts : array_like, shape (k, n_params), optional
-        Extra starts in physical units (e.g. from linear methods).
+        Extra starts in physical units.
+    seed_methods : bool
+        Also start from the linear methods 2 and 3 (thesis Table 3.1) on a coarse q grid, for
+        structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
 
     Returns
     -------
@@ -194,6 +198,10 @@ def fit_structure(
     if coef.any():
         mags = 10.0 ** rng.uniform(-1.5, 1.5, size=(n_starts, int(coef.sum())))
         u0[:, coef] = np.clip(mags, prob.lo[coef] + 1e-9 * span[coef], prob.hi[coef] - 1e-9 * span[coef])
+    if seed_methods:
+        seeds = linear_seeds(structure, data)
+        if seeds.size:
+            starts = seeds if starts is None else np.vstack([np.atleast_2d(starts), seeds])
     if starts is not None:
         extra = structure.to_scaled(np.atleast_2d(np.asarray(starts, float)), prob.scaling)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -248,3 +256,62 @@ def _distinct(thetas: np.ndarray, rtol: float = 1e-3) -> np.ndarray:
         if not any(np.allclose(t, k, rtol=rtol, atol=1e-8) for k in kept):
             kept.append(t)
     return np.array(kept).reshape(-1, thetas.shape[1] if thetas.ndim == 2 else 0)
+
+
+SEED_Q_GRID = np.round(np.arange(0.1, 1.01, 0.1), 2)
+
+
+def thesis_degrees(structure: Structure) -> tuple[int, int] | None:
+    """(n, m) if ``structure`` is B(λ)/A(λ) (or A/B when inverted) with A = 1 + a_1 λ + … +
+    a_n λ^n and B = b_0 + … + b_m λ^m in the thesis' parameter names, else None."""
+    if structure.commensurate_order != "q":
+        return None
+    names = set(structure.param_names) | set(structure.fixed)
+    n = sum(1 for k in range(1, 20) if f"a{k}" in names)
+    m = sum(1 for k in range(20) if f"b{k}" in names) - 1
+    expected = {f"a{k}" for k in range(1, n + 1)} | {f"b{k}" for k in range(m + 1)} | {"q"}
+    if m < 0 or names != expected:
+        return None
+    rng = np.random.default_rng(0)
+    theta = rng.uniform(0.5, 1.5, structure.n_params)
+    vals, _ = structure.values(theta)
+    a = np.r_[1.0, [vals[f"a{k}"][0] for k in range(1, n + 1)]]
+    b = np.array([vals[f"b{k}"][0] for k in range(m + 1)])
+    w = np.array([0.3, 1.0, 3.0])
+    g = commensurate_response(w, a, b, vals["q"][0])
+    g = 1.0 / g if structure.inverted else g
+    return (n, m) if np.allclose(structure.transfer(theta, w), g, rtol=1e-10) else None
+
+
+def linear_seeds(structure: Structure, data: FrequencyResponse, q_values=None,
+                 methods=(2, 3)) -> np.ndarray:
+    """Parameter vectors (physical units) from the linear methods, as starts for optimisers.
+
+    Returns an empty array for structures that are not of the thesis form (e.g. the
+    generalised Maxwell model) or when a method cannot be applied.
+    """
+    from .scan import fit_linear
+
+    degrees = thesis_degrees(structure)
+    if degrees is None:
+        return np.empty((0, structure.n_params))
+    n, m = degrees
+    if "q" in structure.fixed:
+        q_values = [float(structure.fixed["q"])]
+    q_values = SEED_Q_GRID if q_values is None else q_values
+    seeds = []
+    for method in methods:
+        if n == 0 and method != 1:
+            continue
+        try:
+            fits = fit_linear(data, n, m, method, q_values, inverted=structure.inverted)
+        except InputError:
+            continue
+        for f in fits:
+            vals = {f"a{k}": f.a[k] for k in range(1, n + 1)}
+            vals.update({f"b{k}": f.b[k] for k in range(m + 1)})
+            vals["q"] = f.q
+            theta = np.array([vals[name] for name in structure.param_names])
+            if np.all(np.isfinite(theta)):
+                seeds.append(theta)
+    return np.array(seeds).reshape(-1, structure.n_params)

@@ -1,0 +1,188 @@
+"""Linear identification methods 1–5 of the thesis (Table 3.1), vectorised.
+
+For a commensurate structure with given n, m and q, the model
+
+    G̃(s) = (b_0 + b_1 λ + … + b_m λ^m) / (1 + a_1 λ + … + a_n λ^n),   λ = s^q,
+
+is fitted by minimising a weighted *equation error* that is linear in p = [a_1..a_n, b_0..b_m]:
+
+    E_k = A(λ_k) G_k − B(λ_k) = G_k − S_k p,   S_k = [−λ_k G_k, …, −λ_k^n G_k, 1, λ_k, …, λ_k^m]
+
+(Levy's error, eq. (3.8); with U = 1 the output-error form of §3.2.1 is the same error). Real and
+imaginary parts are stacked once (§3.2.1), and the weighted normal equations are solved for a
+whole batch at once: every leading dimension of ``G`` (Monte Carlo realisations) and of ``q``
+(a grid of orders) broadcasts.
+
+The methods differ in the weights:
+
+1. output error with Vinagre's weights entering the rows (Kronecker product of §3.2.3), i.e.
+   cost Σ w_k² |E_k|² with w_k = φ_k/ω_k²;
+2. Levy with Vinagre's weights, cost Σ w_k |E_k|² (eq. (3.14));
+3. Levy with Sanathanan–Koerner iterations, cost Σ |E_k|²/|A_{L−1}(λ_k)|², A_0 = 1, 10
+   iterations (§3.2.4);
+4. Lawrence–Rogers recursion (eqs. (3.19)–(3.21)) with Vinagre's weights, H_0 = I/ε, p_0 = 0;
+5. Lawrence–Rogers recursion with Sanathanan–Koerner weights, 10 iterations.
+
+The recursion minimises Σ w_k² |E_k|², eq. (3.16); with a tiny ε it equals the batch solution
+with weights w_k².
+
+References
+----------
+Thesis §3.2 (eqs. (3.4)–(3.21)), Table 3.1; Levy (1959); Vinagre et al. (2000); Sanathanan and
+Koerner (1963); Lawrence and Rogers (1979).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ..response import jw_power
+
+METHODS = (1, 2, 3, 4, 5)
+SK_ITERATIONS = 10
+LR_EPSILON = 1e-12
+
+
+def vinagre_weights(omega) -> np.ndarray:
+    """Vinagre's weights w_k = φ_k / ω_k² (eq. (3.13)), φ_k the half-width around ω_k."""
+    omega = np.asarray(omega, dtype=float)
+    if omega.size < 2:
+        raise InputError("Vinagre's weights need at least two frequencies")
+    phi = np.empty_like(omega)
+    phi[0] = (omega[1] - omega[0]) / 2
+    phi[-1] = (omega[-1] - omega[-2]) / 2
+    phi[1:-1] = (omega[2:] - omega[:-2]) / 2
+    return phi / omega**2
+
+
+def regressors(omega, G, q, n: int, m: int):
+    """Complex regressor matrix S (..., N, n+m+1), target G (..., N) and λ^k table.
+
+    Columns are ordered as p = [a_1..a_n, b_0..b_m].
+    """
+    G = np.asarray(G, dtype=complex)
+    q = np.asarray(q, dtype=float)
+    lam = jw_power(np.asarray(omega, float), q[..., None])  # (..., N)
+    kmax = max(n, m)
+    powers = [np.ones_like(lam)]
+    for _ in range(kmax):
+        powers.append(powers[-1] * lam)
+    batch = np.broadcast_shapes(G.shape, lam.shape)
+    G = np.broadcast_to(G, batch)
+    cols = [-powers[k] * G for k in range(1, n + 1)] + [
+        np.broadcast_to(powers[k], batch) for k in range(m + 1)
+    ]
+    return np.stack(cols, axis=-1), G, powers
+
+
+def weighted_solve(S, y, weights) -> np.ndarray:
+    """Minimise Σ_k w_k |y_k − S_k p|² over real p: the weighted normal equations.
+
+    Real and imaginary parts are stacked, M = [Re S; Im S], and (Mᵀ W M) p = Mᵀ W y is solved
+    after equilibrating the columns (the powers of λ span many decades).
+    """
+    w = np.asarray(weights, dtype=float)
+    Sr, Si = S.real, S.imag
+    wk = w[..., :, None]
+    A = np.einsum("...ki,...kj->...ij", Sr * wk, Sr) + np.einsum("...ki,...kj->...ij", Si * wk, Si)
+    b = np.einsum("...ki,...k->...i", Sr * wk, y.real) + np.einsum("...ki,...k->...i", Si * wk, y.imag)
+    d = np.sqrt(np.abs(np.diagonal(A, axis1=-2, axis2=-1)))
+    d = np.where(d > 0, d, 1.0)
+    As = A / d[..., :, None] / d[..., None, :]
+    x = np.linalg.solve(As, (b / d)[..., None])[..., 0]
+    return x / d
+
+
+def lawrence_rogers(S, y, weights, *, epsilon: float = LR_EPSILON, passes: int = 1,
+                    p0=None) -> np.ndarray:
+    """The recursion of Lawrence and Rogers, eqs. (3.19)–(3.21), over the frequencies.
+
+    Each frequency adds its real and imaginary regressor as two rank-one updates of
+    H = (Σ 2w_k² Re r Re rᵀ + Im r Im rᵀ)⁻¹ (Sherman–Morrison), starting from H_0 = I/ε and
+    p_0 = 0; a further pass restarts from the previous estimate. The minimised cost is
+    Σ w_k² |E_k|².
+    """
+    w2 = np.asarray(weights, dtype=float) ** 2
+    batch = S.shape[:-2]
+    P = S.shape[-1]
+    p = np.zeros(batch + (P,)) if p0 is None else np.array(np.broadcast_to(p0, batch + (P,)))
+    for _ in range(passes):
+        H = np.broadcast_to(np.eye(P) / epsilon, batch + (P, P)).copy()
+        for k in range(S.shape[-2]):
+            wk = np.broadcast_to(w2[..., k], batch)
+            for part in (S[..., k, :].real, S[..., k, :].imag):
+                Hr = np.einsum("...ij,...j->...i", H, part)
+                denom = 1.0 / (2.0 * wk) + np.einsum("...i,...i->...", part, Hr)
+                H = H - Hr[..., :, None] * Hr[..., None, :] / denom[..., None, None]
+            r = S[..., k, :]
+            e = y[..., k] - np.einsum("...i,...i->...", r, p)
+            grad = 2.0 * wk[..., None] * np.real(np.conj(r) * e[..., None])
+            p = p + np.einsum("...ij,...j->...i", H, grad)
+    return p
+
+
+def identify_linear(omega, G, q, n: int, m: int, method: int, *,
+                    sk_iterations: int = SK_ITERATIONS, lr_epsilon: float = LR_EPSILON,
+                    lr_passes: int = 1):
+    """Identify the coefficients with method 1–5 for a batch of data sets and orders.
+
+    Parameters
+    ----------
+    omega : array_like, shape (N,)
+        Angular frequencies [rad/s] (in the units in which the coefficients are wanted).
+    G : array_like of complex, shape (..., N)
+        Measured responses; leading dimensions are independent data sets.
+    q : float or array_like, shape broadcastable to G.shape[:-1]
+        Commensurate order(s).
+    n, m : int
+        Degrees of the denominator and numerator pseudo-polynomials (n ≥ 1 for methods 2–5,
+        whose error needs a denominator; n ≥ 0 for method 1).
+    method : {1, 2, 3, 4, 5}
+        See the module docstring (thesis Table 3.1).
+
+    Returns
+    -------
+    a : ndarray, shape (..., n+1)
+        Denominator [1, a_1, …, a_n] (thesis convention).
+    b : ndarray, shape (..., m+1)
+        Numerator [b_0, …, b_m].
+
+    Raises
+    ------
+    InputError
+        For an unknown method, negative degrees, or fewer real equations than unknowns.
+    """
+    if method not in METHODS:
+        raise InputError(f"argument 'method' must be one of 1, 2, 3, 4, 5, got {method!r}")
+    if n < 0 or m < 0:
+        raise InputError(f"degrees must be non-negative, got n = {n}, m = {m}")
+    if n < 1 and method != 1:
+        raise InputError(f"method {method} needs a denominator (n >= 1), got n = {n}")
+    omega = np.asarray(omega, dtype=float)
+    if 2 * omega.size < n + m + 1:
+        raise InputError(
+            f"{omega.size} frequencies give {2 * omega.size} real equations, fewer than the "
+            f"{n + m + 1} coefficients"
+        )
+    S, y, powers = regressors(omega, G, q, n, m)
+    if method in (1, 2, 4):
+        wv = vinagre_weights(omega)
+        if method == 1:
+            p = weighted_solve(S, y, wv**2)
+        elif method == 2:
+            p = weighted_solve(S, y, wv)
+        else:
+            p = lawrence_rogers(S, y, wv, epsilon=lr_epsilon, passes=lr_passes)
+    else:
+        w = np.ones(S.shape[:-1])
+        p = None
+        for _ in range(sk_iterations):
+            if method == 3:
+                p = weighted_solve(S, y, w)
+            else:
+                p = lawrence_rogers(S, y, np.sqrt(w), epsilon=lr_epsilon, passes=lr_passes)
+            A = 1.0 + sum(p[..., k - 1 : k] * powers[k] for k in range(1, n + 1))
+            w = 1.0 / np.abs(A) ** 2
+    a = np.concatenate([np.ones(p.shape[:-1] + (1,)), p[..., :n]], axis=-1)
+    return a, p[..., n:]

@@ -51,6 +51,22 @@ def build_parser() -> argparse.ArgumentParser:
                    help="angular frequencies [rad/s] to hold out for validation")
     p.add_argument("--json", action="store_true", help="print JSON")
 
+    p = sub.add_parser("identify", help="deterministic fit of one structure (methods 1-5 or optimisation)")
+    _add_data_options(p)
+    p.add_argument("--structure", required=True, help="structure name, e.g. zener or max-n2m1")
+    p.add_argument("--method", default="opt", choices=("1", "2", "3", "4", "5", "opt"),
+                   help="linear method of thesis Table 3.1, or global optimisation (default)")
+    p.add_argument("--q", type=float, default=None,
+                   help="fix the commensurate order (default: q-grid scan / optimised)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the optimiser's random starts")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+    p = sub.add_parser("simulate", help="thesis Monte Carlo studies beside the printed tables")
+    p.add_argument("study", metavar="STUDY", help="table-3.2, table-a.1, table-a.3, table-3.4, table-a.5, table-a.7")
+    p.add_argument("--runs", type=int, default=None, help="noisy realisations (default: as in the thesis)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--json", action="store_true", help="print JSON")
+
     p = sub.add_parser("structures", help="list the available structures with priors")
     p.add_argument("--json", action="store_true", help="print JSON")
 
@@ -163,7 +179,55 @@ def cmd_extract(args) -> int:
     return 0
 
 
-COMMANDS = {"inspect": cmd_inspect, "structures": cmd_structures, "extract": cmd_extract}
+def cmd_identify(args) -> int:
+    from .identify import identify
+
+    data = _read(args)
+    from .structures import get_structure
+
+    structure = get_structure(args.structure, _library(args))
+    result = identify(data, structure, method=args.method, q=args.q, seed=args.seed)
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    print(f"{result['structure']} by method {result['method']} on {data.label}: "
+          f"{structure.formula}")
+    for name, value in result["parameters"].items():
+        print(f"  {name:>6} = {value:.6g}")
+    print(f"  RMSE = {result['rmse']:.4g} (eq. 3.23), stable: {'yes' if result['stable'] else 'no'}")
+    if result.get("rejected_unstable_q"):
+        print(f"  q values rejected as unstable: {len(result['rejected_unstable_q'])} of the grid")
+    return 0
+
+
+def cmd_simulate(args) -> int:
+    from .studies import run_study
+
+    result = run_study(args.study, runs=args.runs, seed=args.seed)
+    if args.json:
+        print(json.dumps(result, indent=2))
+        return 0
+    print(f"{result['study']}: {result['runs']} runs, seed {result['seed']} (thesis values in brackets)")
+    for key, row in result["methods"].items():
+        th = result["thesis"].get(key, {})
+        print(f"method {key}")
+        for field in ("mean_a", "var_a", "mean_b", "var_b", "mean_q", "var_q", "rmse_spec",
+                      "var_rmse_spec", "rmse_noise", "var_rmse_noise"):
+            ours = np.atleast_1d(row[field])
+            text = " ".join(f"{v:.4g}" for v in ours)
+            if field in th:
+                text += "   [" + " ".join(f"{v:.4g}" for v in np.atleast_1d(th[field])) + "]"
+            print(f"  {field:<15} {text}")
+    return 0
+
+
+COMMANDS = {
+    "inspect": cmd_inspect,
+    "structures": cmd_structures,
+    "extract": cmd_extract,
+    "identify": cmd_identify,
+    "simulate": cmd_simulate,
+}
 
 
 def _one_line_warning(message, category, filename, lineno, file=None, line=None):

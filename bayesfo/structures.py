@@ -430,6 +430,19 @@ class Structure:
                 out = power_ratio(omega, nc, ne, dc, de)
         return out[0] if single else out
 
+    def power_terms(self, theta) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
+        """(coefficient, exponent) pairs of numerator and denominator for one parameter set,
+        as :func:`bayesfo.timedomain.simulate` takes them."""
+        theta = np.asarray(theta, dtype=float)
+        if theta.ndim != 1:
+            raise StructureError(f"power_terms takes one parameter set, got shape {theta.shape}")
+        vals, _ = self.values(theta)
+        sides = []
+        for terms in (self.numerator, self.denominator):
+            coef, expo = self._side_arrays(terms, vals, 1)
+            sides.append([(float(c), float(e)) for c, e in zip(coef[0], expo[0])])
+        return sides[0], sides[1]
+
     def response(self, theta, omega, kind: str = "compliance") -> np.ndarray:
         """The response compared with data of ``kind``: the transfer function, or its reciprocal
         for modulus data (cards describe compliances)."""
@@ -627,6 +640,24 @@ def integer_variant(s: Structure) -> Structure:
         s, name=f"{s.name}-int", parameters=params, fixed=fixed, constraints=constraints,
         integer=True, title=f"{s.title} (integer order)",
     )
+
+
+def fix_parameters(s: Structure, values: dict[str, float]) -> Structure:
+    """A copy of ``s`` with some free parameters fixed (e.g. ``{"q": 0.5}``)."""
+    unknown = [k for k in values if k not in s.param_names]
+    if unknown:
+        raise StructureError(
+            f"structure '{s.name}' has no free parameter '{unknown[0]}'; "
+            f"its free parameters are {', '.join(s.param_names)}"
+        )
+    for k, v in values.items():
+        if not s.priors[k].contains(v):
+            raise StructureError(
+                f"{k} = {v:g} is outside the prior {s.priors[k].describe()} of structure '{s.name}'"
+            )
+    params = tuple(p for p in s.parameters if p.name not in values)
+    fixed = dict(s.fixed) | {k: float(v) for k, v in values.items()}
+    return replace(s, parameters=params, fixed=fixed)
 
 
 def inverted_variant(s: Structure) -> Structure:

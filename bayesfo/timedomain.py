@@ -392,43 +392,6 @@ def rational_approximation(numerator, denominator, omega_low, omega_high, order=
     return signal.TransferFunction(num, den)
 
 
-def _exact_response(numerator, denominator, omega) -> np.ndarray:
-    """Exact ``G(j omega)`` of a ratio of sums of power terms (no approximation).
-
-    Parameters
-    ----------
-    numerator, denominator : sequence of (float, float)
-        Power terms ``(coefficient, exponent)`` as in :func:`rational_approximation`.
-    omega : array_like
-        Angular frequencies in rad/s, > 0.
-
-    Returns
-    -------
-    numpy.ndarray
-        Complex ``G(j omega)``, principal branch ``(j omega)**e = omega**e exp(j e pi / 2)``.
-
-    Raises
-    ------
-    InputError
-        If a term is invalid or ``omega`` has non-positive or non-finite values.
-
-    References
-    ----------
-    Thesis §2.3 (fractional-order LTI systems, transfer function with s = j omega).
-    """
-    num_terms = _check_terms("numerator", numerator)
-    den_terms = _check_terms("denominator", denominator)
-    w = np.asarray(omega, dtype=float)
-    if not np.all(np.isfinite(w)) or np.any(w <= 0):
-        raise InputError("argument 'omega' must hold finite values > 0 rad/s")
-    jw = 1j * w
-
-    def total(terms):
-        return sum(c * jw**e for c, e in terms)
-
-    return total(num_terms) / total(den_terms)
-
-
 # --------------------------------------------------------------------------------------------
 # simulation
 # --------------------------------------------------------------------------------------------
@@ -645,3 +608,31 @@ def simulate(numerator, denominator, t, u, *, omega_low=None, omega_high=None, o
     tau = scaled.omega_c * dt * np.arange(t.size)
     _, y, _ = signal.lsim((a, b, c, np.array([[d]])), u, tau)
     return np.asarray(y, dtype=float).reshape(t.shape)
+
+
+def simulate_structure(structure, theta, t, u, *, kind="compliance", omega_low=None,
+                       omega_high=None, order=None):
+    """Time response of a fitted structure to a measured input (thesis §4.3.3).
+
+    Parameters
+    ----------
+    structure : bayesfo.structures.Structure
+    theta : array_like, shape (n_params,)
+        Parameters in physical units.
+    t, u : array_like
+        Uniform time grid [s] and the input record (stress for a compliance, strain for a
+        modulus, the input of a generic transfer function).
+    kind : {"compliance", "modulus", "generic"}
+        For modulus data the structure's reciprocal is simulated (cards describe compliances).
+    omega_low, omega_high, order
+        Band and order of the Oustaloup approximation (see :func:`simulate`).
+
+    Returns
+    -------
+    numpy.ndarray
+        The simulated output on ``t``.
+    """
+    num, den = structure.power_terms(theta)
+    if kind == "modulus":
+        num, den = den, num
+    return simulate(num, den, t, u, omega_low=omega_low, omega_high=omega_high, order=order)

@@ -296,3 +296,23 @@ def test_simulate_rejects_bad_band_and_order():
         simulate(*HALF, T_STEP, np.ones_like(T_STEP), omega_low=10.0, omega_high=1.0)
     with pytest.raises(InputError, match="'order' must be an integer >= 1"):
         simulate(*HALF, T_STEP, np.ones_like(T_STEP), order=-2)
+
+
+def test_simulate_structure_integer_voigt_step_and_modulus():
+    from bayesfo.structures import get_structure
+    from bayesfo.timedomain import simulate_structure
+
+    t = np.linspace(0.0, 5.0, 2001)
+    u = np.ones_like(t)
+    # voigt-int: b0/(1 + a1 s): creep under a unit stress step is b0 (1 - exp(-t/a1)).
+    y = simulate_structure(get_structure("voigt-int"), [0.5, 2.0], t, u)
+    np.testing.assert_allclose(y, 2.0 * (1 - np.exp(-t / 0.5)), atol=1e-9)
+    # voigt with q = 0.5 against the closed form b0 (1 - erfcx(sqrt(t))) (a1 = 1).
+    from scipy.special import erfcx
+
+    y = simulate_structure(get_structure("voigt"), [1.0, 2.0, 0.5], t, u)
+    np.testing.assert_allclose(y[200:], 2.0 * (1 - erfcx(np.sqrt(t[200:]))), atol=1e-4)
+    # A modulus simulates the reciprocal: maxwell-int as modulus is a1 s/(1 + b1 s), whose step
+    # response is (a1/b1) exp(-t/b1).
+    y = simulate_structure(get_structure("maxwell-int"), [3.0, 0.5], t, u, kind="modulus")
+    np.testing.assert_allclose(y[1:], 6.0 * np.exp(-t[1:] / 0.5), rtol=1e-6, atol=1e-9)

@@ -42,8 +42,8 @@ class LinearFit:
     rmse : float
         (1/N)·sqrt(Σ|G_k − Ĝ_k|²) against the data as measured (thesis eq. (3.23)).
     stable : bool
-        Matignon stability of the fitted denominator (B for inverted fits, integrators
-        accepted).
+        Matignon stability of the fitted denominator (B for inverted fits), and for compliance
+        and modulus data of the numerator too; integrators accepted.
     """
 
     n: int
@@ -57,7 +57,7 @@ class LinearFit:
     stable: bool
 
     def response(self, omega) -> np.ndarray:
-        """The fitted transfer function at ``omega``."""
+        """The fitted structure's transfer function (B/A, or A/B if inverted) at ``omega``."""
         g = commensurate_response(omega, self.a, self.b, self.q)
         return 1.0 / g if self.inverted else g
 
@@ -98,18 +98,27 @@ def fit_linear(data: FrequencyResponse, n: int, m: int, method: int, q, *,
     q : float or array_like
         Commensurate order(s).
     inverted : bool
-        Fit A/B: the methods then run on 1/G (thesis §4.3.4), the RMSE is on G.
+        The structure is A/B (thesis §4.3.4).
 
     Returns
     -------
     list of LinearFit, one per q.
+
+    Notes
+    -----
+    The methods fit B/A to whatever the structure is compared with: the data for compliance
+    and generic data, their reciprocal for modulus data (cards describe compliances), and the
+    reciprocal again for inverted structures. The RMSE is always on the data as measured.
+    Stability is tested on the structure's denominator, and for compliance and modulus data
+    also on its numerator (see :meth:`bayesfo.structures.Structure.stable`).
     """
     q = np.atleast_1d(np.asarray(q, dtype=float))
     if np.any((q <= 0) | ~np.isfinite(q)):
         raise InputError(f"commensurate order q must be positive, got {q[(q <= 0) | ~np.isfinite(q)][0]}")
     n_coef = n + m + 1
     data.check_enough_points((n_coef + 2) // 2, f"the linear fit with n = {n}, m = {m}")
-    target = data.reciprocal() if inverted else data
+    reciprocal = inverted != (data.kind == "modulus")
+    target = data.reciprocal() if reciprocal else data
     w_ref, g_ref = target.omega_ref, target.g_ref
     w = target.omega / w_ref
     a_s, b_s = identify_linear(w, target.response / g_ref, q, n, m, method)
@@ -118,12 +127,12 @@ def fit_linear(data: FrequencyResponse, n: int, m: int, method: int, q, *,
     a = a_s * w_ref ** (-k_a[None, :] * q[:, None])
     b = b_s * g_ref * w_ref ** (-k_b[None, :] * q[:, None])
     fitted = commensurate_response(data.omega, a, b, q)
-    if inverted:
+    if reciprocal:
         with np.errstate(divide="ignore", invalid="ignore"):
             fitted = 1.0 / fitted
-        stable = matignon_stable(b, q, allow_integrator=True)
-    else:
-        stable = matignon_stable(a, q, allow_integrator=True)
+    stable = matignon_stable(b if inverted else a, q, allow_integrator=True)
+    if data.kind in ("compliance", "modulus"):
+        stable &= matignon_stable(a if inverted else b, q, allow_integrator=True)
     err = np.abs(fitted - data.response[None, :]) ** 2
     rmse = np.sqrt(np.sum(err, axis=-1)) / data.n_frequencies
     rmse = np.where(np.isfinite(rmse), rmse, np.inf)

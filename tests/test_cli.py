@@ -1,0 +1,98 @@
+"""The command line: contracts of identify, simulate, extract; exit statuses."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bayesfo.data import FrequencyResponse
+from bayesfo.studies import OMEGA, g_spec
+
+EXAMPLES = Path(__file__).parents[1] / "examples" / "data"
+
+
+@pytest.fixture
+def gspec_csv(tmp_path):
+    rng = np.random.default_rng(0)
+    g = g_spec() + 1e-4 * (rng.normal(size=25) + 1j * rng.normal(size=25))
+    return FrequencyResponse(OMEGA, g, kind="compliance").to_csv(tmp_path / "gspec.csv")
+
+
+@pytest.mark.parametrize("method", ["1", "2", "3", "4", "5", "opt"])
+def test_identify_json_contract_recovers_g_spec(run_cli, gspec_csv, method):
+    status, out, err = run_cli("identify", gspec_csv, "--structure", "voigt", "--method", method, "--json")
+    assert status == 0, err
+    res = json.loads(out)
+    assert {"structure", "method", "q", "a", "b", "rmse", "stable"} <= set(res)
+    assert res["structure"] == "voigt" and res["method"] == method and res["stable"]
+    assert res["a"][0] == 1.0 and len(res["a"]) == 2 and len(res["b"]) == 1
+    np.testing.assert_allclose([res["a"][1], res["b"][0], res["q"]], [1.0, 1.0, 0.5], atol=0.02)
+    assert res["rmse"] < 1e-4
+
+
+def test_identify_with_fixed_q_and_human_output(run_cli, gspec_csv):
+    status, out, _ = run_cli("identify", gspec_csv, "--structure", "zener", "--q", "0.5")
+    assert status == 0 and "q = 0.5" in out and "RMSE" in out
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["identify", "{csv}", "--structure", "maxwell", "--method", "2"], "use --method opt"),
+        (["identify", "{csv}", "--structure", "zenner"], "unknown structure 'zenner'"),
+        (["identify", "{csv}", "--structure", "voigt", "--q", "1.5"], "outside the prior"),
+        (["identify", "{csv}", "--structure", "voigt", "--method", "7"], "invalid choice"),
+        (["identify", "{csv}"], "--structure"),
+        (["simulate", "table-9.9"], "unknown study 'table-9.9'"),
+        (["simulate", "table-3.2", "--runs", "1"], "at least 2"),
+        (["extract", "missing.csv", "--out", "x.csv"], "missing.csv: file not found"),
+        (["inspect", "nope.csv"], "does not exist"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_bad_input_exit_2_one_line(run_cli, gspec_csv, argv, message):
+    status, _, err = run_cli(*[a.replace("{csv}", str(gspec_csv)) for a in argv])
+    assert status == 2
+    assert len(err.strip().splitlines()) == 1 and message in err and "Traceback" not in err
+
+
+def test_simulate_json_contract(run_cli):
+    status, out, _ = run_cli("simulate", "table-3.2", "--runs", "200", "--seed", "3", "--json")
+    res = json.loads(out)
+    assert status == 0 and res["study"] == "table-3.2" and res["runs"] == 200 and res["seed"] == 3
+    assert set(res["methods"]) == {"1", "2", "3", "4", "5"}
+    row = res["methods"]["2"]
+    for key in ("mean_a", "var_a", "mean_b", "var_b", "mean_q", "var_q", "rmse_spec",
+                "var_rmse_spec", "rmse_noise", "var_rmse_noise"):
+        assert key in row
+    assert abs(row["mean_a"][1] - res["thesis"]["2"]["mean_a"][1]) < 0.005
+    assert row["mean_q"] == 0.5 and row["var_q"] == 0.0
+
+
+def test_simulate_local_and_global_studies_quick(run_cli):
+    status, out, _ = run_cli("simulate", "table-3.4", "--runs", "20", "--json")
+    res = json.loads(out)
+    assert status == 0 and len(res["methods"]) == 4
+    for row in res["methods"].values():  # n = 1, m = 0: every initial vector reaches q = 0.5
+        assert abs(row["mean_q"] - 0.5) < 0.01
+    status, out, _ = run_cli("simulate", "table-a.7", "--runs", "4", "--json")
+    res = json.loads(out)
+    for key in ("opt-n1m0", "opt-n1m1"):  # Table A.7: q = 0.4998 for both
+        assert abs(res["methods"][key]["mean_q"] - 0.5) < 0.01
+
+
+def test_extract_bundled_sine_records(run_cli, tmp_path):
+    records = sorted((EXAMPLES / "sine_records").glob("*.csv"))
+    out_csv = tmp_path / "fr.csv"
+    status, out, err = run_cli("extract", *records, "--out", out_csv)
+    assert status == 0, err
+    from bayesfo.data import read_csv
+
+    fr = read_csv(out_csv)
+    assert fr.n_frequencies == 5 and fr.sigma is not None
+    # Records are 1/(1 + s^0.5) with noise sd 0.01 over many periods: within 5 sigma.
+    assert np.all(np.abs(fr.response - g_spec(fr.omega)) < 5 * fr.sigma + 1e-3)
+    assert (tmp_path / "fr_harmonics.csv").exists()

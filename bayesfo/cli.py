@@ -62,9 +62,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print JSON")
 
     p = sub.add_parser("simulate", help="thesis Monte Carlo studies beside the printed tables")
-    p.add_argument("study", metavar="STUDY", help="table-3.2, table-a.1, table-a.3, table-3.4, table-a.5, table-a.7")
+    p.add_argument("study", metavar="STUDY", help="table-3.2, table-a.1, table-a.3, table-3.4, table-a.5, table-a.7, figure-3.2")
     p.add_argument("--runs", type=int, default=None, help="noisy realisations (default: as in the thesis)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--figure", metavar="FILE", help="figure-3.2: write the RMSE surface (.png, .pdf)")
     p.add_argument("--json", action="store_true", help="print JSON")
 
     p = sub.add_parser("structures", help="list the available structures with priors")
@@ -201,8 +202,30 @@ def cmd_identify(args) -> int:
 
 
 def cmd_simulate(args) -> int:
-    from .studies import run_study
+    from .studies import rmse_surface, run_study
 
+    if args.study == "figure-3.2":
+        runs = 1 if args.runs is None else args.runs
+        if runs < 1:
+            raise InputError(f"--runs must be at least 1, got {runs}")
+        surface = rmse_surface(runs=runs, seed=args.seed)
+        if args.figure:
+            from .plotting import plot_rmse_surface, save_figure
+
+            mesh = plot_rmse_surface(surface)
+            save_figure(mesh.axes.figure, args.figure)
+        if args.json:
+            print(json.dumps(surface))
+        else:
+            z = np.asarray(surface["rmse"])
+            for s_, row in zip(surface["sigma"], z):
+                k = int(np.argmin(row))
+                print(f"sigma = {s_:.4f}: minimum RMSE {row[k]:.4g} at q = {surface['q'][k]:.2f}")
+            if args.figure:
+                print(f"wrote {args.figure}")
+        return 0
+    if args.figure:
+        raise InputError("--figure applies to figure-3.2 only")
     result = run_study(args.study, runs=args.runs, seed=args.seed)
     if args.json:
         print(json.dumps(result, indent=2))

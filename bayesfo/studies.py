@@ -8,7 +8,8 @@ noisy data G_noise.
 Studies: ``table-3.2`` (methods 1–5, q = 0.5, n = 1, m = 0; with Table 3.3), ``table-a.1``
 (n = 1, m = 1; with A.2), ``table-a.3`` (q = 0.25, n = m = 2; with A.4), ``table-3.4`` (local
 optimisation from the thesis' four initial vectors, n = 1, m = 0), ``table-a.5`` (the same for
-n = m = 2; Tables A.5/A.6) and ``table-a.7`` (global optimisation for the three orders).
+n = m = 2; Tables A.5/A.6) and ``table-a.7`` (global optimisation for the three orders); ``figure-3.2`` (RMSE against G_noise over
+the noise level σ and the commensurate order q, method 5, n = 1, m = 0).
 """
 
 from __future__ import annotations
@@ -229,3 +230,28 @@ def run_study(study: str, runs: int | None = None, seed: int = 0, *, n_starts: i
             results[f"opt-n{n}m{m}"] = _stats(den, num, q, fitted, noisy)
     return {"study": study, "runs": runs, "seed": seed, "methods": results,
             "thesis": THESIS.get(study, {})}
+
+
+def rmse_surface(sigmas=None, q_grid=None, *, method: int = 5, n: int = 1, m: int = 0,
+                 runs: int = 1, seed: int = 0) -> dict:
+    """RMSE against G_noise over noise levels σ and orders q (thesis Figure 3.2).
+
+    For each σ, ``runs`` noisy data sets are drawn (the thesis used one) and fitted by the
+    linear ``method`` at every q of the grid at once; the RMSE (eq. (3.23)) is averaged over runs.
+
+    Returns
+    -------
+    dict
+        ``sigma`` (n_sigma,), ``q`` (n_q,), ``rmse`` (n_sigma, n_q) as lists, and the settings.
+    """
+    sigmas = np.round(np.arange(1, 11) * 1e-4, 6) if sigmas is None else np.asarray(sigmas, float)
+    q_grid = np.round(np.arange(1, 101) * 0.01, 2) if q_grid is None else np.asarray(q_grid, float)
+    rng = np.random.default_rng(seed)
+    out = np.empty((sigmas.size, q_grid.size))
+    for i, sigma in enumerate(sigmas):
+        noisy = g_spec() + thesis_noise(rng, runs, sigma)
+        a, b = identify_linear(OMEGA, noisy[:, None, :], q_grid[None, :], n, m, method)
+        fitted = commensurate_response(OMEGA, a, b, np.broadcast_to(q_grid, a.shape[:-1]))
+        out[i] = rmse(noisy[:, None, :], fitted).mean(axis=0)
+    return {"study": "figure-3.2", "method": method, "n": n, "m": m, "runs": runs, "seed": seed,
+            "sigma": sigmas.tolist(), "q": q_grid.tolist(), "rmse": out.tolist()}

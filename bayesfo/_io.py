@@ -29,3 +29,20 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
             pass
         raise
     return path
+
+
+def read_text_file(path: str | os.PathLike, what: str = "file") -> str:
+    """The text of a UTF-8 file, or an :class:`~bayesfo.errors.InputError` naming the file."""
+    from .errors import InputError
+
+    where = f"{what} '{path}'"
+    try:
+        return Path(path).read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise InputError(f"{where} does not exist") from None
+    except IsADirectoryError:
+        raise InputError(f"{where} is a directory") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{where} is not a UTF-8 text file") from None
+    except OSError as exc:
+        raise InputError(f"{where} cannot be read: {exc.strerror}") from None

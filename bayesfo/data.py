@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._io import atomic_write_text
+from ._io import atomic_write_text, read_text_file
 from .errors import InputError
 
 KINDS = ("compliance", "modulus", "generic")
@@ -429,16 +429,7 @@ def read_csv(
     """
     path = Path(path)
     where = f"file '{path}'"
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise InputError(f"{where} does not exist") from None
-    except IsADirectoryError:
-        raise InputError(f"{where} is a directory, not a CSV file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{where} is not a UTF-8 text file") from None
-    except OSError as exc:
-        raise InputError(f"{where} cannot be read: {exc.strerror}") from None
+    text = read_text_file(path)
 
     meta: dict[str, str] = {}
     rows: list[tuple[int, list[str]]] = []

@@ -33,6 +33,7 @@ from scipy import signal
 from scipy.linalg import lapack
 
 from bayesfo.errors import InputError
+from bayesfo.timeseries import check_time_grid
 
 __all__ = [
     "oustaloup",
@@ -47,7 +48,6 @@ _INTEGER_TOL = 1e-12
 
 # A sample time may deviate from the uniform grid by this fraction of a step (rounding of
 # recorded time stamps); the simulation then treats the samples as exactly equally spaced.
-_GRID_TOLERANCE = 0.01
 
 # The polynomial degree grows with the exponents; beyond this a typo is far likelier than a model.
 _MAX_EXPONENT = 64
@@ -439,7 +439,7 @@ def default_band(t) -> tuple[float, float]:
     ----------
     Thesis §4.3.3 (frequency set Omega of the Oustaloup filter).
     """
-    t = _check_grid(t)
+    t = check_time_grid(t, min_samples=2)
     dt = (t[-1] - t[0]) / (t.size - 1)
     duration = t[-1] - t[0] + dt
     return 2.0 * np.pi / duration / _LOW_MARGIN, np.pi / dt * _HIGH_MARGIN
@@ -448,33 +448,6 @@ def default_band(t) -> tuple[float, float]:
 def _auto_order(omega_low: float, omega_high: float) -> int:
     decades = math.log10(omega_high / omega_low)
     return max(_MIN_ORDER, math.ceil((_PAIRS_PER_DECADE * decades - 1.0) / 2.0))
-
-
-def _check_grid(t) -> np.ndarray:
-    try:
-        t = np.asarray(t, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError("argument 't' must be a 1-D array of real sample times") from None
-    if t.ndim != 1 or t.size < 2:
-        raise InputError(
-            f"argument 't' must be a 1-D array of >= 2 sample times, got shape {t.shape}"
-        )
-    if not np.all(np.isfinite(t)):
-        i = int(np.flatnonzero(~np.isfinite(t))[0])
-        raise InputError(f"argument 't' has a non-finite value at index {i}")
-    d = np.diff(t)
-    if np.any(d <= 0):
-        i = int(np.flatnonzero(d <= 0)[0])
-        raise InputError(f"argument 't' must be strictly increasing; t[{i + 1}] <= t[{i}]")
-    dt = (t[-1] - t[0]) / (t.size - 1)
-    dev = np.abs(t - (t[0] + dt * np.arange(t.size))) / dt
-    if np.max(dev) > _GRID_TOLERANCE:
-        i = int(np.argmax(dev > _GRID_TOLERANCE))
-        raise InputError(
-            f"argument 't' must be equally spaced: t[{i}] is {dev[i]:.3g} steps off the uniform "
-            f"grid of step {dt:g} s (tolerance {_GRID_TOLERANCE:g} of a step)"
-        )
-    return t
 
 
 def _realisation(scaled: _Scaled) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -578,7 +551,7 @@ def simulate(numerator, denominator, t, u, *, omega_low=None, omega_high=None, o
     >>> bool(np.max(np.abs(y - (1.0 - np.exp(-t)))) < 1e-6)
     True
     """
-    t = _check_grid(t)
+    t = check_time_grid(t, min_samples=2)
     try:
         u = np.asarray(u, dtype=float)
     except (TypeError, ValueError):

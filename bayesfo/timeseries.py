@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize
 
-from bayesfo._io import atomic_write_text
+from bayesfo._io import atomic_write_text, read_text_file
 from bayesfo.errors import InputError, NonlinearityWarning
 
 __all__ = [
@@ -186,15 +186,16 @@ def _grid_violation(t: np.ndarray) -> tuple[int, float] | None:
     return None
 
 
-def _check_time(t) -> np.ndarray:
+def check_time_grid(t, min_samples: int = MIN_SAMPLES) -> np.ndarray:
+    """A uniformly sampled, strictly increasing 1-D time vector, or :class:`InputError`."""
     try:
         t = np.asarray(t, dtype=float)
     except (TypeError, ValueError):
         raise InputError("argument 't' must be a 1-D array of real sample times") from None
     if t.ndim != 1:
         raise InputError(f"argument 't' must be 1-D, got shape {t.shape}")
-    if t.size < MIN_SAMPLES:
-        raise InputError(f"argument 't' has {t.size} samples; at least {MIN_SAMPLES} are needed")
+    if t.size < min_samples:
+        raise InputError(f"argument 't' has {t.size} samples; at least {min_samples} are needed")
     if not np.all(np.isfinite(t)):
         i = int(np.flatnonzero(~np.isfinite(t))[0])
         raise InputError(f"argument 't' has a non-finite value at index {i}")
@@ -429,7 +430,7 @@ def _analyze(t, u, y, omega, n_harmonics, threshold, where: str) -> HarmonicAnal
 
 
 def _check_and_analyze(t, u, y, omega, n_harmonics, nonlinearity_threshold, where=""):
-    t = _check_time(t)
+    t = check_time_grid(t)
     u = _check_signal("u", u, t.size)
     y = _check_signal("y", y, t.size)
     if u.shape != y.shape:
@@ -577,25 +578,13 @@ def read_sine_record(path):
     Thesis §4.2 (measurement procedure: repeated series per frequency), §4.3.1.
     """
     path = Path(path)
-    try:
-        fh = open(path, encoding="utf-8-sig", newline="")
-    except FileNotFoundError:
-        raise InputError(f"{path}: file not found") from None
-    except IsADirectoryError:
-        raise InputError(f"{path}: is a directory, not a record file") from None
-    except OSError as exc:
-        raise InputError(f"{path}: cannot be read ({exc.strerror})") from None
+    text = read_text_file(path, "record file")
 
     header: list[str] | None = None
     header_line = 0
     omega_meta: dict[str, tuple[float, int]] = {}
     rows: list[tuple[int, list[str]]] = []
-    with fh:
-        try:
-            lines = list(enumerate(fh, start=1))
-        except UnicodeDecodeError as exc:
-            raise InputError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
-    for lineno, raw in lines:
+    for lineno, raw in enumerate(text.splitlines(), start=1):
         line = raw.strip()
         if not line:
             continue

@@ -48,7 +48,7 @@ def test_identify_with_fixed_q_and_human_output(run_cli, gspec_csv):
         (["identify", "{csv}"], "--structure"),
         (["simulate", "table-9.9"], "unknown study 'table-9.9'"),
         (["simulate", "table-3.2", "--runs", "1"], "at least 2"),
-        (["extract", "missing.csv", "--out", "x.csv"], "missing.csv: file not found"),
+        (["extract", "missing.csv", "--out", "x.csv"], "does not exist"),
         (["inspect", "nope.csv"], "does not exist"),
         (["frobnicate"], "invalid choice"),
     ],

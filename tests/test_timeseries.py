@@ -468,7 +468,7 @@ def test_read_record_errors_name_file_line_and_column(write_csv, text, match):
 
 
 def test_read_record_missing_file(tmp_path):
-    with pytest.raises(InputError, match="nope.csv: file not found"):
+    with pytest.raises(InputError, match="nope.csv' does not exist"):
         read_sine_record(tmp_path / "nope.csv")
     with pytest.raises(InputError, match="is a directory"):
         read_sine_record(tmp_path)

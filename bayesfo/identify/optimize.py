@@ -48,8 +48,9 @@ class FitResult:
     admissible : bool
         Whether the returned optimum satisfies every constraint of the structure.
     n_starts, n_admissible, n_at_best : int
-        Starts run, starts that ended admissible, and admissible starts within 1e-6 (relative)
-        of the best cost: a measure of how reliably the optimum is found.
+        Starts run (fewer than offered when the search stopped early), starts that ended
+        admissible, and admissible starts within 1e-6 (relative) of the best cost: a measure of
+        how reliably the optimum is found.
     optima : ndarray, shape (k, n_params)
         Distinct admissible local optima (scaled), best first: the modes that seed the sampler.
     """
@@ -149,6 +150,8 @@ def fit_structure(
     weighting: str = "auto",
     starts=None,
     seed_methods: bool = False,
+    min_starts: int = 8,
+    stop_after: int | None = 4,
 ) -> FitResult:
     """Fit ``structure`` to ``data`` by multi-start bounded least squares.
 
@@ -169,6 +172,10 @@ def fit_structure(
     seed_methods : bool
         Also start from the linear methods 2 and 3 (thesis Table 3.1) on a coarse q grid, for
         structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
+    min_starts, stop_after : int
+        Stop once at least ``min_starts`` starts have run and ``stop_after`` of them ended at
+        the best admissible cost found so far (``stop_after=None`` runs every start). Given and
+        seeded starts alternate with random ones, so an early stop still has both kinds.
 
     Returns
     -------
@@ -207,19 +214,29 @@ def fit_structure(
         with np.errstate(divide="ignore", invalid="ignore"):
             extra_u = np.where(prob.log, np.log(np.abs(extra)), extra)
         extra_u = np.clip(extra_u, prob.lo + 1e-9 * span, prob.hi - 1e-9 * span)
-        u0 = np.vstack([extra_u[np.all(np.isfinite(extra_u), axis=1)], u0])
+        u0 = _interleave(extra_u[np.all(np.isfinite(extra_u), axis=1)], u0)
 
-    sols, costs = [], []
-    for u in u0:
+    sols, costs, oks = [], [], []
+    best_cost, hits = np.inf, 0
+    for i, u in enumerate(u0):
         res = optimize.least_squares(
             prob.fun, u, jac=prob.jac, bounds=(prob.lo, prob.hi), method="trf",
             x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400,
         )
+        cost = 2 * res.cost
+        ok_i = bool(np.isfinite(cost) and structure.admissible(prob.theta(res.x), data.kind, prob.grid))
         sols.append(res.x)
-        costs.append(2 * res.cost)
-    sols, costs = np.array(sols), np.array(costs)
+        costs.append(cost)
+        oks.append(ok_i)
+        if ok_i:
+            if cost < best_cost * (1 - 1e-6) - 1e-12:
+                best_cost, hits = cost, 1
+            elif cost <= best_cost * (1 + 1e-6) + 1e-12:
+                hits += 1
+        if stop_after is not None and i + 1 >= min_starts and hits >= stop_after:
+            break
+    sols, costs, ok = np.array(sols), np.array(costs), np.array(oks)
     thetas = prob.theta(sols)
-    ok = structure.admissible(thetas, data.kind, prob.grid) & np.isfinite(costs)
     n_adm = int(ok.sum())
     if n_adm:
         idx = np.flatnonzero(ok)[np.argsort(costs[ok])]
@@ -242,11 +259,22 @@ def fit_structure(
         chi2=float(costs[best]),
         weighting=weighting,
         admissible=bool(n_adm),
-        n_starts=len(u0),
+        n_starts=len(sols),
         n_admissible=n_adm,
         n_at_best=at_best,
         optima=optima,
     )
+
+
+def _interleave(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Rows of ``first`` and ``second`` alternately, the rest of the longer one at the end."""
+    out = []
+    for i in range(max(len(first), len(second))):
+        if i < len(first):
+            out.append(first[i])
+        if i < len(second):
+            out.append(second[i])
+    return np.array(out).reshape(-1, second.shape[1])
 
 
 def _distinct(thetas: np.ndarray, rtol: float = 1e-3) -> np.ndarray:

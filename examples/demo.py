@@ -42,7 +42,7 @@ def main(argv=None):
     rows = []
     t0 = time.perf_counter()
     for s in resolve_structures(args.structures):
-        fit = fit_structure(s, data, rng=args.seed)
+        fit = fit_structure(s, data, rng=args.seed, seed_methods=True)
         n_real = 2 * data.n_frequencies
         aic = n_real * math.log(fit.chi2 / n_real) + 2 * s.n_params if fit.admissible else math.nan
         q = next((fit.theta[i] for i, n in enumerate(s.param_names) if n in ("q", "beta")), 1.0)

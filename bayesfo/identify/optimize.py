@@ -150,7 +150,7 @@ def fit_structure(
     weighting: str = "auto",
     starts=None,
     seed_methods: bool = False,
-    min_starts: int = 8,
+    min_starts: int = 12,
     stop_after: int | None = 4,
 ) -> FitResult:
     """Fit ``structure`` to ``data`` by multi-start bounded least squares.

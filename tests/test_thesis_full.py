@@ -48,7 +48,9 @@ def test_n2m2_global_optimum_is_at_least_as_good_as_any_q_one_half_fit():
         free = fit_structure(s, data, rng=r, weighting="none", seed_methods=True)
         half = fit_structure(fix_parameters(s, {"q": 0.5}), data, rng=r, weighting="none",
                              seed_methods=True)
-        assert free.chi2 <= half.chi2 * (1 + 1e-9)
+        assert free.admissible
+        if half.admissible:  # with q = 0.5 the best optimum may be unstable or not dissipative
+            assert free.chi2 <= half.chi2 * (1 + 1e-9)
         qs.append(free.theta[-1])
     assert np.std(qs) > 0.05
 

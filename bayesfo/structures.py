@@ -482,12 +482,38 @@ class Structure:
         return ok[0] if single else ok
 
     def passive(self, theta, kind: str, omega_grid) -> np.ndarray:
-        """Dissipation ≥ 0 of the response compared with ``kind`` data on ``omega_grid``."""
+        """Dissipation ≥ 0 of the response compared with ``kind`` data on ``omega_grid``.
+
+        Commensurate structures of degree ≤ 1 on both sides use the exact condition instead of
+        the grid: Im[(b0 + b1 λ)/(a0 + a1 λ)] = (b1 a0 − b0 a1) Im λ / |A|², and Im λ > 0 for
+        0 < q < 2, so a compliance (and its reciprocal, a modulus) dissipates iff
+        b1 a0 ≤ b0 a1, at every frequency.
+        """
+        theta2 = np.atleast_2d(np.asarray(theta, float))
+        single = np.ndim(theta) != 2
         if kind == "generic":
-            n = np.atleast_2d(np.asarray(theta, float)).shape[0]
-            ok = np.ones(n, dtype=bool)
-            return ok if np.ndim(theta) == 2 else ok[0]
-        return is_dissipative(self.response(theta, omega_grid, kind), kind)
+            ok = np.ones(theta2.shape[0], dtype=bool)
+        elif self._first_degree:
+            den, num, q = self.polynomials(theta2)
+            den = np.pad(den, ((0, 0), (0, 2 - den.shape[1])))
+            num = np.pad(num, ((0, 0), (0, 2 - num.shape[1])))
+            lhs, rhs = num[:, 1] * den[:, 0], num[:, 0] * den[:, 1]
+            scale = np.abs(lhs) + np.abs(rhs)
+            ok = (lhs <= rhs + 1e-12 * scale) | ~((q > 0) & (q < 2))
+            ok &= np.all(np.isfinite(theta2), axis=1)
+        else:
+            ok = is_dissipative(self.response(theta2, omega_grid, kind), kind)
+        return ok[0] if single else ok
+
+    @cached_property
+    def _first_degree(self) -> bool:
+        """Commensurate with numerator and denominator of degree ≤ 1 in λ = s^q."""
+        if self.commensurate_order is None:
+            return False
+        return all(
+            (t.exponent.multiple if t.exponent.param else 0) <= 1
+            for t in self.numerator + self.denominator
+        )
 
     def admissible(self, theta, kind: str, omega_grid=None) -> np.ndarray:
         """All declared constraints and prior supports at once: the support of the posterior.
@@ -643,12 +669,19 @@ def integer_variant(s: Structure) -> Structure:
 
 
 def fix_parameters(s: Structure, values: dict[str, float]) -> Structure:
-    """A copy of ``s`` with some free parameters fixed (e.g. ``{"q": 0.5}``)."""
+    """A copy of ``s`` with some exponent parameters fixed (e.g. ``{"q": 0.5}``)."""
     unknown = [k for k in values if k not in s.param_names]
     if unknown:
         raise StructureError(
             f"structure '{s.name}' has no free parameter '{unknown[0]}'; "
             f"its free parameters are {', '.join(s.param_names)}"
+        )
+    # Coefficients change with the internal scaling of ω and G; only exponents are unit-free.
+    coef = [k for k in values if k not in s.exponent_params]
+    if coef:
+        raise StructureError(
+            f"only exponent parameters ({', '.join(s.exponent_params) or 'none'}) can be fixed "
+            f"in structure '{s.name}', not '{coef[0]}'"
         )
     for k, v in values.items():
         if not s.priors[k].contains(v):

@@ -243,3 +243,21 @@ def test_stable_needs_a_polynomial_denominator(tmp_path):
 def test_missing_card_path():
     with pytest.raises(StructureError, match="does not exist"):
         load_library(extra=["/nonexistent/cards"])
+
+
+@pytest.mark.parametrize("name", ["voigt", "zener-inv", "voigt-inv-int", "max-n1m1", "max-n1m1-inv",
+                                  "max-n0m1-inv", "zener-int"])
+@pytest.mark.parametrize("kind", ["compliance", "modulus"])
+def test_exact_dissipation_of_first_degree_structures_equals_grid(name, kind):
+    from bayesfo.response import is_dissipative
+
+    s = LIB[name]
+    assert s._first_degree
+    rng = np.random.default_rng(len(name))
+    theta = rng.uniform(-1.0, 3.0, (400, s.n_params))
+    if "q" in s.param_names:
+        theta[:, s.param_names.index("q")] = rng.uniform(0.05, 1.0, 400)
+    grid = dissipation_grid(1e-2, 1e2)
+    on_grid = is_dissipative(s.response(theta, grid, kind), kind)
+    np.testing.assert_array_equal(s.passive(theta, kind, grid), on_grid)
+    assert 20 < on_grid.sum() < 380

@@ -1,0 +1,224 @@
+"""Likelihood of a structure on complex frequency-response data, and its prior support.
+
+Each measured point G_k is modelled as the structure's response plus circular complex Gaussian
+noise: real and imaginary parts independent with variance σ_k²/2 each, so σ_k² = E|ΔG_k|² (the σ of
+the CSV contract). The pointwise log-likelihood of a complex point is
+
+    ln p(G_k | θ) = −ln(π σ_k²) − |G_k − Ĝ_k(θ)|² / σ_k²,
+
+which is the sum of the two real Gaussian terms of the stacked real and imaginary parts. Noise
+models:
+
+``known``
+    σ_k from the data (a ``sigma`` column or replicates).
+``constant``
+    One unknown σ for all points, sampled with a log-uniform (scale-invariant) prior.
+``proportional``
+    σ_k = σ_rel·|G_k| (data magnitude), σ_rel sampled with a log-uniform prior: relative errors,
+    suited to data spanning decades.
+
+Everything is evaluated on the scaled data (ω/ω_ref, G/g_ref) and vectorised over parameter sets;
+the log-likelihood is reported in physical units (the scaling adds −2·ln g_ref per point).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..errors import InputError
+from ..priors import LogUniform, Prior
+from ..response import dissipation_grid
+from ..structures import Scaling, Structure
+
+NOISE_MODELS = ("known", "constant", "proportional")
+
+#: Priors of the noise scale on the scaled data (|G|/g_ref is of order one).
+NOISE_PRIORS = {
+    "constant": ("sigma", LogUniform(1e-6, 10.0)),
+    "proportional": ("sigma_rel", LogUniform(1e-5, 1.0)),
+}
+
+
+def choose_noise(data: FrequencyResponse, noise: str = "auto") -> tuple[str, str]:
+    """Resolve ``"auto"`` and say why.
+
+    Returns
+    -------
+    noise, reason : str
+        ``known`` when the data carry σ; else ``proportional`` when |G| spans more than a decade
+        (a constant σ would let the largest values dominate); else ``constant``.
+    """
+    if noise not in NOISE_MODELS + ("auto",):
+        raise InputError(f"noise model must be auto, {', '.join(NOISE_MODELS)}; got {noise!r}")
+    if noise == "known" and data.sigma is None:
+        raise InputError(f"noise model 'known' needs sigma in {data.where()}")
+    if noise != "auto":
+        return noise, "chosen by the user"
+    if data.sigma is not None:
+        return "known", "the data give sigma per point"
+    mag = data.magnitude
+    if mag.max() > 10 * mag.min():
+        return "proportional", f"|G| spans {np.log10(mag.max() / mag.min()):.1f} decades"
+    return "constant", "|G| spans less than a decade"
+
+
+@dataclass(frozen=True, eq=False)
+class Likelihood:
+    """Log-likelihood and prior support of ``structure`` on ``data``.
+
+    Parameter vectors are the structure's parameters on the scaled problem followed by the noise
+    parameter (``sigma`` or ``sigma_rel``) unless the noise is known: see :attr:`param_names`.
+
+    Parameters
+    ----------
+    structure : Structure
+    data : FrequencyResponse
+    noise : {"auto", "known", "constant", "proportional"}
+    priors : dict, optional
+        Overrides of structure or noise priors, ``{name: Prior}``.
+    """
+
+    structure: Structure
+    data: FrequencyResponse
+    noise: str = "auto"
+    priors: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.structure.check_data(self.data)
+        noise, reason = choose_noise(self.data, self.noise)
+        object.__setattr__(self, "noise", noise)
+        object.__setattr__(self, "noise_reason", reason)
+        struct_priors = {k: v for k, v in self.priors.items() if k in self.structure.param_names}
+        structure = self.structure.with_priors(struct_priors) if struct_priors else self.structure
+        object.__setattr__(self, "structure", structure)
+        noise_param = NOISE_PRIORS.get(noise)
+        unknown = set(self.priors) - set(structure.param_names) - ({noise_param[0]} if noise_param else set())
+        if unknown:
+            raise InputError(
+                f"prior override for unknown parameter '{sorted(unknown)[0]}'; parameters are "
+                f"{', '.join(structure.param_names + ((noise_param[0],) if noise_param else ()))}"
+            )
+        if noise_param is not None and noise_param[0] in self.priors:
+            noise_param = (noise_param[0], self.priors[noise_param[0]])
+        object.__setattr__(self, "noise_param", noise_param)
+        scaling = Scaling.from_data(self.data)
+        object.__setattr__(self, "scaling", scaling)
+        w = self.data.omega / scaling.omega_ref
+        g = self.data.response / scaling.g_ref
+        object.__setattr__(self, "omega_scaled", w)
+        object.__setattr__(self, "g_scaled", g)
+        object.__setattr__(self, "grid", dissipation_grid(w.min(), w.max()))
+        if noise == "known":
+            s2 = (self.data.sigma / scaling.g_ref) ** 2
+            object.__setattr__(self, "_var", s2)
+            object.__setattr__(self, "_log_norm", -np.log(np.pi * s2))
+        else:
+            object.__setattr__(self, "_abs_g2", np.abs(g) ** 2)
+        object.__setattr__(self, "_unit_shift", -2.0 * math.log(scaling.g_ref))
+
+    # ------------------------------------------------------------------ names and priors
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        names = self.structure.param_names
+        return names + ((self.noise_param[0],) if self.noise_param else ())
+
+    @property
+    def ndim(self) -> int:
+        return len(self.param_names)
+
+    @property
+    def prior_list(self) -> list[Prior]:
+        """The prior of every parameter, in the order of :attr:`param_names`."""
+        out = [p.prior for p in self.structure.parameters]
+        if self.noise_param:
+            out.append(self.noise_param[1])
+        return out
+
+    def describe_priors(self) -> dict[str, dict]:
+        return {n: p.to_dict() for n, p in zip(self.param_names, self.prior_list)}
+
+    # ------------------------------------------------------------------ evaluation
+    def model(self, theta) -> np.ndarray:
+        """Scaled model response for parameter sets ``theta`` (n_sets, ndim)."""
+        theta = np.atleast_2d(theta)
+        return self.structure.response(theta[:, : self.structure.n_params], self.omega_scaled,
+                                       self.data.kind)
+
+    def pointwise(self, theta) -> np.ndarray:
+        """Log-likelihood of each frequency, shape (n_sets, n_freq), ignoring the support.
+
+        Non-finite model values give −inf.
+        """
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        model = self.model(theta)
+        r2 = np.abs(self.g_scaled - model) ** 2
+        if self.noise == "known":
+            out = self._log_norm - r2 / self._var
+        else:
+            s = theta[:, -1:]
+            var = s * s if self.noise == "constant" else (s * s) * self._abs_g2
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out = -np.log(np.pi * var) - r2 / var
+        out = out + self._unit_shift
+        return np.where(np.isfinite(out), out, -np.inf)
+
+    def in_support(self, theta) -> np.ndarray:
+        """True where θ lies in the support of the prior: every prior range, the structure's
+        inequalities, stability and dissipation."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        ok = np.all(np.isfinite(theta), axis=1)
+        if self.noise_param:
+            ok &= self.noise_param[1].contains(theta[:, -1])
+        rows = np.flatnonzero(ok)
+        if rows.size:
+            ok[rows] = self.structure.admissible(
+                theta[rows, : self.structure.n_params], self.data.kind, self.grid
+            )
+        return ok
+
+    def log_prior(self, theta) -> np.ndarray:
+        """Log prior density of θ (−inf outside the support)."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        out = np.zeros(theta.shape[0])
+        for i, prior in enumerate(self.prior_list):
+            out += prior.log_prob(theta[:, i])
+        support = self.in_support(theta)
+        return np.where(support & np.isfinite(out), out, -np.inf)
+
+    def __call__(self, theta) -> np.ndarray:
+        """Total log-likelihood, shape (n_sets,) (ignores the support)."""
+        return self.pointwise(theta).sum(axis=1)
+
+    def to_physical(self, theta) -> np.ndarray:
+        """Scaled parameter sets → physical units (σ in the units of G; σ_rel unchanged)."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        out = theta.copy()
+        k = self.structure.n_params
+        out[:, :k] = self.structure.to_physical(theta[:, :k], self.scaling)
+        if self.noise == "constant":
+            out[:, k] = theta[:, k] * self.scaling.g_ref
+        return out
+
+    def to_scaled(self, theta) -> np.ndarray:
+        """Physical parameter sets → the scaled problem."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        out = theta.copy()
+        k = self.structure.n_params
+        out[:, :k] = self.structure.to_scaled(theta[:, :k], self.scaling)
+        if self.noise == "constant":
+            out[:, k] = theta[:, k] / self.scaling.g_ref
+        return out
+
+    def noise_estimate(self, theta_structure) -> np.ndarray:
+        """The noise parameter that maximises the likelihood for given structure parameters
+        (scaled): sqrt(mean |r|²) or sqrt(mean |r|²/|G|²)."""
+        theta_structure = np.atleast_2d(theta_structure)
+        model = self.structure.response(theta_structure, self.omega_scaled, self.data.kind)
+        r2 = np.abs(self.g_scaled - model) ** 2
+        if self.noise == "constant":
+            return np.sqrt(r2.mean(axis=1))
+        return np.sqrt((r2 / self._abs_g2).mean(axis=1))

@@ -1,0 +1,447 @@
+"""Posterior sampling with emcee, seeded by the deterministic fits, and its summaries.
+
+The sampler works in coordinates u where log-uniform parameters are replaced by their logarithm
+(there the prior is flat and scale parameters spanning decades mix well); the density includes the
+Jacobian, so samples are from the posterior of the declared priors. Walkers start around every
+distinct admissible optimum of the global optimisation and the linear methods that lies within
+``mode_window`` log-likelihood units of the best one (jittered, kept inside the support), and move
+with a mixture of differential-evolution, DE-snooker and stretch moves, which can jump between the
+q modes of high-order structures (thesis Table A.9).
+
+The run length is set by the integrated autocorrelation time τ (emcee): it continues until it is
+at least ``tau_factor``·τ steps long and τ has settled, up to ``max_steps``. Burn-in is 2·τ_max,
+thinning τ_min/2. Convergence is judged with arviz' rank-normalised split R-hat over walkers and
+bulk and tail effective sample sizes; a run that misses them issues a :class:`ConvergenceWarning`
+and has ``converged = False``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..priors import LogUniform
+from ._arviz import arviz
+from .likelihood import Likelihood
+
+HDI_PROB = 0.94
+RHAT_MAX = 1.01
+ESS_MIN = 400
+
+
+class ConvergenceWarning(UserWarning):
+    """The sampler stopped before its diagnostics reached the targets."""
+
+
+@dataclass(frozen=True)
+class ParameterSummary:
+    """Posterior summary of one parameter, in physical units.
+
+    ``poorly_determined``: the 94 % HDI covers more than half of the prior range (in the sampling
+    coordinate, i.e. in log for log-uniform priors). ``multimodal``: the marginal density has more
+    than one clearly separated peak.
+    """
+
+    mean: float
+    sd: float
+    hdi_low: float
+    hdi_high: float
+    map: float
+    median: float
+    poorly_determined: bool
+    multimodal: bool
+
+    def to_dict(self) -> dict:
+        return {k: (bool(v) if isinstance(v, (bool, np.bool_)) else float(v))
+                for k, v in self.__dict__.items()}
+
+
+@dataclass(frozen=True, eq=False)
+class PosteriorResult:
+    """Posterior draws of one structure on one data set, with diagnostics.
+
+    Attributes
+    ----------
+    structure : str
+    param_names : tuple of str
+        Structure parameters, then ``sigma``/``sigma_rel`` when the noise is sampled.
+    noise, noise_reason : str
+        The noise model and why it was chosen.
+    samples : ndarray, shape (n_draws, ndim)
+        Thinned post-burn-in draws in physical units (walkers × kept steps).
+    samples_scaled : ndarray
+        The same draws on the scaled problem.
+    log_likelihood : ndarray, shape (n_draws,)
+        Total log-likelihood of each draw (physical units).
+    summary : dict
+        ``{name: ParameterSummary}``.
+    map_theta : ndarray
+        The draw with the highest posterior density (physical units).
+    max_log_likelihood : float
+        Highest log-likelihood among the draws.
+    tau : ndarray
+        Integrated autocorrelation time of each parameter [steps].
+    n_steps, burn, thin, n_walkers : int
+    acceptance : float
+        Mean acceptance fraction.
+    rhat_max, ess_bulk_min, ess_tail_min : float
+    converged : bool
+    messages : tuple of str
+        Warnings raised during the run.
+    idata : arviz.InferenceData
+        Posterior, log_likelihood (per frequency), posterior_predictive, observed_data and
+        sample_stats, coordinates named by frequency.
+    """
+
+    structure: str
+    param_names: tuple[str, ...]
+    noise: str
+    noise_reason: str
+    samples: np.ndarray
+    samples_scaled: np.ndarray
+    log_likelihood: np.ndarray
+    summary: dict
+    map_theta: np.ndarray
+    max_log_likelihood: float
+    tau: np.ndarray
+    n_steps: int
+    burn: int
+    thin: int
+    n_walkers: int
+    acceptance: float
+    rhat_max: float
+    ess_bulk_min: float
+    ess_tail_min: float
+    converged: bool
+    messages: tuple[str, ...] = ()
+    idata: object = field(default=None, repr=False)
+
+    @property
+    def ess_min(self) -> float:
+        return min(self.ess_bulk_min, self.ess_tail_min)
+
+    def to_dict(self) -> dict:
+        return {
+            "structure": self.structure,
+            "noise": self.noise,
+            "noise_reason": self.noise_reason,
+            "parameters": {k: v.to_dict() for k, v in self.summary.items()},
+            "max_log_likelihood": self.max_log_likelihood,
+            "tau": dict(zip(self.param_names, map(float, self.tau))),
+            "n_steps": self.n_steps, "burn": self.burn, "thin": self.thin,
+            "n_walkers": self.n_walkers, "n_draws": int(self.samples.shape[0]),
+            "acceptance": self.acceptance,
+            "rhat_max": self.rhat_max, "ess_bulk_min": self.ess_bulk_min,
+            "ess_tail_min": self.ess_tail_min, "ess_min": self.ess_min,
+            "converged": self.converged, "messages": list(self.messages),
+        }
+
+
+class _Transform:
+    """θ ↔ u (log for log-uniform priors) and the log-Jacobian."""
+
+    def __init__(self, lik: Likelihood):
+        self.log = np.array([isinstance(p, LogUniform) for p in lik.prior_list])
+
+    def to_theta(self, u):
+        return np.where(self.log, np.exp(np.clip(u, -700, 700)), u)
+
+    def to_u(self, theta):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.log, np.log(np.abs(theta)), theta)
+
+    def log_jacobian(self, u):
+        return np.sum(np.where(self.log, u, 0.0), axis=-1)
+
+
+def _log_prob_fn(lik: Likelihood, tr: _Transform):
+    def log_prob(u):
+        u = np.atleast_2d(u)
+        theta = tr.to_theta(u)
+        lp = lik.log_prior(theta)
+        ok = np.isfinite(lp)
+        out = np.full(u.shape[0], -np.inf)
+        if ok.any():
+            ll = lik(theta[ok])
+            out[ok] = ll + lp[ok] + tr.log_jacobian(u[ok])
+        return out
+
+    return log_prob
+
+
+def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.random.Generator,
+                    *, mode_window: float = 10.0, jitter: float = 1e-3) -> np.ndarray:
+    """Walker positions (θ, scaled) around the seeds' modes, inside the support.
+
+    ``seeds_scaled`` holds structure parameters (without noise) on the scaled problem. Seeds whose
+    best log-likelihood is more than ``mode_window`` below the best seed are dropped; the rest
+    share the walkers round-robin, each walker a Gaussian jitter of relative size ``jitter`` in
+    the sampling coordinates, redrawn until it lies in the support.
+    """
+    seeds = np.atleast_2d(np.asarray(seeds_scaled, dtype=float))
+    if lik.noise_param:
+        seeds = np.column_stack([seeds, lik.noise_estimate(seeds)])
+    ok = lik.in_support(seeds)
+    if not ok.any():
+        raise InputError(
+            f"no starting point of structure '{lik.structure.name}' lies in the prior support "
+            "(stable, dissipative, within the prior ranges)"
+        )
+    seeds = seeds[ok]
+    ll = lik(seeds)
+    keep = ll >= ll.max() - mode_window
+    seeds = seeds[keep][np.argsort(-ll[keep])]
+    tr = _Transform(lik)
+    u_seeds = tr.to_u(seeds)
+    out = np.empty((n_walkers, lik.ndim))
+    for i in range(n_walkers):
+        base = u_seeds[i % len(u_seeds)]
+        for _ in range(100):
+            u = base + jitter * (1.0 + np.abs(base)) * rng.normal(size=base.size)
+            theta = tr.to_theta(u)
+            if lik.in_support(theta[None, :])[0]:
+                break
+        else:
+            theta = tr.to_theta(base)
+        out[i] = theta
+    return out
+
+
+def sample_posterior(
+    lik: Likelihood,
+    seeds_scaled,
+    *,
+    seed: int = 0,
+    n_walkers: int | None = None,
+    tau_factor: float = 50.0,
+    max_steps: int = 20_000,
+    check_every: int = 250,
+    max_draws: int = 4000,
+    progress: bool | None = None,
+    predictive: bool = True,
+) -> PosteriorResult:
+    """Sample the posterior of ``lik`` with emcee.
+
+    Parameters
+    ----------
+    lik : Likelihood
+    seeds_scaled : array_like, shape (k, n_structure_params)
+        Starting modes on the scaled problem (e.g. ``FitResult.optima`` and linear seeds).
+    seed : int
+        Seed of the walker jitter, the moves and the posterior predictive draws.
+    n_walkers : int, optional
+        Default max(32, 4·ndim), even.
+    tau_factor, max_steps, check_every
+        Run until the chain is ``tau_factor``·τ long (τ changing by < 5 % between checks), at
+        most ``max_steps`` steps, checking every ``check_every`` steps.
+    max_draws : int
+        Upper bound on the stored draws (thinning is raised to respect it).
+    progress : bool, optional
+        Progress bar (tqdm); default: on when stderr is a terminal.
+    predictive : bool
+        Store the posterior predictive and the model response in the InferenceData.
+
+    Returns
+    -------
+    PosteriorResult
+    """
+    import emcee
+
+    rng = np.random.default_rng(seed)
+    ndim = lik.ndim
+    n_walkers = n_walkers or max(32, 4 * ndim)
+    n_walkers += n_walkers % 2
+    if n_walkers < 2 * ndim:
+        raise InputError(f"n_walkers must be at least {2 * ndim} for {ndim} parameters")
+    if progress is None:
+        progress = sys.stderr.isatty()
+    tr = _Transform(lik)
+    p0 = tr.to_u(initial_walkers(lik, seeds_scaled, n_walkers, rng))
+    moves = [(emcee.moves.DEMove(), 0.6), (emcee.moves.DESnookerMove(), 0.2),
+             (emcee.moves.StretchMove(), 0.2)]
+    sampler = emcee.EnsembleSampler(n_walkers, ndim, _log_prob_fn(lik, tr), moves=moves,
+                                    vectorize=True)
+    sampler.random_state = np.random.RandomState(seed).get_state()
+
+    old_tau = np.inf
+    tau = np.full(ndim, np.nan)
+    settled = False
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for _ in sampler.sample(p0, iterations=max_steps, progress=progress,
+                                progress_kwargs={"desc": lik.structure.name, "leave": False}):
+            it = sampler.iteration
+            if it % check_every:
+                continue
+            tau = sampler.get_autocorr_time(tol=0, discard=it // 5)
+            if np.all(np.isfinite(tau)):
+                settled = np.all(tau * tau_factor < it) and np.all(np.abs(old_tau - tau) < 0.05 * tau)
+                if settled:
+                    break
+                old_tau = tau
+    n_steps = sampler.iteration
+    if not np.all(np.isfinite(tau)):
+        tau = sampler.get_autocorr_time(tol=0, discard=n_steps // 5)
+    tau_max = float(np.nanmax(tau)) if np.any(np.isfinite(tau)) else n_steps / 10
+    tau_min = float(np.nanmin(tau)) if np.any(np.isfinite(tau)) else 1.0
+    burn = min(int(math.ceil(2 * tau_max)), n_steps // 2)
+    thin = max(1, int(tau_min // 2))
+    kept = (n_steps - burn) // thin
+    if kept * n_walkers > max_draws:
+        thin = int(math.ceil((n_steps - burn) * n_walkers / max_draws))
+    chain_u = sampler.get_chain(discard=burn, thin=thin)  # (steps, walkers, ndim)
+    log_post = sampler.get_log_prob(discard=burn, thin=thin)
+    chain = tr.to_theta(chain_u)
+    n_kept = chain.shape[0]
+    flat_scaled = chain.transpose(1, 0, 2).reshape(-1, ndim)  # walker-major: chain = walker
+    pointwise = lik.pointwise(flat_scaled)
+    loglik = pointwise.sum(axis=1)
+    flat_phys = lik.to_physical(flat_scaled)
+    lp_flat = log_post.T.reshape(-1)
+
+    az = arviz()
+
+    post = {name: flat_phys[:, i].reshape(n_walkers, n_kept) for i, name in enumerate(lik.param_names)}
+    ds = az.convert_to_dataset(post)
+    rhat = az.rhat(ds)
+    ess_bulk = az.ess(ds, method="bulk")
+    ess_tail = az.ess(ds, method="tail")
+    rhat_max = float(max(float(rhat[n]) for n in lik.param_names))
+    ess_bulk_min = float(min(float(ess_bulk[n]) for n in lik.param_names))
+    ess_tail_min = float(min(float(ess_tail[n]) for n in lik.param_names))
+    messages = []
+    if not settled:
+        messages.append(
+            f"{lik.structure.name}: stopped at the cap of {max_steps} steps before the chain was "
+            f"{tau_factor:g} autocorrelation times long (tau up to {tau_max:.0f} steps)"
+        )
+    if not rhat_max < RHAT_MAX:
+        messages.append(f"{lik.structure.name}: R-hat {rhat_max:.3f} is not below {RHAT_MAX}")
+    if not min(ess_bulk_min, ess_tail_min) >= ESS_MIN:
+        messages.append(
+            f"{lik.structure.name}: effective sample size {min(ess_bulk_min, ess_tail_min):.0f} "
+            f"is below {ESS_MIN}"
+        )
+    converged = not messages
+    for m in messages:
+        warnings.warn(m, ConvergenceWarning, stacklevel=2)
+
+    best = int(np.argmax(lp_flat))
+    map_theta = flat_phys[best]
+    summary = _summaries(lik, tr, flat_phys, chain_u.transpose(1, 0, 2).reshape(-1, ndim), map_theta)
+    idata = _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kept,
+                            rng if predictive else None)
+    return PosteriorResult(
+        structure=lik.structure.name,
+        param_names=lik.param_names,
+        noise=lik.noise,
+        noise_reason=lik.noise_reason,
+        samples=flat_phys,
+        samples_scaled=flat_scaled,
+        log_likelihood=loglik,
+        summary=summary,
+        map_theta=map_theta,
+        max_log_likelihood=float(loglik.max()),
+        tau=np.asarray(tau, dtype=float),
+        n_steps=int(n_steps),
+        burn=int(burn),
+        thin=int(thin),
+        n_walkers=int(n_walkers),
+        acceptance=float(np.mean(sampler.acceptance_fraction)),
+        rhat_max=rhat_max,
+        ess_bulk_min=ess_bulk_min,
+        ess_tail_min=ess_tail_min,
+        converged=converged,
+        messages=tuple(messages),
+        idata=idata,
+    )
+
+
+def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:
+    """Peaks of a kernel density of ``u`` with a prominence of at least 10 % of the highest."""
+    from scipy import signal, stats
+
+    if np.ptp(u) <= 0 or u.size < 20:
+        return 1
+    grid = np.linspace(max(lo, u.min()), min(hi, u.max()), 256)
+    dens = stats.gaussian_kde(u)(grid)
+    padded = np.r_[0.0, dens, 0.0]
+    peaks, _ = signal.find_peaks(padded, prominence=0.1 * dens.max())
+    return max(1, len(peaks))
+
+
+def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:
+    az = arviz()
+
+    out = {}
+    for i, (name, prior) in enumerate(zip(lik.param_names, lik.prior_list)):
+        x = flat_phys[:, i]
+        lo, hi = az.hdi(x, hdi_prob=HDI_PROB)
+        plo, phi = prior.bounds
+        if tr.log[i]:
+            plo, phi = math.log(plo), math.log(phi)
+        u = flat_u[:, i]
+        ulo, uhi = az.hdi(u, hdi_prob=HDI_PROB)
+        wide = bool(np.isfinite(phi - plo) and (uhi - ulo) > 0.5 * (phi - plo))
+        out[name] = ParameterSummary(
+            mean=float(x.mean()), sd=float(x.std(ddof=1)), hdi_low=float(lo), hdi_high=float(hi),
+            map=float(map_theta[i]), median=float(np.median(x)), poorly_determined=wide,
+            multimodal=_count_modes(u, plo, phi) > 1,
+        )
+    return out
+
+
+def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kept, rng):
+    az = arviz()
+
+    omega = lik.data.omega
+    shape = (n_walkers, n_kept, omega.size)
+    g = lik.data.response
+    groups = dict(
+        posterior=post,
+        log_likelihood={"G": pointwise.reshape(shape)},
+        observed_data={"G_real": g.real, "G_imag": g.imag},
+        sample_stats={"lp": lp_flat.reshape(n_walkers, n_kept)},
+    )
+    if rng is not None:
+        model = lik.model(flat_scaled) * lik.scaling.g_ref
+        if lik.noise == "known":
+            sd = np.broadcast_to(lik.data.sigma, model.shape)
+        else:
+            s = flat_scaled[:, -1:] * lik.scaling.g_ref
+            sd = s * np.ones(model.shape) if lik.noise == "constant" else flat_scaled[:, -1:] * np.abs(g)
+        noise = sd / math.sqrt(2.0) * (rng.normal(size=model.shape) + 1j * rng.normal(size=model.shape))
+        rep = model + noise
+        groups["posterior_predictive"] = {"G_real": rep.real.reshape(shape), "G_imag": rep.imag.reshape(shape)}
+        groups["posterior"] = dict(post, model_real=model.real.reshape(shape), model_imag=model.imag.reshape(shape))
+    dims = {k: ["omega"] for k in ("G", "G_real", "G_imag", "model_real", "model_imag")}
+    idata = az.from_dict(**groups, coords={"omega": omega}, dims=dims)
+    idata.posterior.attrs.update(
+        structure=lik.structure.name, noise=lik.noise, kind=lik.data.kind,
+        omega_units="rad/s", data=lik.data.label,
+    )
+    return idata
+
+
+def save_netcdf(idata, path) -> Path:
+    """Write InferenceData to NetCDF through a temporary file and an atomic rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".nc", dir=path.parent)
+    os.close(fd)
+    try:
+        idata.to_netcdf(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path

@@ -331,8 +331,8 @@ def sample_posterior(
             f"is below {ESS_MIN}"
         )
     converged = not messages
-    for m in messages:
-        warnings.warn(m, ConvergenceWarning, stacklevel=2)
+    if messages:
+        warnings.warn("; ".join(messages), ConvergenceWarning, stacklevel=2)
 
     best = int(np.argmax(lp_flat))
     map_theta = flat_phys[best]

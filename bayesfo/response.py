@@ -179,6 +179,14 @@ def matignon_stable(a, q, *, allow_integrator: bool = False) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     if a.ndim == 0:
         raise InputError("argument 'a' must hold at least the constant coefficient")
+    if a.shape[-1] == 2:
+        # a0 + a1 λ: the root -a0/a1 is negative real (arg π, stable for q < 2) iff a0 a1 > 0;
+        # a1 = 0 leaves no root; a0 = 0 is a root at the origin (an integrator).
+        a0, a1 = a[..., 0], a[..., 1]
+        ok = ((a0 * a1 > 0) & (q < 2)) | ((a1 == 0) & (a0 != 0))
+        if allow_integrator:
+            ok |= (a0 == 0) & (a1 != 0)
+        return ok
     batch = np.broadcast_shapes(a.shape[:-1], q.shape)
     a = np.broadcast_to(a, batch + a.shape[-1:]).reshape(-1, a.shape[-1]).copy()
     q = np.broadcast_to(q, batch).reshape(-1)

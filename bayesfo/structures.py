@@ -495,9 +495,9 @@ class Structure:
             ok = np.ones(theta2.shape[0], dtype=bool)
         elif self._first_degree:
             den, num, q = self.polynomials(theta2)
-            den = np.pad(den, ((0, 0), (0, 2 - den.shape[1])))
-            num = np.pad(num, ((0, 0), (0, 2 - num.shape[1])))
-            lhs, rhs = num[:, 1] * den[:, 0], num[:, 0] * den[:, 1]
+            d1 = den[:, 1] if den.shape[1] > 1 else 0.0
+            n1 = num[:, 1] if num.shape[1] > 1 else 0.0
+            lhs, rhs = n1 * den[:, 0], num[:, 0] * d1
             scale = np.abs(lhs) + np.abs(rhs)
             ok = (lhs <= rhs + 1e-12 * scale) | ~((q > 0) & (q < 2))
             ok &= np.all(np.isfinite(theta2), axis=1)
@@ -528,18 +528,26 @@ class Structure:
         """
         theta = np.asarray(theta, dtype=float)
         ok = np.atleast_1d(self.in_support(theta)).copy()
-        vals, single = self.values(theta)
+        ok &= self.constraints_hold(theta, kind, omega_grid, where=ok)
+        return ok[0] if theta.ndim == 1 else ok
+
+    def constraints_hold(self, theta, kind: str, omega_grid=None, where=None) -> np.ndarray:
+        """The card's constraints (inequalities, ``stable``, ``passive``) without the prior
+        ranges; rows where ``where`` is false are skipped (returned false)."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        ok = np.ones(theta.shape[0], dtype=bool) if where is None else np.array(where, dtype=bool)
+        vals, _ = self.values(theta)
         for c in self.constraints:
             if isinstance(c, Inequality):
                 ok &= c.holds(vals)
         names = {c for c in self.constraints if isinstance(c, str)}
         if "stable" in names and ok.any():
-            ok &= np.atleast_1d(self.stable(np.atleast_2d(theta), kind))
+            ok &= self.stable(theta, kind)
         if "passive" in names and kind != "generic" and ok.any():
             grid = dissipation_grid(1.0, 1.0) if omega_grid is None else omega_grid
             rows = np.flatnonzero(ok)
-            ok[rows] = self.passive(np.atleast_2d(theta)[rows], kind, grid)
-        return ok[0] if single else ok
+            ok[rows] = self.passive(theta[rows], kind, grid)
+        return ok
 
     # ------------------------------------------------------------------ units
     @cached_property

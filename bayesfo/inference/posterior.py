@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..priors import LogUniform
+from ..priors import LogUniform, Uniform
 from ._arviz import arviz
 from .likelihood import Likelihood
 
@@ -146,10 +146,21 @@ class PosteriorResult:
 
 
 class _Transform:
-    """θ ↔ u (log for log-uniform priors) and the log-Jacobian."""
+    """θ ↔ u (log for log-uniform priors) and the log-Jacobian.
+
+    In u, uniform and log-uniform priors are flat: their log density is the constant
+    ``flat_const`` inside the box [lo_u, hi_u]; other priors (normal) are evaluated as such.
+    """
 
     def __init__(self, lik: Likelihood):
-        self.log = np.array([isinstance(p, LogUniform) for p in lik.prior_list])
+        priors = lik.prior_list
+        self.log = np.array([isinstance(p, LogUniform) for p in priors])
+        flat = np.array([isinstance(p, (LogUniform, Uniform)) for p in priors])
+        lo, hi = np.array([p.bounds for p in priors], dtype=float).T
+        self.lo_u = np.where(self.log, np.log(np.where(self.log, lo, 1.0)), lo)
+        self.hi_u = np.where(self.log, np.log(np.where(self.log, hi, 1.0)), hi)
+        self.flat_const = float(-np.sum(np.log(self.hi_u - self.lo_u)[flat]))
+        self.other = [(i, p) for i, p in enumerate(priors) if not flat[i]]
 
     def to_theta(self, u):
         return np.where(self.log, np.exp(np.clip(u, -700, 700)), u)
@@ -163,15 +174,24 @@ class _Transform:
 
 
 def _log_prob_fn(lik: Likelihood, tr: _Transform):
+    """Log posterior density in u (the hot path: one vectorised call per half-ensemble)."""
+    k = lik.structure.n_params
+    kind, grid = lik.data.kind, lik.grid
+
     def log_prob(u):
         u = np.atleast_2d(u)
-        theta = tr.to_theta(u)
-        lp = lik.log_prior(theta)
-        ok = np.isfinite(lp)
         out = np.full(u.shape[0], -np.inf)
-        if ok.any():
-            ll = lik(theta[ok])
-            out[ok] = ll + lp[ok] + tr.log_jacobian(u[ok])
+        rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
+        if not rows.size:
+            return out
+        theta = tr.to_theta(u[rows])
+        ok = lik.structure.constraints_hold(theta[:, :k], kind, grid)
+        rows, theta = rows[ok], theta[ok]
+        if rows.size:
+            lp = tr.flat_const + lik(theta)
+            for i, prior in tr.other:
+                lp = lp + prior.log_prob(theta[:, i])
+            out[rows] = lp
         return out
 
     return log_prob

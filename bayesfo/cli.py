@@ -11,6 +11,7 @@ import json
 import os
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -23,6 +24,9 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message):
         raise InputError(f"{message} (see '{self.prog} --help')")
+
+
+DEFAULT_STRUCTURES = "voigt,zener,maxwell,voigt-int,zener-int,maxwell-int"
 
 
 def _add_data_options(p):
@@ -50,6 +54,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] to hold out for validation")
     p.add_argument("--json", action="store_true", help="print JSON")
+
+    p = sub.add_parser("compare", help="posteriors and criteria of several structures on one data set")
+    _add_data_options(p)
+    p.add_argument("--structures", default=DEFAULT_STRUCTURES,
+                   help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory (default: bayesfo-<data name>)")
+    p.add_argument("--noise", default="auto", choices=("auto", "known", "constant", "proportional"),
+                   help="noise model (default: known if the data give sigma, else relative or constant)")
+    p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
+                   help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--quiet", action="store_true", help="no progress bar or table")
 
     p = sub.add_parser("identify", help="deterministic fit of one structure (methods 1-5 or optimisation)")
     _add_data_options(p)
@@ -180,6 +197,58 @@ def cmd_extract(args) -> int:
     return 0
 
 
+def _parse_priors(specs) -> dict:
+    from .priors import prior_from_dict
+
+    out = {}
+    for spec in specs:
+        name, _, rest = spec.partition("=")
+        parts = rest.split(":")
+        if not name or len(parts) != 3:
+            raise InputError(f"--prior takes NAME=TYPE:A:B (e.g. q=uniform:0.2:1), got {spec!r}")
+        kind, a, b = parts
+        keys = ("mu", "sd") if kind == "normal" else ("low", "high")
+        try:
+            values = {keys[0]: float(a), keys[1]: float(b)}
+        except ValueError:
+            raise InputError(f"--prior {spec!r}: the bounds must be numbers") from None
+        out[name.strip()] = prior_from_dict({"prior": kind, **values}, f"--prior {spec!r}")
+    return out
+
+
+def cmd_compare(args) -> int:
+    from .compare import compare, write_outputs
+    from .structures import resolve_structures
+
+    data = _read(args)
+    structures = resolve_structures(args.structures, _library(args))
+    priors = _parse_priors(args.prior)
+    known = {p for s in structures for p in s.param_names} | {"sigma", "sigma_rel"}
+    unknown = [k for k in priors if k not in known]
+    if unknown:
+        raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
+    out = Path(args.out) if args.out else Path(f"bayesfo-{Path(args.data).stem}")
+    progress = not args.quiet and sys.stderr.isatty()
+    result = compare(data, structures, noise=args.noise, seed=args.seed, priors=priors,
+                     progress=progress)
+    write_outputs(result, out)
+    if not args.quiet:
+        print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; "
+              f"ranked by PSIS-LOO (higher is better)")
+        print(f"{'#':>2} {'structure':<16} {'k':>2} {'elpd_loo':>10} {'dloo':>8} {'BIC':>10} "
+              f"{'q (sd)':>16} {'R-hat':>6} {'ok':>3}")
+        for row in result.table():
+            if row.get("error"):
+                print(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  skipped: {row['error']}")
+                continue
+            q = "" if row["q_mean"] is None else f"{row['q_mean']:.3f} ({row['q_sd']:.3f})"
+            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {row['loo']:>10.2f} "
+                  f"{row['delta_loo']:>8.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
+                  f"{'yes' if row['converged'] else 'NO':>3}")
+        print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
+    return 0
+
+
 def cmd_identify(args) -> int:
     from .identify import identify
 
@@ -245,6 +314,7 @@ def cmd_simulate(args) -> int:
 
 
 COMMANDS = {
+    "compare": cmd_compare,
     "inspect": cmd_inspect,
     "structures": cmd_structures,
     "extract": cmd_extract,

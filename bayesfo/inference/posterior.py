@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._io import publish
 from ..errors import InputError
 from ..priors import LogUniform, Uniform
 from ._arviz import arviz
@@ -242,9 +243,9 @@ def sample_posterior(
     seed: int = 0,
     n_walkers: int | None = None,
     tau_factor: float = 50.0,
-    max_steps: int = 20_000,
+    max_steps: int = 10_000,
     check_every: int = 250,
-    max_draws: int = 4000,
+    max_draws: int = 2000,
     progress: bool | None = None,
     predictive: bool = True,
 ) -> PosteriorResult:
@@ -260,8 +261,9 @@ def sample_posterior(
     n_walkers : int, optional
         Default max(32, 4·ndim), even.
     tau_factor, max_steps, check_every
-        Run until the chain is ``tau_factor``·τ long (τ changing by < 5 % between checks), at
-        most ``max_steps`` steps, checking every ``check_every`` steps.
+        Run until the chain is ``tau_factor``·τ long (τ changing by < 5 % between checks) and
+        R-hat < 1.01 and bulk and tail ESS ≥ 400 hold, at most ``max_steps`` steps, checking
+        every ``check_every`` steps.
     max_draws : int
         Upper bound on the stored draws (thinning is raised to respect it).
     progress : bool, optional
@@ -303,10 +305,14 @@ def sample_posterior(
                 continue
             tau = sampler.get_autocorr_time(tol=0, discard=it // 5)
             if np.all(np.isfinite(tau)):
-                settled = np.all(tau * tau_factor < it) and np.all(np.abs(old_tau - tau) < 0.05 * tau)
-                if settled:
-                    break
+                settled = bool(np.all(tau * tau_factor < it)
+                               and np.all(np.abs(old_tau - tau) < 0.05 * tau))
                 old_tau = tau
+                # Long enough by τ: stop when the walkers also agree (R-hat) and the draws
+                # carry enough information (ESS); otherwise keep going up to the cap.
+                if settled and _diagnostics_pass(sampler, tau, tr, lik.param_names):
+                    break
+                settled = False
     n_steps = sampler.iteration
     if not np.all(np.isfinite(tau)):
         tau = sampler.get_autocorr_time(tol=0, discard=n_steps // 5)
@@ -385,6 +391,17 @@ def sample_posterior(
     )
 
 
+def _diagnostics_pass(sampler, tau, tr, names) -> bool:
+    az = arviz()
+    burn = int(math.ceil(2 * np.max(tau)))
+    thin = max(1, int(np.min(tau) // 2))
+    chain = tr.to_theta(sampler.get_chain(discard=burn, thin=thin))
+    ds = az.convert_to_dataset({n: chain[:, :, i].T for i, n in enumerate(names)})
+    rhat = max(float(v) for v in az.rhat(ds).data_vars.values())
+    ess = min(min(float(v) for v in az.ess(ds, method=m).data_vars.values()) for m in ("bulk", "tail"))
+    return rhat < RHAT_MAX and ess >= ESS_MIN
+
+
 def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:
     """Peaks of a kernel density of ``u`` with a prominence of at least 10 % of the highest."""
     from scipy import signal, stats
@@ -459,7 +476,7 @@ def save_netcdf(idata, path) -> Path:
     os.close(fd)
     try:
         idata.to_netcdf(tmp)
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)

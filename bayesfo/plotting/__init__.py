@@ -50,13 +50,15 @@ def save_figure(fig, path) -> None:
     import tempfile
     from pathlib import Path
 
+    from .._io import publish
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=200)
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)

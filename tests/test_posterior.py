@@ -106,13 +106,23 @@ def test_non_convergence_is_a_warning_and_a_flag():
 
 
 def test_g_spec_posterior_sd_of_q_matches_spread_of_optimum():
-    # Thesis set-up (G_spec, σ = 0.001 per time sample, so E|Ξ|² = 25σ²): Table 3.4 reports
-    # var(q) = 7.19e-6 (sd 0.0027) over 1000 global optimisations. The posterior sd of q on one
-    # data set with the matching noise level must agree within the sampling error of either.
+    # Thesis set-up: G_spec with noise of E|Ξ|² = 25σ², σ = 0.001 (complex sd 0.005).
+    # (1) Over realisations of that noise drawn independently per frequency (the likelihood's
+    # model), the global optimum's q scatters with the posterior sd of q on one data set.
+    # (2) Table 3.4 reports var(q) = 7.19e-6 (sd 0.0027) for the thesis' FFT-of-a-real-vector
+    # noise, whose conjugate-symmetric pairs make the estimate ~17 % less variable (measured:
+    # optimiser sd 0.0028 with that noise, 0.0033 with independent noise): within 1.35×.
+    from bayesfo.identify import fit_structure
+
+    s = get_structure("voigt")
     rng = np.random.default_rng(8)
-    xi = rng.normal(0, 1e-3, 25)
-    data = FrequencyResponse(OMEGA, g_spec() + np.fft.fft(xi), np.full(25, 5e-3), kind="compliance")
-    result, _ = run_posterior(get_structure("voigt"), data, seed=3, progress=False)
+    noise = 5e-3 / np.sqrt(2) * (rng.normal(size=(101, 25)) + 1j * rng.normal(size=(101, 25)))
+    qs = [fit_structure(s, FrequencyResponse(OMEGA, g_spec() + noise[r]), rng=r,
+                        weighting="none").theta[-1] for r in range(100)]
+    spread = np.std(qs, ddof=1)  # relative standard error ~7 % for 100 realisations
+    data = FrequencyResponse(OMEGA, g_spec() + noise[100], np.full(25, 5e-3), kind="compliance")
+    result, _ = run_posterior(s, data, seed=3, progress=False, predictive=False)
     sd_q = result.summary["q"].sd
-    assert sd_q == pytest.approx(np.sqrt(7.1897e-6), rel=0.25)
+    assert sd_q == pytest.approx(spread, rel=0.2)
+    assert 1 / 1.35 <= sd_q / np.sqrt(7.1897e-6) <= 1.35
     assert abs(result.summary["q"].mean - 0.5) < 4 * sd_q

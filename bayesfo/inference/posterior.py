@@ -310,7 +310,7 @@ def sample_posterior(
                 old_tau = tau
                 # Long enough by τ: stop when the walkers also agree (R-hat) and the draws
                 # carry enough information (ESS); otherwise keep going up to the cap.
-                if settled and _diagnostics_pass(sampler, tau, tr, lik.param_names):
+                if settled and _diagnostics(sampler, tau, tr, lik.param_names)[3]:
                     break
                 settled = False
     n_steps = sampler.iteration
@@ -333,16 +333,9 @@ def sample_posterior(
     flat_phys = lik.to_physical(flat_scaled)
     lp_flat = log_post.T.reshape(-1)
 
-    az = arviz()
-
     post = {name: flat_phys[:, i].reshape(n_walkers, n_kept) for i, name in enumerate(lik.param_names)}
-    ds = az.convert_to_dataset(post)
-    rhat = az.rhat(ds)
-    ess_bulk = az.ess(ds, method="bulk")
-    ess_tail = az.ess(ds, method="tail")
-    rhat_max = float(max(float(rhat[n]) for n in lik.param_names))
-    ess_bulk_min = float(min(float(ess_bulk[n]) for n in lik.param_names))
-    ess_tail_min = float(min(float(ess_tail[n]) for n in lik.param_names))
+    diag_tau = tau if np.all(np.isfinite(tau)) else np.full(ndim, tau_max)
+    rhat_max, ess_bulk_min, ess_tail_min, _ = _diagnostics(sampler, diag_tau, tr, lik.param_names)
     messages = []
     if not settled:
         messages.append(
@@ -391,15 +384,19 @@ def sample_posterior(
     )
 
 
-def _diagnostics_pass(sampler, tau, tr, names) -> bool:
+def _diagnostics(sampler, tau, tr, names):
+    """(R-hat max, bulk ESS min, tail ESS min, pass) after a burn-in of 2·τ_max, thinned by
+    τ_min/2, each walker a chain."""
     az = arviz()
-    burn = int(math.ceil(2 * np.max(tau)))
-    thin = max(1, int(np.min(tau) // 2))
+    n = sampler.iteration
+    burn = min(int(math.ceil(2 * np.nanmax(tau))), n // 2)
+    thin = max(1, int(np.nanmin(tau) // 2))
     chain = tr.to_theta(sampler.get_chain(discard=burn, thin=thin))
-    ds = az.convert_to_dataset({n: chain[:, :, i].T for i, n in enumerate(names)})
+    ds = az.convert_to_dataset({name: chain[:, :, i].T for i, name in enumerate(names)})
     rhat = max(float(v) for v in az.rhat(ds).data_vars.values())
-    ess = min(min(float(v) for v in az.ess(ds, method=m).data_vars.values()) for m in ("bulk", "tail"))
-    return rhat < RHAT_MAX and ess >= ESS_MIN
+    bulk = min(float(v) for v in az.ess(ds, method="bulk").data_vars.values())
+    tail = min(float(v) for v in az.ess(ds, method="tail").data_vars.values())
+    return rhat, bulk, tail, bool(rhat < RHAT_MAX and min(bulk, tail) >= ESS_MIN)
 
 
 def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:

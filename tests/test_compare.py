@@ -1,0 +1,117 @@
+"""bayesfo compare: the summary.json contract, files, ranking, real data."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bayesfo.compare import PredictiveWarning, compare, write_outputs
+from bayesfo.data import FrequencyResponse
+from bayesfo.inference._arviz import arviz
+from bayesfo.structures import get_structure, resolve_structures
+
+W = np.logspace(np.log10(0.6), np.log10(300), 25)
+ADHESIVE = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
+CONTRACT = {"name", "inverted", "integer", "n_params", "parameters", "log_evidence",
+            "log_evidence_err", "evidence_method", "max_log_likelihood", "aic", "aicc", "bic",
+            "waic", "loo", "loo_se", "pareto_k_max", "rhat_max", "ess_min", "converged", "rmse",
+            "posterior_probability"}
+
+
+@pytest.fixture(scope="module")
+def voigt_comparison(tmp_path_factory):
+    rng = np.random.default_rng(0)
+    g = get_structure("voigt").response([1.0, 1e-3, 0.5], W, "compliance")
+    sd = 0.02 * np.abs(g)
+    data = FrequencyResponse(W, g + sd / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25)),
+                             sd, kind="compliance", name="simulated voigt")
+    # The integer baseline is badly misspecified here: its PSIS-LOO is flagged as unreliable.
+    with pytest.warns(PredictiveWarning, match="voigt-int: Pareto k") as record:
+        result = compare(data, resolve_structures("voigt,voigt-int,zener"), seed=1, progress=False)
+    assert all("voigt-int" in str(w.message) for w in record if w.category is PredictiveWarning)
+    assert result["voigt-int"].criteria["pareto_k_max"] > 0.7
+    out = tmp_path_factory.mktemp("cmp")
+    write_outputs(result, out)
+    return result, out
+
+
+def test_summary_contract_and_files(voigt_comparison):
+    result, out = voigt_comparison
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["data"]["n_frequencies"] == 25 and summary["data"]["kind"] == "compliance"
+    assert {s["name"] for s in summary["structures"]} == {"voigt", "voigt-int", "zener"}
+    for s in summary["structures"]:
+        assert CONTRACT <= set(s)
+        for p in s["parameters"].values():
+            assert {"mean", "sd", "hdi_low", "hdi_high", "map"} <= set(p)
+            assert p["hdi_low"] <= p["mean"] <= p["hdi_high"]
+        assert s["n_params"] == get_structure(s["name"]).n_params
+        nc = arviz().from_netcdf(out / f"{s['name']}.nc")
+        assert nc.log_likelihood["G"].shape[-1] == 25
+    # The true q = 0.5 structure beats its integer baseline clearly, by every criterion.
+    assert summary["ranking"].index("voigt") < summary["ranking"].index("voigt-int")
+    v, vi = (next(s for s in summary["structures"] if s["name"] == n) for n in ("voigt", "voigt-int"))
+    assert v["loo"] > vi["loo"] + 10 and v["bic"] < vi["bic"] - 10
+    q = v["parameters"]["q"]
+    assert abs(q["mean"] - 0.5) < 4 * q["sd"] and q["sd"] < 0.01
+    rows = list(csv.DictReader((out / "ranking.csv").open()))
+    assert [r["structure"] for r in rows] == summary["ranking"]
+
+
+def test_criteria_are_consistent(voigt_comparison):
+    result, _ = voigt_comparison
+    r = result["voigt"]
+    k, n = 3, 50  # known sigma: no noise parameter; 25 complex points = 50 real numbers
+    c = r.criteria
+    assert c["aic"] == pytest.approx(2 * k - 2 * c["max_log_likelihood"])
+    assert c["bic"] == pytest.approx(k * np.log(n) - 2 * c["max_log_likelihood"])
+    assert c["aicc"] == pytest.approx(c["aic"] + 2 * k * (k + 1) / (n - k - 1))
+    # elpd estimates lie below the maximum log-likelihood by about the number of parameters.
+    assert c["max_log_likelihood"] - 10 < c["loo"] < c["max_log_likelihood"]
+    assert c["rmse"] < 0.05 * 1e-3
+
+
+def test_interrupted_write_leaves_no_summary(voigt_comparison, tmp_path, monkeypatch):
+    result, _ = voigt_comparison
+    import bayesfo.compare as cmp
+
+    def boom(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cmp.json, "dumps", boom)
+    with pytest.raises(KeyboardInterrupt):
+        write_outputs(result, tmp_path)
+    assert not (tmp_path / "summary.json").exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
+    out = tmp_path / "adhesive"
+    status, stdout, err = run_cli("compare", ADHESIVE, "--structures", "voigt,zener-int",
+                                  "--out", out, "--prior", "q=uniform:0.2:1")
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["data"]["kind"] == "modulus" and summary["data"]["n_frequencies"] == 17
+    voigt = next(s for s in summary["structures"] if s["name"] == "voigt")
+    assert voigt["priors"]["q"] == {"prior": "uniform", "low": 0.2, "high": 1.0}
+    assert voigt["noise"] == "proportional"  # |G*| spans more than a decade here
+    assert voigt["converged"] and 0.5 < voigt["parameters"]["q"]["mean"] < 0.6
+    assert "ranked by PSIS-LOO" in stdout
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--prior", "q=uniform:0.2"], "NAME=TYPE:A:B"),
+        (["--prior", "q=beta:0:1"], "unknown prior 'beta'"),
+        (["--prior", "zeta=uniform:0:1"], "no selected structure has"),
+        (["--structures", "voigt,nope"], "unknown structure 'nope'"),
+    ],
+)
+def test_cli_compare_bad_options(run_cli, tmp_path, argv, message):
+    status, _, err = run_cli("compare", ADHESIVE, "--out", tmp_path / "x", *argv)
+    assert status == 2 and message in err and len(err.strip().splitlines()) == 1

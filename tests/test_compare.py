@@ -58,7 +58,8 @@ def test_summary_contract_and_files(voigt_comparison):
     assert v["loo"] > vi["loo"] + 10 and v["bic"] < vi["bic"] - 10
     q = v["parameters"]["q"]
     assert abs(q["mean"] - 0.5) < 4 * q["sd"] and q["sd"] < 0.01
-    rows = list(csv.DictReader((out / "ranking.csv").open()))
+    with (out / "ranking.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
     assert [r["structure"] for r in rows] == summary["ranking"]
 
 

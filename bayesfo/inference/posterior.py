@@ -10,8 +10,8 @@ q modes of high-order structures (thesis Table A.9).
 
 The run length is set by the integrated autocorrelation time τ (emcee): it continues until it is
 at least ``tau_factor``·τ steps long and τ has settled, up to ``max_steps``. Burn-in is 2·τ_max,
-thinning τ_min/2. Convergence is judged with arviz' rank-normalised split R-hat over walkers and
-bulk and tail effective sample sizes; a run that misses them issues a :class:`ConvergenceWarning`
+thinning τ_min/2. Convergence is judged with arviz' rank-normalised split R-hat across four groups
+of walkers and bulk and tail effective sample sizes over walkers; a run that misses them issues a :class:`ConvergenceWarning`
 and has ``converged = False``.
 """
 
@@ -259,9 +259,9 @@ def sample_posterior(
     seed : int
         Seed of the walker jitter, the moves and the posterior predictive draws.
     n_walkers : int, optional
-        Default max(32, 4·ndim), even.
+        Default max(32, 4·ndim), rounded up to a multiple of 4 (the walker groups of R-hat).
     tau_factor, max_steps, check_every
-        Run until the chain is ``tau_factor``·τ long (τ changing by < 5 % between checks) and
+        Run until the chain is ``tau_factor``·τ long (τ changing by < 10 % between checks) and
         R-hat < 1.01 and bulk and tail ESS ≥ 400 hold, at most ``max_steps`` steps, checking
         every ``check_every`` steps.
     max_draws : int
@@ -280,7 +280,7 @@ def sample_posterior(
     rng = np.random.default_rng(seed)
     ndim = lik.ndim
     n_walkers = n_walkers or max(32, 4 * ndim)
-    n_walkers += n_walkers % 2
+    n_walkers += -n_walkers % WALKER_GROUPS  # equal groups for R-hat (and even for emcee)
     if n_walkers < 2 * ndim:
         raise InputError(f"n_walkers must be at least {2 * ndim} for {ndim} parameters")
     if progress is None:
@@ -306,7 +306,7 @@ def sample_posterior(
             tau = sampler.get_autocorr_time(tol=0, discard=it // 5)
             if np.all(np.isfinite(tau)):
                 settled = bool(np.all(tau * tau_factor < it)
-                               and np.all(np.abs(old_tau - tau) < 0.05 * tau))
+                               and np.all(np.abs(old_tau - tau) < 0.1 * tau))
                 old_tau = tau
                 # Long enough by τ: stop when the walkers also agree (R-hat) and the draws
                 # carry enough information (ESS); otherwise keep going up to the cap.
@@ -384,18 +384,31 @@ def sample_posterior(
     )
 
 
+WALKER_GROUPS = 4
+
+
 def _diagnostics(sampler, tau, tr, names):
     """(R-hat max, bulk ESS min, tail ESS min, pass) after a burn-in of 2·τ_max, thinned by
-    τ_min/2, each walker a chain."""
+    τ_min/2.
+
+    R-hat is the rank-normalised split R-hat across ``WALKER_GROUPS`` groups of walkers (each
+    group's walkers, step by step, form one chain): it compares the groups with each other and
+    the first half of the run with the second. The effective sample sizes treat every walker
+    as a chain.
+    """
     az = arviz()
     n = sampler.iteration
     burn = min(int(math.ceil(2 * np.nanmax(tau))), n // 2)
     thin = max(1, int(np.nanmin(tau) // 2))
-    chain = tr.to_theta(sampler.get_chain(discard=burn, thin=thin))
-    ds = az.convert_to_dataset({name: chain[:, :, i].T for i, name in enumerate(names)})
-    rhat = max(float(v) for v in az.rhat(ds).data_vars.values())
-    bulk = min(float(v) for v in az.ess(ds, method="bulk").data_vars.values())
-    tail = min(float(v) for v in az.ess(ds, method="tail").data_vars.values())
+    chain = tr.to_theta(sampler.get_chain(discard=burn, thin=thin))  # (steps, walkers, ndim)
+    steps, walkers, _ = chain.shape
+    groups = chain.reshape(steps, WALKER_GROUPS, walkers // WALKER_GROUPS, -1)
+    groups = groups.transpose(1, 0, 2, 3).reshape(WALKER_GROUPS, -1, chain.shape[2])
+    by_group = az.convert_to_dataset({name: groups[:, :, i] for i, name in enumerate(names)})
+    by_walker = az.convert_to_dataset({name: chain[:, :, i].T for i, name in enumerate(names)})
+    rhat = max(float(v) for v in az.rhat(by_group).data_vars.values())
+    bulk = min(float(v) for v in az.ess(by_walker, method="bulk").data_vars.values())
+    tail = min(float(v) for v in az.ess(by_walker, method="tail").data_vars.values())
     return rhat, bulk, tail, bool(rhat < RHAT_MAX and min(bulk, tail) >= ESS_MIN)
 
 

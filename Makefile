@@ -30,8 +30,13 @@ test-slow: $(STAMP)
 test-all: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 
+DEMO_DATA ?= examples/data/adhesive_468mp/Tp020C.csv
+DEMO_STRUCTURES ?= voigt,zener,maxwell,voigt-int,zener-int,maxwell-int
+
 demo: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/python examples/demo.py --out $(DEMO_OUT)
+	@echo "Comparing $(DEMO_STRUCTURES) on $(DEMO_DATA) (3M 468MP adhesive, 20 C, storage and loss modulus)"
+	MPLBACKEND=Agg $(BIN)/bayesfo compare $(DEMO_DATA) --structures $(DEMO_STRUCTURES) --out $(DEMO_OUT)
+	@echo "Results: $(DEMO_OUT)/summary.json (all numbers), $(DEMO_OUT)/ranking.csv, one NetCDF posterior per structure"
 
 bench: $(STAMP)
 	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done

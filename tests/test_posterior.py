@@ -126,3 +126,29 @@ def test_g_spec_posterior_sd_of_q_matches_spread_of_optimum():
     assert sd_q == pytest.approx(spread, rel=0.2)
     assert 1 / 1.35 <= sd_q / np.sqrt(7.1897e-6) <= 1.35
     assert abs(result.summary["q"].mean - 0.5) < 4 * sd_q
+
+
+def test_high_order_q_posterior_is_flagged_multimodal():
+    # The thesis suspected that q is poorly determined for high orders (Table A.9); on G_spec
+    # data the max-n2m2 posterior of q has a mode at 0.25 (1/(1 + λ²) with λ = s^0.25 is G_spec
+    # exactly) besides the one at 0.5, and the summary says so. The Voigt's q has one tight mode.
+    rng = np.random.default_rng(3)
+    noise = 5e-3 / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25))
+    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+    with pytest.warns(ConvergenceWarning):
+        high, _ = run_posterior(get_structure("max-n2m2"), data, seed=1, progress=False,
+                                predictive=False, max_steps=3000)
+    q = high.samples[:, high.param_names.index("q")]
+    assert high.summary["q"].multimodal and not high.converged
+    assert np.mean((q > 0.2) & (q < 0.35)) > 0.05 and np.mean((q > 0.45) & (q < 0.55)) > 0.3
+    low, _ = run_posterior(get_structure("voigt"), data, seed=1, progress=False, predictive=False)
+    assert not low.summary["q"].multimodal and low.summary["q"].sd < 0.01
+
+
+def test_count_modes_on_known_mixtures():
+    from bayesfo.inference.posterior import _count_modes
+
+    rng = np.random.default_rng(0)
+    assert _count_modes(rng.normal(0.5, 0.02, 4000), 0, 1) == 1
+    two = np.r_[rng.normal(0.25, 0.02, 1500), rng.normal(0.5, 0.02, 2500)]
+    assert _count_modes(two, 0, 1) == 2

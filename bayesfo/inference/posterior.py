@@ -318,8 +318,7 @@ def sample_posterior(
         tau = sampler.get_autocorr_time(tol=0, discard=n_steps // 5)
     tau_max = float(np.nanmax(tau)) if np.any(np.isfinite(tau)) else n_steps / 10
     tau_min = float(np.nanmin(tau)) if np.any(np.isfinite(tau)) else 1.0
-    burn = min(int(math.ceil(2 * tau_max)), n_steps // 2)
-    thin = max(1, int(tau_min // 2))
+    burn, thin = _burn_thin(n_steps, np.array([tau_min, tau_max]))
     kept = (n_steps - burn) // thin
     if kept * n_walkers > max_draws:
         thin = int(math.ceil((n_steps - burn) * n_walkers / max_draws))
@@ -387,6 +386,18 @@ def sample_posterior(
 WALKER_GROUPS = 4
 
 
+MIN_DRAWS_PER_WALKER = 100
+
+
+def _burn_thin(n_steps: int, tau) -> tuple[int, int]:
+    """Burn-in 2·τ_max (at most half the run) and thinning τ_min/2, reduced so that every walker
+    keeps at least ``MIN_DRAWS_PER_WALKER`` draws (short, capped runs still get diagnostics)."""
+    burn = min(int(math.ceil(2 * np.nanmax(tau))), n_steps // 2)
+    thin = max(1, int(np.nanmin(tau) // 2))
+    thin = max(1, min(thin, (n_steps - burn) // MIN_DRAWS_PER_WALKER))
+    return burn, thin
+
+
 def _diagnostics(sampler, tau, tr, names):
     """(R-hat max, bulk ESS min, tail ESS min, pass) after a burn-in of 2·τ_max, thinned by
     τ_min/2.
@@ -398,8 +409,7 @@ def _diagnostics(sampler, tau, tr, names):
     """
     az = arviz()
     n = sampler.iteration
-    burn = min(int(math.ceil(2 * np.nanmax(tau))), n // 2)
-    thin = max(1, int(np.nanmin(tau) // 2))
+    burn, thin = _burn_thin(n, tau)
     chain = tr.to_theta(sampler.get_chain(discard=burn, thin=thin))  # (steps, walkers, ndim)
     steps, walkers, _ = chain.shape
     groups = chain.reshape(steps, WALKER_GROUPS, walkers // WALKER_GROUPS, -1)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bayesfo.data import FrequencyResponse
-from bayesfo.inference import ConvergenceWarning, Likelihood, run_posterior, sample_posterior, save_netcdf
+from bayesfo.inference import ConvergenceWarning, Likelihood, run_posterior, save_netcdf
 from bayesfo.inference._arviz import arviz
 from bayesfo.structures import fix_parameters, get_structure
 from bayesfo.studies import OMEGA, g_spec

@@ -13,7 +13,6 @@ from bayesfo.response import dissipation_grid
 from bayesfo.structures import (
     Scaling,
     default_library,
-    get_structure,
     load_library,
     resolve_structures,
 )

@@ -8,7 +8,6 @@ least squares of the complex residual on scaled data for every structure (§3.3,
 
 from __future__ import annotations
 
-
 from ..errors import InputError
 from ..structures import Structure, fix_parameters
 from .optimize import FitResult, fit_structure, linear_seeds, thesis_degrees

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..identify.optimize import fit_structure, linear_seeds
+from ..structures import Scaling
 from .likelihood import NOISE_MODELS, Likelihood, choose_noise
 from .posterior import ConvergenceWarning, PosteriorResult, sample_posterior, save_netcdf
 
@@ -19,7 +20,7 @@ __all__ = [
 
 
 def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: int = 0,
-                  fit=None, **kwargs):
+                  fit=None, scaling=None, **kwargs):
     """Posterior of ``structure`` on ``data``, started from the deterministic fits.
 
     Parameters
@@ -33,6 +34,8 @@ def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: in
         Seeds the optimiser's random starts and the sampler.
     fit : FitResult, optional
         A global optimisation already run on the same data (else it is run here).
+    scaling : Scaling, optional
+        Units of the scaled problem on which the priors are declared (see :class:`Likelihood`).
     **kwargs
         Passed to :func:`~bayesfo.inference.posterior.sample_posterior`.
 
@@ -40,14 +43,15 @@ def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: in
     -------
     (PosteriorResult, FitResult)
     """
-    lik = Likelihood(structure, data, noise=noise, priors=dict(priors or {}))
+    lik = Likelihood(structure, data, noise=noise, priors=dict(priors or {}), scaling=scaling)
     if fit is None:
         fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
-    seeds = [fit.optima] if fit.optima.size else []
+    # The optimiser reports optima on its own scaling of the data; go through physical units.
+    fit_scaling = Scaling.from_data(data)
+    modes = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
+    seeds = [lik.structure.to_scaled(lik.structure.to_physical(modes, fit_scaling), lik.scaling)]
     lin = linear_seeds(lik.structure, data)
     if lin.size:
         seeds.append(lik.structure.to_scaled(lin, lik.scaling))
-    if not seeds:
-        seeds.append(np.atleast_2d(fit.theta_scaled))
     result = sample_posterior(lik, np.vstack(seeds), seed=seed, **kwargs)
     return result, fit

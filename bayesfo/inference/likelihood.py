@@ -80,12 +80,17 @@ class Likelihood:
     noise : {"auto", "known", "constant", "proportional"}
     priors : dict, optional
         Overrides of structure or noise priors, ``{name: Prior}``.
+    scaling : Scaling, optional
+        The units of the scaled problem on which the priors are declared (default
+        ``Scaling.from_data(data)``: ω_ref the geometric mean of ω, g_ref the median |G|). Fixing
+        it makes priors mean the same on several data sets.
     """
 
     structure: Structure
     data: FrequencyResponse
     noise: str = "auto"
     priors: dict = field(default_factory=dict)
+    scaling: Scaling | None = None
 
     def __post_init__(self):
         self.structure.check_data(self.data)
@@ -105,7 +110,9 @@ class Likelihood:
         if noise_param is not None and noise_param[0] in self.priors:
             noise_param = (noise_param[0], self.priors[noise_param[0]])
         object.__setattr__(self, "noise_param", noise_param)
-        scaling = Scaling.from_data(self.data)
+        scaling = Scaling.from_data(self.data) if self.scaling is None else self.scaling
+        if scaling.reciprocal != (self.data.kind == "modulus"):
+            raise InputError("argument 'scaling' must have reciprocal=True exactly for modulus data")
         object.__setattr__(self, "scaling", scaling)
         w = self.data.omega / scaling.omega_ref
         g = self.data.response / scaling.g_ref

@@ -4,22 +4,39 @@ From a measured complex frequency response G(jω) to the answer "which model str
 data support, and how sure can I be?". The data flow, module by module:
 
 ``data`` (FrequencyResponse, CSV reader) → ``structures`` (model cards in ``models/*.toml``,
-evaluated by ``response``) → identification seeds → posteriors → evidence and criteria → ranking.
-``timeseries`` turns raw sine records into frequency responses; ``timedomain`` simulates fitted
-models in the time domain for validation.
+evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optimisation: the seeds)
+→ ``inference`` (likelihood, emcee posterior, diagnostics) → ``compare`` (criteria, ranking,
+output files). ``timeseries`` turns raw sine records into frequency responses; ``timedomain``
+simulates fitted models in the time domain for validation; ``studies`` reruns the thesis'
+Monte Carlo studies.
+
+Example
+-------
+>>> from bayesfo import read_csv, get_structure, compare          # doctest: +SKIP
+>>> data = read_csv("examples/data/adhesive_468mp/Tp020C.csv")       # doctest: +SKIP
+>>> result = compare(data, [get_structure("voigt"), get_structure("zener")])  # doctest: +SKIP
+>>> result.ranking                                                   # doctest: +SKIP
+['voigt', 'zener']
 """
 
+from .compare import Comparison, compare, write_outputs
 from .data import FrequencyResponse, read_csv
 from .errors import BayesfoError, InputError, NonlinearityWarning, StructureError
+from .structures import get_structure, resolve_structures
 
 __version__ = "0.1.0"
 
 __all__ = [
     "BayesfoError",
+    "Comparison",
     "FrequencyResponse",
     "InputError",
     "NonlinearityWarning",
     "StructureError",
     "__version__",
+    "compare",
+    "get_structure",
     "read_csv",
+    "resolve_structures",
+    "write_outputs",
 ]

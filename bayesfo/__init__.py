@@ -12,14 +12,14 @@ Monte Carlo studies.
 
 Example
 -------
->>> from bayesfo import read_csv, get_structure, compare          # doctest: +SKIP
+>>> from bayesfo import read_csv, get_structure                   # doctest: +SKIP
+>>> from bayesfo.compare import compare                           # doctest: +SKIP
 >>> data = read_csv("examples/data/adhesive_468mp/Tp020C.csv")       # doctest: +SKIP
 >>> result = compare(data, [get_structure("voigt"), get_structure("zener")])  # doctest: +SKIP
 >>> result.ranking                                                   # doctest: +SKIP
 ['voigt', 'zener']
 """
 
-from .compare import Comparison, compare, write_outputs
 from .data import FrequencyResponse, read_csv
 from .errors import BayesfoError, InputError, NonlinearityWarning, StructureError
 from .structures import get_structure, resolve_structures
@@ -28,15 +28,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     "BayesfoError",
-    "Comparison",
     "FrequencyResponse",
     "InputError",
     "NonlinearityWarning",
     "StructureError",
     "__version__",
-    "compare",
     "get_structure",
     "read_csv",
     "resolve_structures",
-    "write_outputs",
 ]

@@ -53,6 +53,8 @@ class FitResult:
         how reliably the optimum is found.
     optima : ndarray, shape (k, n_params)
         Distinct admissible local optima (scaled), best first: the modes that seed the sampler.
+    scaling : Scaling
+        The units of the scaled problem (``theta_scaled``, ``optima``).
     """
 
     structure: str
@@ -67,6 +69,7 @@ class FitResult:
     n_admissible: int
     n_at_best: int
     optima: np.ndarray = field(repr=False)
+    scaling: Scaling = field(default_factory=Scaling, repr=False)
 
     def to_dict(self) -> dict:
         return {
@@ -100,10 +103,11 @@ def choose_weighting(data: FrequencyResponse, weighting: str = "auto") -> str:
 class _Problem:
     """Scaled least-squares problem in optimiser coordinates u (log for log-uniform priors)."""
 
-    def __init__(self, structure: Structure, data: FrequencyResponse, weighting: str):
+    def __init__(self, structure: Structure, data: FrequencyResponse, weighting: str,
+                 scaling: Scaling | None = None):
         self.s = structure
         self.kind = data.kind
-        self.scaling = Scaling.from_data(data)
+        self.scaling = Scaling.from_data(data) if scaling is None else scaling
         self.w = data.omega / self.scaling.omega_ref
         self.g = data.response / self.scaling.g_ref
         if weighting == "sigma":
@@ -152,6 +156,7 @@ def fit_structure(
     seed_methods: bool = False,
     min_starts: int = 12,
     stop_after: int | None = 4,
+    scaling: Scaling | None = None,
 ) -> FitResult:
     """Fit ``structure`` to ``data`` by multi-start bounded least squares.
 
@@ -172,6 +177,9 @@ def fit_structure(
     seed_methods : bool
         Also start from the linear methods 2 and 3 (thesis Table 3.1) on a coarse q grid, for
         structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
+    scaling : Scaling, optional
+        Units of the scaled problem, in which the prior bounds hold (default
+        ``Scaling.from_data(data)``).
     min_starts, stop_after : int
         Stop once at least ``min_starts`` starts have run and ``stop_after`` of them ended at
         the best admissible cost found so far (``stop_after=None`` runs every start). Given and
@@ -195,7 +203,7 @@ def fit_structure(
         raise InputError(f"argument 'n_starts' must be at least 1, got {n_starts}")
     rng = np.random.default_rng(rng)
     weighting = choose_weighting(data, weighting)
-    prob = _Problem(structure, data, weighting)
+    prob = _Problem(structure, data, weighting, scaling)
     span = prob.hi - prob.lo
     u0 = prob.lo + span * (0.05 + 0.9 * rng.uniform(size=(n_starts, structure.n_params)))
     # Coefficients with a uniform prior: on the scaled data they are of order one, so start
@@ -263,6 +271,7 @@ def fit_structure(
         n_admissible=n_adm,
         n_at_best=at_best,
         optima=optima,
+        scaling=prob.scaling,
     )
 
 

@@ -45,11 +45,10 @@ def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: in
     """
     lik = Likelihood(structure, data, noise=noise, priors=dict(priors or {}), scaling=scaling)
     if fit is None:
-        fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
-    # The optimiser reports optima on its own scaling of the data; go through physical units.
-    fit_scaling = Scaling.from_data(data)
+        fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True, scaling=lik.scaling)
+    # Modes go through physical units: a fit passed in may have used another scaling.
     modes = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
-    seeds = [lik.structure.to_scaled(lik.structure.to_physical(modes, fit_scaling), lik.scaling)]
+    seeds = [lik.structure.to_scaled(lik.structure.to_physical(modes, fit.scaling), lik.scaling)]
     lin = linear_seeds(lik.structure, data)
     if lin.size:
         seeds.append(lik.structure.to_scaled(lin, lik.scaling))

@@ -210,17 +210,26 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
     seeds = np.atleast_2d(np.asarray(seeds_scaled, dtype=float))
     if lik.noise_param:
         seeds = np.column_stack([seeds, lik.noise_estimate(seeds)])
+    tr = _Transform(lik)
+    # Project the seeds into the prior box (in the sampling coordinates), then keep those that
+    # satisfy the constraints; without any, start from prior draws inside the support.
+    span = tr.hi_u - tr.lo_u
+    u = np.clip(tr.to_u(seeds), tr.lo_u + 1e-6 * span, tr.hi_u - 1e-6 * span)
+    seeds = tr.to_theta(u)
     ok = lik.in_support(seeds)
     if not ok.any():
-        raise InputError(
-            f"no starting point of structure '{lik.structure.name}' lies in the prior support "
-            "(stable, dissipative, within the prior ranges)"
-        )
+        draws = np.column_stack([p.sample(rng, 2000) for p in lik.prior_list])
+        draws = draws[lik.in_support(draws)]
+        if not draws.size:
+            raise InputError(
+                f"no starting point of structure '{lik.structure.name}' lies in the prior "
+                "support (stable, dissipative, within the prior ranges)"
+            )
+        seeds, ok = draws[np.argsort(-lik(draws))[:8]], np.ones(min(8, len(draws)), dtype=bool)
     seeds = seeds[ok]
     ll = lik(seeds)
     keep = ll >= ll.max() - mode_window
     seeds = seeds[keep][np.argsort(-ll[keep])]
-    tr = _Transform(lik)
     u_seeds = tr.to_u(seeds)
     out = np.empty((n_walkers, lik.ndim))
     for i in range(n_walkers):

@@ -152,3 +152,19 @@ def test_count_modes_on_known_mixtures():
     assert _count_modes(rng.normal(0.5, 0.02, 4000), 0, 1) == 1
     two = np.r_[rng.normal(0.25, 0.02, 1500), rng.normal(0.5, 0.02, 2500)]
     assert _count_modes(two, 0, 1) == 2
+
+
+def test_poorly_determined_flag_follows_the_prior_width():
+    from bayesfo.inference.posterior import _summaries, _Transform
+
+    s = get_structure("voigt")
+    data = _noisy(s, [1.0, 1.0, 0.5], 0.02, seed=9)
+    lik = Likelihood(s, data)
+    tr = _Transform(lik)
+    rng = np.random.default_rng(0)
+    # q spread over most of its prior, a1 and b0 within a tiny part of their log ranges.
+    u = np.column_stack([rng.normal(0, 0.1, 4000), rng.normal(0, 0.1, 4000), rng.uniform(0.1, 0.9, 4000)])
+    phys = lik.to_physical(tr.to_theta(u))
+    summary = _summaries(lik, tr, phys, u, phys[0])
+    assert summary["q"].poorly_determined and not summary["q"].multimodal
+    assert not summary["a1"].poorly_determined and not summary["b0"].poorly_determined

@@ -70,7 +70,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("identify", help="deterministic fit of one structure (methods 1-5 or optimisation)")
     _add_data_options(p)
-    p.add_argument("--structure", required=True, help="structure name, e.g. zener or max-n2m1")
+    p.add_argument("--structure", required=True,
+                   help="structure name (e.g. zener, max-n2m1) or a list/shortcut such as max3 "
+                        "for the max-order loop")
     p.add_argument("--method", default="opt", choices=("1", "2", "3", "4", "5", "opt"),
                    help="linear method of thesis Table 3.1, or global optimisation (default)")
     p.add_argument("--q", type=float, default=None,
@@ -252,10 +254,13 @@ def cmd_compare(args) -> int:
 def cmd_identify(args) -> int:
     from .identify import identify
 
-    data = _read(args)
-    from .structures import get_structure
+    from .structures import resolve_structures
 
-    structure = get_structure(args.structure, _library(args))
+    data = _read(args)
+    structures = resolve_structures(args.structure, _library(args))
+    if len(structures) > 1:
+        return _identify_loop(args, data, structures)
+    structure = structures[0]
     result = identify(data, structure, method=args.method, q=args.q, seed=args.seed)
     if args.json:
         print(json.dumps(result, indent=2))
@@ -267,6 +272,33 @@ def cmd_identify(args) -> int:
     print(f"  RMSE = {result['rmse']:.4g} (eq. 3.23), stable: {'yes' if result['stable'] else 'no'}")
     if result.get("rejected_unstable_q"):
         print(f"  q values rejected as unstable: {len(result['rejected_unstable_q'])} of the grid")
+    return 0
+
+
+def _identify_loop(args, data, structures) -> int:
+    """The max-order loop of thesis §4.3.2: every member, and the one with the lowest RMSE."""
+    from .identify import identify
+
+    results, skipped = [], {}
+    for s in structures:
+        try:
+            results.append(identify(data, s, method=args.method, q=args.q, seed=args.seed))
+        except InputError as exc:
+            skipped[s.name] = str(exc)
+    if not results:
+        raise InputError("; ".join(f"{k}: {v}" for k, v in skipped.items()))
+    best = min(results, key=lambda r: r["rmse"])["structure"]
+    if args.json:
+        print(json.dumps({"structures": results, "skipped": skipped, "best_by_rmse": best}, indent=2))
+        return 0
+    print(f"{'structure':<16} {'q':>6} {'RMSE':>11}  stable")
+    for r in results:
+        q = "" if r["q"] is None else f"{r['q']:.3f}"
+        print(f"{r['structure']:<16} {q:>6} {r['rmse']:>11.4g}  {'yes' if r['stable'] else 'no'}")
+    for name, why in skipped.items():
+        print(f"{name:<16} skipped: {why}")
+    print(f"lowest RMSE: {best} (the thesis' choice; it favours the largest members: "
+          "compare them with `bayesfo compare` for a penalised ranking)")
     return 0
 
 

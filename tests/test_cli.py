@@ -96,3 +96,15 @@ def test_extract_bundled_sine_records(run_cli, tmp_path):
     # Records are 1/(1 + s^0.5) with noise sd 0.01 over many periods: within 5 sigma.
     assert np.all(np.abs(fr.response - g_spec(fr.omega)) < 5 * fr.sigma + 1e-3)
     assert (tmp_path / "fr_harmonics.csv").exists()
+
+
+def test_identify_max_order_loop(run_cli, gspec_csv):
+    status, out, err = run_cli("identify", gspec_csv, "--structure", "max2", "--method", "3", "--json")
+    assert status == 0, err
+    res = json.loads(out)
+    names = [r["structure"] for r in res["structures"]]
+    assert names == ["max-n1m0", "max-n1m1", "max-n2m0", "max-n2m1", "max-n2m2"]
+    rmse = {r["structure"]: r["rmse"] for r in res["structures"]}
+    assert res["best_by_rmse"] == min(rmse, key=rmse.get)
+    # The true structure already fits to the noise level: RMSE ≈ sqrt(25·2e-8)/25 = 2.8e-5.
+    assert rmse["max-n1m0"] < 4e-5

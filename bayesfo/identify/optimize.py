@@ -205,11 +205,16 @@ def fit_structure(
     weighting = choose_weighting(data, weighting)
     prob = _Problem(structure, data, weighting, scaling)
     span = prob.hi - prob.lo
-    u0 = prob.lo + span * (0.05 + 0.9 * rng.uniform(size=(n_starts, structure.n_params)))
+    finite = np.isfinite(span)
+    u0 = np.where(finite, prob.lo, 0.0) + np.where(finite, span, 0.0) * (
+        0.05 + 0.9 * rng.uniform(size=(n_starts, structure.n_params)))
+    for i, p in enumerate(structure.parameters):
+        if not finite[i]:  # unbounded (normal) prior: start from prior draws
+            u0[:, i] = p.prior.sample(rng, n_starts)
     # Coefficients with a uniform prior: on the scaled data they are of order one, so start
     # them at magnitudes 10^U(-1.5, 1.5), positive (the physical sign of the material models),
     # inside the bounds, rather than spread over the whole, mostly unphysical, prior range.
-    coef = np.array([p.role == "coefficient" for p in structure.parameters]) & ~prob.log
+    coef = np.array([p.role == "coefficient" for p in structure.parameters]) & ~prob.log & finite
     if coef.any():
         mags = 10.0 ** rng.uniform(-1.5, 1.5, size=(n_starts, int(coef.sum())))
         u0[:, coef] = np.clip(mags, prob.lo[coef] + 1e-9 * span[coef], prob.hi[coef] - 1e-9 * span[coef])
@@ -221,7 +226,8 @@ def fit_structure(
         extra = structure.to_scaled(np.atleast_2d(np.asarray(starts, float)), prob.scaling)
         with np.errstate(divide="ignore", invalid="ignore"):
             extra_u = np.where(prob.log, np.log(np.abs(extra)), extra)
-        extra_u = np.clip(extra_u, prob.lo + 1e-9 * span, prob.hi - 1e-9 * span)
+        margin = np.where(finite, 1e-9 * span, 0.0)
+        extra_u = np.clip(extra_u, prob.lo + margin, prob.hi - margin)
         u0 = _interleave(extra_u[np.all(np.isfinite(extra_u), axis=1)], u0)
 
     sols, costs, oks = [], [], []

@@ -214,7 +214,8 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
     # Project the seeds into the prior box (in the sampling coordinates), then keep those that
     # satisfy the constraints; without any, start from prior draws inside the support.
     span = tr.hi_u - tr.lo_u
-    u = np.clip(tr.to_u(seeds), tr.lo_u + 1e-6 * span, tr.hi_u - 1e-6 * span)
+    margin = np.where(np.isfinite(span), 1e-6 * span, 0.0)
+    u = np.clip(tr.to_u(seeds), tr.lo_u + margin, tr.hi_u - margin)
     seeds = tr.to_theta(u)
     ok = lik.in_support(seeds)
     if not ok.any():

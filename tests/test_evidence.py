@@ -1,0 +1,70 @@
+"""Log-evidence: bridge sampling and nested sampling against a closed form."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from bayesfo.data import FrequencyResponse
+from bayesfo.inference import Likelihood, run_posterior
+from bayesfo.inference.evidence import bridge_evidence, log_support_fraction, nested_evidence
+from bayesfo.priors import Normal
+from bayesfo.structures import Scaling, fix_parameters, get_structure, load_library
+
+LINEAR_CARD = """
+name = "linear"
+numerator = [["b0", 0], ["b1", "q"]]
+denominator = [[1, 0]]
+[parameters]
+b0 = { prior = "normal", mu = 1.0, sd = 0.5 }
+b1 = { prior = "normal", mu = 0.5, sd = 0.5 }
+q = { prior = "uniform", low = 0, high = 1 }
+"""
+
+
+@pytest.fixture(scope="module")
+def linear_case(tmp_path_factory):
+    # G = b0 + b1 (jω)^0.5 with q fixed: linear in (b0, b1), Gaussian priors, known σ, so
+    # y ~ N(X μ0, X Σ0 Xᵀ + σ²/2 I) for the stacked real and imaginary parts: ln Z is closed-form.
+    path = tmp_path_factory.mktemp("cards") / "linear.toml"
+    path.write_text(LINEAR_CARD)
+    s = fix_parameters(load_library(extra=[path])["linear"], {"q": 0.5})
+    w = np.logspace(-1, 1, 21)  # geometric mean 1
+    rng = np.random.default_rng(2)
+    lam = (1j * w) ** 0.5
+    sigma = 0.05
+    g = 1.2 + 0.3 * lam + sigma / np.sqrt(2) * (rng.normal(size=21) + 1j * rng.normal(size=21))
+    data = FrequencyResponse(w, g, np.full(21, sigma), kind="generic")
+    X = np.vstack([np.column_stack([np.ones(21), lam.real]), np.column_stack([np.zeros(21), lam.imag])])
+    y = np.r_[g.real, g.imag]
+    mu, cov0 = np.array([1.0, 0.5]), np.diag([0.25, 0.25])
+    exact = stats.multivariate_normal(X @ mu, X @ cov0 @ X.T + sigma**2 / 2 * np.eye(42)).logpdf(y)
+    lik = Likelihood(s, data, scaling=Scaling(omega_ref=1.0, g_ref=1.0))
+    return s, data, lik, exact
+
+
+def test_bridge_sampling_matches_closed_form(linear_case):
+    s, data, lik, exact = linear_case
+    post, _ = run_posterior(s, data, scaling=lik.scaling, seed=1, progress=False, predictive=False)
+    ev = bridge_evidence(lik, post, seed=1)
+    assert abs(ev.log_z - exact) < 0.1
+    assert abs(ev.log_z - exact) < 4 * ev.log_z_err + 0.02
+    assert ev.log_support == 0.0 and ev.log_z_err < 0.05
+
+
+def test_nested_sampling_matches_closed_form(linear_case):
+    s, data, lik, exact = linear_case
+    ev = nested_evidence(lik, seed=1, nlive=300)
+    assert abs(ev.log_z - exact) < 4 * ev.log_z_err
+    assert abs(ev.log_z - exact) < 0.5 and ev.log_z_err < 0.3
+
+
+def test_support_fraction_of_the_zener_prior():
+    # Log-uniform priors on a1, b0, b1 over the same range: ln b1 <= ln a1 + ln b0 holds with
+    # probability 1/2 by symmetry, and this ordering is the whole support for a compliance.
+    w = np.logspace(-1, 1, 11)
+    lik = Likelihood(get_structure("zener"), FrequencyResponse(w, np.ones(11), np.ones(11), kind="compliance"))
+    log_p, err = log_support_fraction(lik, np.random.default_rng(0), n=40_000)
+    assert abs(np.exp(log_p) - 0.5) < 4 * 0.5 * err + 1e-3
+    assert err == pytest.approx(np.sqrt(0.5 / 40_000 / 0.5), rel=0.05)

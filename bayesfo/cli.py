@@ -66,6 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--evidence-check", action="store_true",
+                   help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
 
     p = sub.add_parser("identify", help="deterministic fit of one structure (methods 1-5 or optimisation)")
@@ -232,20 +234,26 @@ def cmd_compare(args) -> int:
     out = Path(args.out) if args.out else Path(f"bayesfo-{Path(args.data).stem}")
     progress = not args.quiet and sys.stderr.isatty()
     result = compare(data, structures, noise=args.noise, seed=args.seed, priors=priors,
-                     progress=progress)
+                     progress=progress, evidence_check=args.evidence_check)
     write_outputs(result, out)
     if not args.quiet:
-        print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; "
-              f"ranked by PSIS-LOO (higher is better)")
-        print(f"{'#':>2} {'structure':<16} {'k':>2} {'elpd_loo':>10} {'dloo':>8} {'BIC':>10} "
-              f"{'q (sd)':>16} {'R-hat':>6} {'ok':>3}")
+        print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; ranked by "
+              "log-evidence ln Z (bridge sampling); P = posterior probability, equal prior odds")
+        print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>16} {'dlnZ':>8} {'P':>6} "
+              f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3}")
         for row in result.table():
             if row.get("error"):
                 print(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  skipped: {row['error']}")
                 continue
             q = "" if row["q_mean"] is None else f"{row['q_mean']:.3f} ({row['q_sd']:.3f})"
-            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {row['loo']:>10.2f} "
-                  f"{row['delta_loo']:>8.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
+            if row["log_evidence"] is None:
+                z = dz = p = "-"
+            else:
+                z = f"{row['log_evidence']:.2f} ± {row['log_evidence_err']:.2f}"
+                dz = f"{row['delta_log_evidence']:.2f}"
+                p = f"{row['posterior_probability']:.3f}"
+            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>16} {dz:>8} "
+                  f"{p:>6} {row['loo']:>10.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
                   f"{'yes' if row['converged'] else 'NO':>3}")
         print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
     return 0

@@ -3,9 +3,11 @@
 For every structure: the global least-squares optimisation (modes and a maximum-likelihood
 start), the emcee posterior, and the criteria that follow from them: maximum log-likelihood,
 AIC, AICc, BIC (from the higher of the optimiser's and the sampler's maximum), WAIC and PSIS-LOO
-(arviz, pointwise per frequency), RMSE at the posterior mode (thesis eq. (3.23)). Structures are
-ranked by PSIS-LOO (expected log predictive density), the Bayesian criterion available without
-the evidence.
+(arviz, pointwise per frequency), RMSE at the posterior mode (thesis eq. (3.23)), and the
+log-evidence ln Z by bridge sampling from the posterior draws (optionally checked by dynesty
+nested sampling, with a flag when the two disagree by more than twice their combined error).
+Structures are ranked by ln Z; posterior model probabilities assume equal prior odds unless
+given.
 
 Outputs (:func:`write_outputs`, each file written atomically): ``summary.json`` (the contract of
 DESIGN.md), ``ranking.csv``, and one ``<structure>.nc`` (arviz InferenceData) per structure.
@@ -29,6 +31,7 @@ from .data import FrequencyResponse
 from .errors import InputError
 from .identify.optimize import FitResult, fit_structure
 from .inference import Likelihood, PosteriorResult, run_posterior, save_netcdf
+from .inference.evidence import bridge_evidence, nested_evidence
 from .inference._arviz import arviz
 from .structures import Structure
 
@@ -66,12 +69,19 @@ class StructureResult:
             out["error"] = self.error
             return out
         post = self.posterior
+        ev = self.criteria.get("evidence")
+        check = self.criteria.get("evidence_check")
         out.update(
             parameters={k: v.to_dict() for k, v in post.summary.items()},
             priors=self.criteria["priors"],
             noise=post.noise, noise_reason=post.noise_reason,
-            log_evidence=None, log_evidence_err=None, evidence_method=None,
-            posterior_probability=None,
+            log_evidence=None if ev is None else ev.log_z,
+            log_evidence_err=None if ev is None else ev.log_z_err,
+            evidence_method=None if ev is None else ev.method,
+            log_prior_support=None if ev is None else ev.log_support,
+            evidence_check=None if check is None else check.to_dict(),
+            evidence_agree=self.criteria.get("evidence_agree"),
+            posterior_probability=self.criteria.get("posterior_probability"),
         )
         for key in ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
                     "pareto_k_max", "rmse"):
@@ -95,13 +105,19 @@ class Comparison:
     data: FrequencyResponse
     results: tuple[StructureResult, ...]
     seed: int
-    ranked_by: str = "loo"
+    ranked_by: str = "log_evidence"
 
     @property
     def ranking(self) -> list[str]:
-        """Structure names, best first by PSIS-LOO; structures that failed are left out."""
+        """Structure names, best first by ln Z (those without an evidence after them, by
+        PSIS-LOO); structures that failed are left out."""
         ok = [r for r in self.results if r.error is None]
-        return [r.name for r in sorted(ok, key=lambda r: -r.criteria["loo"])]
+
+        def key(r):
+            ev = r.criteria.get("evidence")
+            return (ev is None, -(ev.log_z if ev is not None else r.criteria["loo"]))
+
+        return [r.name for r in sorted(ok, key=key)]
 
     def __getitem__(self, name: str) -> StructureResult:
         for r in self.results:
@@ -113,7 +129,14 @@ class Comparison:
         """One row per structure, best first (failed structures last), for printing or CSV."""
         order = {n: i for i, n in enumerate(self.ranking)}
         rows = []
-        best = self[self.ranking[0]].criteria["loo"] if self.ranking else math.nan
+        ok = [r for r in self.results if r.error is None]
+        best_loo = max((r.criteria["loo"] for r in ok), default=math.nan)
+        evs = [r.criteria["evidence"].log_z for r in ok if r.criteria.get("evidence") is not None]
+        best_z = max(evs, default=math.nan)
+        ranks = {}
+        for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
+            ordered = sorted(ok, key=lambda r, c=crit, g=sign: g * r.criteria[c])
+            ranks[crit] = {r.name: i + 1 for i, r in enumerate(ordered)}
         for r in sorted(self.results, key=lambda r: order.get(r.name, len(order))):
             if r.error is not None:
                 rows.append({"rank": None, "structure": r.name, "n_params": r.structure.n_params,
@@ -121,9 +144,17 @@ class Comparison:
                 continue
             c, p = r.criteria, r.posterior
             q = p.summary.get("q") or p.summary.get("beta")
+            ev = c.get("evidence")
+            log_z = None if ev is None else ev.log_z
             rows.append({
                 "rank": order[r.name] + 1, "structure": r.name, "n_params": r.structure.n_params,
-                "loo": c["loo"], "loo_se": c["loo_se"], "delta_loo": c["loo"] - best,
+                "log_evidence": log_z, "log_evidence_err": None if ev is None else ev.log_z_err,
+                "delta_log_evidence": None if ev is None else log_z - best_z,
+                "bayes_factor": None if ev is None else math.exp(log_z - best_z),
+                "posterior_probability": c.get("posterior_probability"),
+                "evidence_agree": c.get("evidence_agree"),
+                **{f"rank_{k}": v[r.name] for k, v in ranks.items()},
+                "loo": c["loo"], "loo_se": c["loo_se"], "delta_loo": c["loo"] - best_loo,
                 "waic": c["waic"], "aic": c["aic"], "aicc": c["aicc"], "bic": c["bic"],
                 "max_log_likelihood": c["max_log_likelihood"], "rmse": c["rmse"],
                 "q_mean": None if q is None else q.mean, "q_sd": None if q is None else q.sd,
@@ -190,7 +221,8 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
 
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
-            priors=None, progress: bool | None = None, **sampler_kwargs) -> Comparison:
+            priors=None, progress: bool | None = None, evidence_check: bool = False,
+            prior_odds: dict | None = None, **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
     Parameters
@@ -204,6 +236,11 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         Prior overrides ``{name: Prior}`` applied to every structure that has the parameter.
     progress : bool, optional
         A progress bar over structures (default: when stderr is a terminal).
+    evidence_check : bool
+        Also compute ln Z by dynesty nested sampling and flag disagreements with the bridge
+        estimate larger than twice the combined error (slower: seconds to minutes each).
+    prior_odds : dict, optional
+        Prior model probabilities ``{name: weight}`` (default equal).
 
     Returns
     -------
@@ -229,17 +266,68 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
             fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
             post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
                                     fit=fit, progress=False, **sampler_kwargs)
-            results.append(StructureResult(s, fit, post, _criteria(lik, fit, post)))
+            criteria = _criteria(lik, fit, post)
+            extra = _evidence(lik, post, seed, evidence_check)
+            criteria["warnings"].extend(extra.pop("warnings"))
+            criteria.update(extra)
+            results.append(StructureResult(s, fit, post, criteria))
         except InputError as exc:
             results.append(StructureResult(s, error=str(exc)))
     if all(r.error is not None for r in results):
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
+    _model_probabilities(results, prior_odds or {})
     return Comparison(data, tuple(results), seed)
 
 
-RANKING_FIELDS = ("rank", "structure", "n_params", "loo", "loo_se", "delta_loo", "waic", "aic",
-                  "aicc", "bic", "max_log_likelihood", "rmse", "q_mean", "q_sd", "pareto_k_max",
-                  "rhat_max", "ess_min", "converged", "error")
+class EvidenceWarning(UserWarning):
+    """The two evidence estimates disagree, or the evidence could not be computed."""
+
+
+def _evidence(lik, post, seed, check: bool) -> dict:
+    out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": []}
+    try:
+        out["evidence"] = bridge_evidence(lik, post, seed=seed)
+    except InputError as exc:
+        warnings.warn(f"{post.structure}: no evidence: {exc}", EvidenceWarning, stacklevel=3)
+        return out
+    if not post.converged:
+        out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
+    if check:
+        nested = nested_evidence(lik, seed=seed)
+        out["evidence_check"] = nested
+        combined = math.hypot(out["evidence"].log_z_err, nested.log_z_err)
+        agree = abs(out["evidence"].log_z - nested.log_z) <= 2 * combined
+        out["evidence_agree"] = bool(agree)
+        if not agree:
+            out["warnings"].append(f"{post.structure}: bridge and nested ln Z disagree")
+            warnings.warn(
+                f"{post.structure}: bridge ln Z = {out['evidence'].log_z:.2f} ± "
+                f"{out['evidence'].log_z_err:.2f} and nested ln Z = {nested.log_z:.2f} ± "
+                f"{nested.log_z_err:.2f} disagree", EvidenceWarning, stacklevel=3)
+    return out
+
+
+def _model_probabilities(results, prior_odds: dict) -> None:
+    """Posterior model probabilities from ln Z and the prior odds, in place."""
+    with_z = [r for r in results if r.error is None and r.criteria.get("evidence") is not None]
+    unknown = set(prior_odds) - {r.name for r in results}
+    if unknown:
+        raise InputError(f"prior odds given for unknown structure '{sorted(unknown)[0]}'")
+    if not with_z:
+        return
+    log_w = np.array([r.criteria["evidence"].log_z + math.log(prior_odds.get(r.name, 1.0))
+                      for r in with_z])
+    p = np.exp(log_w - log_w.max())
+    p /= p.sum()
+    for r, prob in zip(with_z, p, strict=True):
+        r.criteria["posterior_probability"] = float(prob)
+
+
+RANKING_FIELDS = ("rank", "structure", "n_params", "log_evidence", "log_evidence_err",
+                  "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
+                  "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
+                  "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse", "q_mean",
+                  "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "error")
 
 
 def ranking_csv(comparison: Comparison) -> str:

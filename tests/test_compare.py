@@ -52,8 +52,14 @@ def test_summary_contract_and_files(voigt_comparison):
         assert s["n_params"] == get_structure(s["name"]).n_params
         nc = arviz().from_netcdf(out / f"{s['name']}.nc")
         assert nc.log_likelihood["G"].shape[-1] == 25
-    # The true q = 0.5 structure beats its integer baseline clearly, by every criterion.
+    # The true q = 0.5 structure beats its integer baseline clearly, by every criterion, and the
+    # ranking follows ln Z with probabilities from it (equal prior odds).
     assert summary["ranking"].index("voigt") < summary["ranking"].index("voigt-int")
+    z = {s["name"]: s["log_evidence"] for s in summary["structures"]}
+    assert summary["ranking"] == sorted(z, key=lambda n: -z[n])
+    p = {s["name"]: s["posterior_probability"] for s in summary["structures"]}
+    assert p["voigt"] / p["zener"] == pytest.approx(np.exp(z["voigt"] - z["zener"]), rel=1e-9)
+    assert sum(p.values()) == pytest.approx(1.0)
     v, vi = (next(s for s in summary["structures"] if s["name"] == n) for n in ("voigt", "voigt-int"))
     assert v["loo"] > vi["loo"] + 10 and v["bic"] < vi["bic"] - 10
     q = v["parameters"]["q"]
@@ -101,7 +107,10 @@ def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
     assert voigt["priors"]["q"] == {"prior": "uniform", "low": 0.2, "high": 1.0}
     assert voigt["noise"] == "proportional"  # |G*| spans more than a decade here
     assert voigt["converged"] and 0.5 < voigt["parameters"]["q"]["mean"] < 0.6
-    assert "ranked by PSIS-LOO" in stdout
+    assert "ranked by log-evidence" in stdout
+    assert summary["ranked_by"] == "log_evidence" and voigt["evidence_method"] == "bridge"
+    assert voigt["log_evidence"] < voigt["max_log_likelihood"]
+    assert sum(s["posterior_probability"] for s in summary["structures"]) == pytest.approx(1.0)
 
 
 @pytest.mark.parametrize(

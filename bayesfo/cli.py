@@ -66,6 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--holdout", default=None, metavar="W1,W2",
+                   help="angular frequencies [rad/s] left out of the fit for validation")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
@@ -234,7 +236,8 @@ def cmd_compare(args) -> int:
     out = Path(args.out) if args.out else Path(f"bayesfo-{Path(args.data).stem}")
     progress = not args.quiet and sys.stderr.isatty()
     result = compare(data, structures, noise=args.noise, seed=args.seed, priors=priors,
-                     progress=progress, evidence_check=args.evidence_check)
+                     progress=progress, evidence_check=args.evidence_check,
+                     holdout=_parse_floats(args.holdout, "--holdout") if args.holdout else None)
     write_outputs(result, out)
     if not args.quiet:
         print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; ranked by "
@@ -255,6 +258,12 @@ def cmd_compare(args) -> int:
             print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>16} {dz:>8} "
                   f"{p:>6} {row['loo']:>10.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
                   f"{'yes' if row['converged'] else 'NO':>3}")
+        if result.holdout is not None:
+            print("held out " + ", ".join(f"{w:.4g}" for w in result.holdout.omega) + " rad/s:")
+            for row in result.table():
+                if not row.get("error"):
+                    print(f"   {row['structure']:<16} log predictive density {row['holdout_lpd']:10.2f}, "
+                          f"RMSE {row['holdout_rmse']:.4g} (in-sample RMSE {row['rmse']:.4g})")
         print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
     return 0
 

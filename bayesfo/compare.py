@@ -86,6 +86,9 @@ class StructureResult:
         for key in ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
                     "pareto_k_max", "rmse"):
             out[key] = self.criteria[key]
+        for key in ("holdout_lpd", "holdout_rmse", "holdout_lpd_pointwise", "holdout_omega"):
+            if key in self.criteria:
+                out[key] = self.criteria[key]
         out.update(
             rhat_max=post.rhat_max, ess_min=post.ess_min, ess_bulk_min=post.ess_bulk_min,
             ess_tail_min=post.ess_tail_min, converged=post.converged, tau_max=float(np.max(post.tau)),
@@ -106,6 +109,7 @@ class Comparison:
     results: tuple[StructureResult, ...]
     seed: int
     ranked_by: str = "log_evidence"
+    holdout: FrequencyResponse | None = None
 
     @property
     def ranking(self) -> list[str]:
@@ -157,6 +161,7 @@ class Comparison:
                 "loo": c["loo"], "loo_se": c["loo_se"], "delta_loo": c["loo"] - best_loo,
                 "waic": c["waic"], "aic": c["aic"], "aicc": c["aicc"], "bic": c["bic"],
                 "max_log_likelihood": c["max_log_likelihood"], "rmse": c["rmse"],
+                "holdout_lpd": c.get("holdout_lpd"), "holdout_rmse": c.get("holdout_rmse"),
                 "q_mean": None if q is None else q.mean, "q_sd": None if q is None else q.sd,
                 "pareto_k_max": c["pareto_k_max"], "rhat_max": p.rhat_max, "ess_min": p.ess_min,
                 "converged": p.converged, "error": "",
@@ -165,7 +170,7 @@ class Comparison:
 
     def to_summary(self) -> dict:
         """The ``summary.json`` contract."""
-        return {
+        summary = {
             "data": {"path": self.data.source, "name": self.data.label,
                      "n_frequencies": self.data.n_frequencies, "kind": self.data.kind,
                      "units": self.data.units, "omega_min": float(self.data.omega.min()),
@@ -174,7 +179,35 @@ class Comparison:
             "ranked_by": self.ranked_by,
             "structures": [r.to_dict() for r in self.results],
             "ranking": self.ranking,
+            "families": self.families(),
         }
+        if self.holdout is not None:
+            summary["data"]["holdout_omega"] = self.holdout.omega.tolist()
+        return summary
+
+    def families(self) -> list[dict]:
+        """Evidence of each family with several members (e.g. the max-order family), with equal
+        prior weight on its members: ln Z_family = ln mean_i Z_i."""
+        groups: dict[str, list] = {}
+        for r in self.results:
+            if r.error is None and r.criteria.get("evidence") is not None:
+                groups.setdefault(r.structure.family, []).append(r)
+        out = []
+        for family, members in groups.items():
+            if len(members) < 2:
+                continue
+            z = np.array([m.criteria["evidence"].log_z for m in members])
+            err = np.array([m.criteria["evidence"].log_z_err for m in members])
+            top = z.max()
+            w = np.exp(z - top)
+            log_z = float(top + np.log(w.mean()))
+            out.append({
+                "family": family, "members": [m.name for m in members], "log_evidence": log_z,
+                "log_evidence_err": float(np.sqrt(np.sum((w / w.sum() * err) ** 2))),
+                "posterior_probability": float(sum(m.criteria.get("posterior_probability") or 0.0
+                                                   for m in members)),
+            })
+        return sorted(out, key=lambda f: -f["log_evidence"])
 
 
 def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
@@ -222,7 +255,7 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
             priors=None, progress: bool | None = None, evidence_check: bool = False,
-            prior_odds: dict | None = None, **sampler_kwargs) -> Comparison:
+            prior_odds: dict | None = None, holdout=None, **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
     Parameters
@@ -241,6 +274,9 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         estimate larger than twice the combined error (slower: seconds to minutes each).
     prior_odds : dict, optional
         Prior model probabilities ``{name: weight}`` (default equal).
+    holdout : sequence of float, optional
+        Angular frequencies [rad/s] left out of the fit (thesis §4.3.3); the log predictive
+        density and the RMSE on them are reported next to the in-sample figures.
 
     Returns
     -------
@@ -256,6 +292,9 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     structures = list(structures)
     if not structures:
         raise InputError("no structure to compare")
+    test = None
+    if holdout is not None and len(holdout):
+        data, test = data.split(holdout)
     if progress is None:
         progress = sys.stderr.isatty()
     results = []
@@ -267,6 +306,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
             post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
                                     fit=fit, progress=False, **sampler_kwargs)
             criteria = _criteria(lik, fit, post)
+            if test is not None:
+                criteria.update(_holdout(lik, post, test))
             extra = _evidence(lik, post, seed, evidence_check)
             criteria["warnings"].extend(extra.pop("warnings"))
             criteria.update(extra)
@@ -276,7 +317,23 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     if all(r.error is not None for r in results):
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
     _model_probabilities(results, prior_odds or {})
-    return Comparison(data, tuple(results), seed)
+    return Comparison(data, tuple(results), seed, holdout=test)
+
+
+def _holdout(lik, post, test: FrequencyResponse) -> dict:
+    """Log pointwise predictive density and RMSE on held-out frequencies."""
+    from scipy.special import logsumexp
+
+    # Same structure, noise model, priors and units as the fit: the draws apply unchanged.
+    held = Likelihood(lik.structure, test, noise=lik.noise, priors=lik.priors,
+                      scaling=lik.scaling, require_points=False)
+    draws = post.samples_scaled
+    pointwise = held.pointwise(draws)
+    lpd = logsumexp(pointwise, axis=0) - np.log(draws.shape[0])
+    model = lik.structure.response(post.map_theta[: lik.structure.n_params], test.omega, test.kind)
+    rmse = float(np.sqrt(np.sum(np.abs(test.response - model) ** 2)) / test.n_frequencies)
+    return {"holdout_lpd": float(lpd.sum()), "holdout_lpd_pointwise": lpd.tolist(),
+            "holdout_rmse": rmse, "holdout_omega": test.omega.tolist()}
 
 
 class EvidenceWarning(UserWarning):
@@ -326,7 +383,8 @@ def _model_probabilities(results, prior_odds: dict) -> None:
 RANKING_FIELDS = ("rank", "structure", "n_params", "log_evidence", "log_evidence_err",
                   "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
                   "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
-                  "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse", "q_mean",
+                  "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",
+                  "holdout_lpd", "holdout_rmse", "q_mean",
                   "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "error")
 
 

@@ -125,3 +125,35 @@ def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
 def test_cli_compare_bad_options(run_cli, tmp_path, argv, message):
     status, _, err = run_cli("compare", ADHESIVE, "--out", tmp_path / "x", *argv)
     assert status == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_holdout_log_predictive_density_and_families():
+    from scipy import stats
+    from scipy.special import logsumexp
+
+    rng = np.random.default_rng(4)
+    s = get_structure("voigt")
+    g = s.response([1.0, 1e-3, 0.5], W, "compliance")
+    sd = 0.02 * np.abs(g)
+    data = FrequencyResponse(W, g + sd / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25)),
+                             sd, kind="compliance")
+    held = [W[3], W[17]]
+    with pytest.warns(PredictiveWarning):
+        result = compare(data, resolve_structures("voigt,voigt-int"), seed=2, progress=False,
+                         holdout=held)
+    assert result.data.n_frequencies == 23
+    np.testing.assert_allclose(result.holdout.omega, held)
+    v = result["voigt"]
+    # Independent computation from the physical draws with scipy: mean predictive density.
+    draws = v.posterior.samples
+    model = s.response(draws, np.array(held), "compliance")
+    obs = data.response[[3, 17]]
+    logp = (stats.norm.logpdf(obs.real, model.real, sd[[3, 17]] / np.sqrt(2))
+            + stats.norm.logpdf(obs.imag, model.imag, sd[[3, 17]] / np.sqrt(2)))
+    expected = (logsumexp(logp, axis=0) - np.log(draws.shape[0])).sum()
+    assert v.criteria["holdout_lpd"] == pytest.approx(expected, rel=1e-9)
+    assert v.criteria["holdout_lpd"] > result["voigt-int"].criteria["holdout_lpd"] + 5
+    assert v.criteria["holdout_rmse"] < 0.05 * np.abs(obs).max()
+    (family,) = result.families()
+    z = [result[n].criteria["evidence"].log_z for n in ("voigt", "voigt-int")]
+    assert family["log_evidence"] == pytest.approx(np.logaddexp(*z) - np.log(2))

@@ -84,6 +84,9 @@ class Likelihood:
         The units of the scaled problem on which the priors are declared (default
         ``Scaling.from_data(data)``: ω_ref the geometric mean of ω, g_ref the median |G|). Fixing
         it makes priors mean the same on several data sets.
+    require_points : bool
+        Refuse data with fewer frequencies than parameters (off for held-out validation points,
+        which are only evaluated).
     """
 
     structure: Structure
@@ -91,9 +94,11 @@ class Likelihood:
     noise: str = "auto"
     priors: dict = field(default_factory=dict)
     scaling: Scaling | None = None
+    require_points: bool = True
 
     def __post_init__(self):
-        self.structure.check_data(self.data)
+        if self.require_points:
+            self.structure.check_data(self.data)
         noise, reason = choose_noise(self.data, self.noise)
         object.__setattr__(self, "noise", noise)
         object.__setattr__(self, "noise_reason", reason)

@@ -23,7 +23,8 @@ SCENARIOS = {
     "voigt": ("voigt", [1.0, 1e-3, 0.5], "compliance", 0.02, "voigt,zener,max-n2m1"),
     "zener": ("zener", [20.0, 1e-3, 2e-4, 0.6], "compliance", 0.02, "voigt,zener,maxwell"),
     "integer": ("zener-int", [0.05, 1e-3, 1e-5], "compliance", 0.02, "zener,zener-int,voigt"),
-    "inverted": ("max-n0m1-inv", [1e-3, 0.5, 0.9], "generic", 0.02, "voigt,zener,max-n0m1-inv,zener-inv"),
+    # A dashpot-like response: (1 + a1 λ)/(b0 + b1 λ) with b0 → 0, an integrator with a zero.
+    "inverted": ("zener-inv", [2.0, 1e-6, 0.5, 0.9], "generic", 0.02, "voigt,zener,zener-inv"),
 }
 
 

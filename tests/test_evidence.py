@@ -9,7 +9,6 @@ from scipy import stats
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood, run_posterior
 from bayesfo.inference.evidence import bridge_evidence, log_support_fraction, nested_evidence
-from bayesfo.priors import Normal
 from bayesfo.structures import Scaling, fix_parameters, get_structure, load_library
 
 LINEAR_CARD = """

@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..identify.optimize import fit_structure, linear_seeds
-from ..structures import Scaling
 from .likelihood import NOISE_MODELS, Likelihood, choose_noise
 from .posterior import ConvergenceWarning, PosteriorResult, sample_posterior, save_netcdf
 

@@ -67,3 +67,31 @@ def test_support_fraction_of_the_zener_prior():
     log_p, err = log_support_fraction(lik, np.random.default_rng(0), n=40_000)
     assert abs(np.exp(log_p) - 0.5) < 4 * 0.5 * err + 1e-3
     assert err == pytest.approx(np.sqrt(0.5 / 40_000 / 0.5), rel=0.05)
+
+
+@pytest.mark.slow
+def test_nested_sampling_within_a_tenth_of_a_nat_with_many_live_points(linear_case):
+    s, data, lik, exact = linear_case
+    ev = nested_evidence(lik, seed=3, nlive=2000)
+    assert abs(ev.log_z - exact) < 0.1 and abs(ev.log_z - exact) < 3 * ev.log_z_err
+
+
+@pytest.mark.slow
+def test_routes_agree_on_the_thesis_set_up():
+    # G_spec = 1/(1 + s^0.5), 25 points, thesis noise (σ = 0.001 per time sample, 0.005 complex).
+    import warnings
+
+    from bayesfo.compare import compare
+    from bayesfo.structures import resolve_structures
+    from bayesfo.studies import OMEGA, g_spec, thesis_noise
+
+    noise = thesis_noise(np.random.default_rng(0), 1)[0]
+    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = compare(data, resolve_structures("voigt,zener,voigt-int,zener-int"), seed=0,
+                         progress=False, evidence_check=True)
+    for r in result.results:
+        bridge, nested = r.criteria["evidence"], r.criteria["evidence_check"]
+        assert abs(bridge.log_z - nested.log_z) < 0.3, r.name
+        assert r.criteria["evidence_agree"]

@@ -63,7 +63,7 @@ class StructureResult:
         s = self.structure
         out = {
             "name": s.name, "family": s.family, "formula": s.formula, "inverted": s.inverted,
-            "integer": s.integer, "n_params": s.n_params,
+            "integer": s.integer, "parent": _parent(s), "n_params": s.n_params,
         }
         if self.error is not None:
             out["error"] = self.error
@@ -99,6 +99,11 @@ class StructureResult:
                      "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible},
         )
         return out
+
+
+def _parent(structure) -> str | None:
+    """The fractional structure an integer baseline comes from (``zener-int`` → ``zener``)."""
+    return structure.name[: -len("-int")] if structure.integer else None
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,7 +157,7 @@ class Comparison:
             log_z = None if ev is None else ev.log_z
             rows.append({
                 "rank": order[r.name] + 1, "structure": r.name, "n_params": r.structure.n_params,
-                "log_evidence": log_z, "log_evidence_err": None if ev is None else ev.log_z_err,
+                "parent": _parent(r.structure), "log_evidence": log_z, "log_evidence_err": None if ev is None else ev.log_z_err,
                 "delta_log_evidence": None if ev is None else log_z - best_z,
                 "bayes_factor": None if ev is None else math.exp(log_z - best_z),
                 "posterior_probability": c.get("posterior_probability"),
@@ -380,7 +385,7 @@ def _model_probabilities(results, prior_odds: dict) -> None:
         r.criteria["posterior_probability"] = float(prob)
 
 
-RANKING_FIELDS = ("rank", "structure", "n_params", "log_evidence", "log_evidence_err",
+RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "log_evidence_err",
                   "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
                   "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
                   "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",

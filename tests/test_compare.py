@@ -61,6 +61,7 @@ def test_summary_contract_and_files(voigt_comparison):
     assert p["voigt"] / p["zener"] == pytest.approx(np.exp(z["voigt"] - z["zener"]), rel=1e-9)
     assert sum(p.values()) == pytest.approx(1.0)
     v, vi = (next(s for s in summary["structures"] if s["name"] == n) for n in ("voigt", "voigt-int"))
+    assert vi["parent"] == "voigt" and v["parent"] is None
     assert v["loo"] > vi["loo"] + 10 and v["bic"] < vi["bic"] - 10
     q = v["parameters"]["q"]
     assert abs(q["mean"] - 0.5) < 4 * q["sd"] and q["sd"] < 0.01

@@ -136,9 +136,7 @@ def _monic_reversed_roots(a: np.ndarray) -> np.ndarray:
     of roots at infinity, and the companion matrix stays finite. |arg λ| = |arg μ|.
     """
     c = a[:, 1:] / a[:, :1]
-    n = c.shape[1]
-    if n == 1:
-        return -c
+    n = c.shape[1]  # >= 2: first-degree denominators are handled in closed form by the caller
     if n == 2:
         disc = np.sqrt((c[:, 0] ** 2 - 4 * c[:, 1]).astype(complex))
         return np.stack([(-c[:, 0] + disc) / 2, (-c[:, 0] - disc) / 2], axis=1)

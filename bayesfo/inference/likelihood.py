@@ -207,22 +207,21 @@ class Likelihood:
 
     def to_physical(self, theta) -> np.ndarray:
         """Scaled parameter sets → physical units (σ in the units of G; σ_rel unchanged)."""
-        theta = np.atleast_2d(np.asarray(theta, dtype=float))
-        out = theta.copy()
-        k = self.structure.n_params
-        out[:, :k] = self.structure.to_physical(theta[:, :k], self.scaling)
-        if self.noise == "constant":
-            out[:, k] = theta[:, k] * self.scaling.g_ref
-        return out
+        return self._convert(theta, to_physical=True)
 
     def to_scaled(self, theta) -> np.ndarray:
         """Physical parameter sets → the scaled problem."""
+        return self._convert(theta, to_physical=False)
+
+    def _convert(self, theta, to_physical: bool) -> np.ndarray:
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         out = theta.copy()
         k = self.structure.n_params
-        out[:, :k] = self.structure.to_scaled(theta[:, :k], self.scaling)
+        convert = self.structure.to_physical if to_physical else self.structure.to_scaled
+        out[:, :k] = convert(theta[:, :k], self.scaling)
         if self.noise == "constant":
-            out[:, k] = theta[:, k] / self.scaling.g_ref
+            g = self.scaling.g_ref
+            out[:, k] = theta[:, k] * (g if to_physical else 1.0 / g)
         return out
 
     def noise_estimate(self, theta_structure) -> np.ndarray:

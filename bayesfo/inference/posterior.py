@@ -170,9 +170,6 @@ class _Transform:
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(self.log, np.log(np.abs(theta)), theta)
 
-    def log_jacobian(self, u):
-        return np.sum(np.where(self.log, u, 0.0), axis=-1)
-
 
 def _log_prob_fn(lik: Likelihood, tr: _Transform):
     """Log posterior density in u (the hot path: one vectorised call per half-ensemble)."""

@@ -258,6 +258,21 @@ def cmd_compare(args) -> int:
             print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>16} {dz:>8} "
                   f"{p:>6} {row['loo']:>10.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
                   f"{'yes' if row['converged'] else 'NO':>3}")
+        pairs = result.baselines()
+        if pairs:
+            print("integer baselines (q = 1) against their fractional parents:")
+            for b in pairs:
+                if b["delta_log_evidence"] is None:
+                    continue
+                d = b["delta_log_evidence"]
+                verdict = "fractional order favoured" if d > 0 else "integer order favoured"
+                hdi = ""
+                if b["order"] is not None:
+                    lo, hi = b["order_hdi"]
+                    hdi = (f"; {b['order']} of {b['parent']} in [{lo:.3f}, {hi:.3f}] (94 % HDI"
+                           f"{', includes 1' if b['order_hdi_includes_1'] else ''})")
+                print(f"   {b['parent']:<14} vs {b['baseline']:<16} ln Z difference "
+                      f"{d:+9.2f} ± {b['delta_log_evidence_err']:.2f}: {verdict}{hdi}")
         if result.holdout is not None:
             print("held out " + ", ".join(f"{w:.4g}" for w in result.holdout.omega) + " rad/s:")
             for row in result.table():

@@ -185,10 +185,42 @@ class Comparison:
             "structures": [r.to_dict() for r in self.results],
             "ranking": self.ranking,
             "families": self.families(),
+            "baselines": self.baselines(),
         }
         if self.holdout is not None:
             summary["data"]["holdout_omega"] = self.holdout.omega.tolist()
         return summary
+
+    def baselines(self) -> list[dict]:
+        """Each integer baseline next to its fractional parent (both run on these data).
+
+        Returns one dict per pair: ``parent``, ``baseline``, ``delta_log_evidence`` (ln Z of the
+        parent minus the baseline's; > 0 favours the fractional order), ``bayes_factor`` (parent
+        over baseline), the parent's posterior order ``order`` (``q``, or ``beta`` for the
+        Maxwell) with ``order_mean``, ``order_hdi`` (94 %) and ``order_hdi_includes_1``: whether
+        q = 1, the baseline, is inside the parent's HDI.
+        """
+        done = {r.name: r for r in self.results if r.error is None}
+        out = []
+        for r in self.results:
+            parent = _parent(r.structure)
+            if parent is None or r.name not in done or parent not in done:
+                continue
+            p = done[parent]
+            ev_p, ev_b = p.criteria.get("evidence"), r.criteria.get("evidence")
+            d = None if ev_p is None or ev_b is None else ev_p.log_z - ev_b.log_z
+            order = next((k for k in ("q", "beta") if k in p.posterior.summary), None)
+            row = {"parent": parent, "baseline": r.name, "delta_log_evidence": d,
+                   "delta_log_evidence_err": None if d is None
+                   else math.hypot(ev_p.log_z_err, ev_b.log_z_err),
+                   "bayes_factor": None if d is None else math.exp(min(d, 700.0)),
+                   "order": order}
+            if order is not None:
+                o = p.posterior.summary[order]
+                row.update(order_mean=o.mean, order_hdi=[o.hdi_low, o.hdi_high],
+                           order_hdi_includes_1=bool(o.hdi_low <= 1.0 <= o.hdi_high))
+            out.append(row)
+        return out
 
     def families(self) -> list[dict]:
         """Evidence of each family with several members (e.g. the max-order family), with equal

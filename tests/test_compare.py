@@ -65,6 +65,12 @@ def test_summary_contract_and_files(voigt_comparison):
     assert v["loo"] > vi["loo"] + 10 and v["bic"] < vi["bic"] - 10
     q = v["parameters"]["q"]
     assert abs(q["mean"] - 0.5) < 4 * q["sd"] and q["sd"] < 0.01
+    # The baseline sits next to its parent: the ln Z difference, and q = 1 outside the HDI.
+    (pair,) = summary["baselines"]
+    assert (pair["parent"], pair["baseline"], pair["order"]) == ("voigt", "voigt-int", "q")
+    assert pair["delta_log_evidence"] == pytest.approx(z["voigt"] - z["voigt-int"])
+    assert pair["delta_log_evidence"] > 10 and not pair["order_hdi_includes_1"]
+    assert pair["order_hdi"] == [q["hdi_low"], q["hdi_high"]]
     with (out / "ranking.csv").open() as fh:
         rows = list(csv.DictReader(fh))
     assert [r["structure"] for r in rows] == summary["ranking"]

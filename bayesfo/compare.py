@@ -173,6 +173,20 @@ class Comparison:
             })
         return rows
 
+    def to_dataframe(self):
+        """The ranking table as a ``pandas.DataFrame`` with a ``data`` column naming the data
+        set, so tables of several comparisons combine with ``pandas.concat``.
+
+        Examples
+        --------
+        >>> tables = [compare(d, structures).to_dataframe() for d in datasets]  # doctest: +SKIP
+        >>> combined = pandas.concat(tables, ignore_index=True)  # doctest: +SKIP
+        """
+        import pandas as pd
+
+        rows = [{"data": self.data.label, **row} for row in self.table()]
+        return pd.DataFrame(rows, columns=["data", *RANKING_FIELDS])
+
     def to_summary(self) -> dict:
         """The ``summary.json`` contract."""
         summary = {

@@ -164,3 +164,15 @@ def test_holdout_log_predictive_density_and_families():
     (family,) = result.families()
     z = [result[n].criteria["evidence"].log_z for n in ("voigt", "voigt-int")]
     assert family["log_evidence"] == pytest.approx(np.logaddexp(*z) - np.log(2))
+
+
+def test_tables_of_several_comparisons_combine(voigt_comparison):
+    import pandas as pd
+
+    result, _ = voigt_comparison
+    frame = result.to_dataframe()
+    rows = result.table()
+    assert list(frame["structure"]) == [r["structure"] for r in rows]
+    assert np.allclose(frame["log_evidence"], [r["log_evidence"] for r in rows])
+    both = pd.concat([frame, frame.assign(data="copy")], ignore_index=True)
+    assert both.groupby("data")["log_evidence"].max().nunique() == 1 and len(both) == 2 * len(rows)

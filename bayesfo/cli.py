@@ -70,6 +70,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="angular frequencies [rad/s] left out of the fit for validation")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
+    p.add_argument("--workers", type=int, default=0, metavar="N",
+                   help="processes running structures side by side (default 0: one per CPU); "
+                        "the numbers do not depend on it")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
 
     p = sub.add_parser("identify", help="deterministic fit of one structure (methods 1-5 or optimisation)")
@@ -237,7 +240,8 @@ def cmd_compare(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     result = compare(data, structures, noise=args.noise, seed=args.seed, priors=priors,
                      progress=progress, evidence_check=args.evidence_check,
-                     holdout=_parse_floats(args.holdout, "--holdout") if args.holdout else None)
+                     holdout=_parse_floats(args.holdout, "--holdout") if args.holdout else None,
+                     workers=args.workers)
     write_outputs(result, out)
     if not args.quiet:
         print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; ranked by "

@@ -19,6 +19,7 @@ import csv
 import io
 import json
 import math
+import os
 import sys
 import warnings
 from dataclasses import dataclass, field
@@ -306,7 +307,8 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
             priors=None, progress: bool | None = None, evidence_check: bool = False,
-            prior_odds: dict | None = None, holdout=None, **sampler_kwargs) -> Comparison:
+            prior_odds: dict | None = None, holdout=None, workers: int = 1,
+            **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
     Parameters
@@ -328,6 +330,11 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     holdout : sequence of float, optional
         Angular frequencies [rad/s] left out of the fit (thesis §4.3.3); the log predictive
         density and the RMSE on them are reported next to the in-sample figures.
+    workers : int
+        Processes running structures side by side (0: one per CPU). The numbers do not depend
+        on it: every structure runs with ``seed``.
+    **sampler_kwargs
+        Passed to :func:`~bayesfo.inference.posterior.sample_posterior` (e.g. ``max_steps``).
 
     Returns
     -------
@@ -343,32 +350,80 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     structures = list(structures)
     if not structures:
         raise InputError("no structure to compare")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
     test = None
     if holdout is not None and len(holdout):
         data, test = data.split(holdout)
     if progress is None:
         progress = sys.stderr.isatty()
+    n_proc = min(os.cpu_count() or 1, len(structures)) if workers == 0 else min(workers, len(structures))
+    options = {"noise": noise, "priors": priors, "seed": seed, "evidence_check": evidence_check,
+               "test": test, "sampler_kwargs": sampler_kwargs}
+    bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
+    if n_proc <= 1:
+        outcomes = []
+        for s in structures:
+            outcomes.append(_run_structure(s, data, options))
+            bar.update()
+    else:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        # spawn: no fork of a process that may hold threads (BLAS, tqdm); each structure gets
+        # the same seed whatever the worker count, so the numbers do not depend on it.
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(n_proc, mp_context=ctx) as pool:
+            # Larger structures first (they take longest); results keep the order given.
+            order = sorted(range(len(structures)), key=lambda i: -structures[i].n_params)
+            futures = {i: pool.submit(_run_structure, structures[i], data, options) for i in order}
+            for f in futures.values():
+                f.add_done_callback(lambda _: bar.update())
+            outcomes = [futures[i].result() for i in range(len(structures))]
+    bar.close()
     results = []
-    for s in tqdm(structures, desc="structures", disable=not progress, leave=False):
-        try:
-            own = {k: v for k, v in (priors or {}).items() if k in s.param_names or k in ("sigma", "sigma_rel")}
-            lik = Likelihood(s, data, noise=noise, priors=own)
-            fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
-            post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
-                                    fit=fit, progress=False, **sampler_kwargs)
-            criteria = _criteria(lik, fit, post)
-            if test is not None:
-                criteria.update(_holdout(lik, post, test))
-            extra = _evidence(lik, post, seed, evidence_check)
-            criteria["warnings"].extend(extra.pop("warnings"))
-            criteria.update(extra)
-            results.append(StructureResult(s, fit, post, criteria))
-        except InputError as exc:
-            results.append(StructureResult(s, error=str(exc)))
+    for result, caught in outcomes:
+        # Warnings of the run, re-issued here so that they look the same whichever process ran it.
+        for category, message in caught:
+            warnings.warn(message, category, stacklevel=2)
+        results.append(result)
     if all(r.error is not None for r in results):
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
     _model_probabilities(results, prior_odds or {})
     return Comparison(data, tuple(results), seed, holdout=test)
+
+
+def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
+    """Optimisation, posterior, criteria and evidence of one structure (runs in a worker process
+    when ``compare`` has several). Returns the result and the warnings raised on the way."""
+    seed, test = options["seed"], options["test"]
+    noise = options["noise"]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            own = {k: v for k, v in (options["priors"] or {}).items()
+                   if k in s.param_names or k in ("sigma", "sigma_rel")}
+            lik = Likelihood(s, data, noise=noise, priors=own)
+            fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
+            post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
+                                    fit=fit, progress=False, **options["sampler_kwargs"])
+            criteria = _criteria(lik, fit, post)
+            if test is not None:
+                criteria.update(_holdout(lik, post, test))
+            extra = _evidence(lik, post, seed, options["evidence_check"])
+            criteria["warnings"].extend(extra.pop("warnings"))
+            criteria.update(extra)
+            result = StructureResult(s, fit, post, criteria)
+        except InputError as exc:
+            result = StructureResult(s, error=str(exc))
+    seen = set()
+    kept = []
+    for w in caught:
+        key = (w.category, str(w.message))
+        if key not in seen and not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
+            seen.add(key)
+            kept.append(key)
+    return result, kept
 
 
 def _holdout(lik, post, test: FrequencyResponse) -> dict:

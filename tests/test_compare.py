@@ -176,3 +176,17 @@ def test_tables_of_several_comparisons_combine(voigt_comparison):
     assert np.allclose(frame["log_evidence"], [r["log_evidence"] for r in rows])
     both = pd.concat([frame, frame.assign(data="copy")], ignore_index=True)
     assert both.groupby("data")["log_evidence"].max().nunique() == 1 and len(both) == 2 * len(rows)
+
+
+def test_worker_processes_give_the_same_numbers(voigt_comparison):
+    result, _ = voigt_comparison
+    data = result.data
+    with pytest.warns(PredictiveWarning, match="voigt-int: Pareto k"):
+        parallel = compare(data, resolve_structures("voigt,voigt-int"), seed=1, progress=False,
+                           workers=2)
+    for name in ("voigt", "voigt-int"):
+        a, b = result[name], parallel[name]
+        assert a.criteria["evidence"].log_z == b.criteria["evidence"].log_z
+        assert np.array_equal(a.posterior.samples, b.posterior.samples)
+    with pytest.raises(ValueError, match="workers"):
+        compare(data, resolve_structures("voigt"), workers=-1)

@@ -1,0 +1,65 @@
+"""Both evidence routes on the thesis' G_spec set-up (25 points, complex noise σ = 0.005, known):
+bridge sampling from the emcee draws (the default) against dynesty static nested sampling on the
+same prior and likelihood, for each structure given.
+
+Prints ln Z ± error of both routes, their difference, the combined error, the wall time of each
+route, and whether the posterior converged. Goal (issue 5): agreement within 0.3 nats.
+
+Usage: python benchmarks/bench_evidence_routes.py [--structures voigt,zener,maxwell,max3]
+       [--nlive 500] [--seed 0]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import platform
+import time
+import warnings
+
+import numpy as np
+
+from bayesfo.compare import compare
+from bayesfo.data import FrequencyResponse
+from bayesfo.errors import InputError
+from bayesfo.inference import Likelihood
+from bayesfo.inference._arviz import arviz
+from bayesfo.inference.evidence import nested_evidence
+from bayesfo.structures import resolve_structures
+from bayesfo.studies import OMEGA, g_spec, thesis_noise
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--structures", default="voigt,zener,maxwell,max3")
+    parser.add_argument("--nlive", type=int, default=500)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    warnings.simplefilter("ignore")
+    arviz()
+    print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}")
+    noise = thesis_noise(np.random.default_rng(args.seed), 1)[0]
+    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance",
+                             name="G_spec + thesis noise")
+    print(f"{'structure':<12} {'bridge ln Z':>16} {'t [s]':>6} {'nested ln Z':>16} {'t [s]':>6} "
+          f"{'diff':>6} {'comb.err':>8} converged", flush=True)
+    for s in resolve_structures(args.structures):
+        t = time.perf_counter()
+        try:
+            r = compare(data, [s], seed=args.seed, progress=False).results[0]
+        except InputError as exc:
+            print(f"{s.name:<12} not run: {exc}", flush=True)
+            continue
+        t_bridge = time.perf_counter() - t
+        bridge = r.criteria["evidence"]
+        lik = Likelihood(s, data)
+        nested = nested_evidence(lik, seed=args.seed, nlive=args.nlive)
+        diff = bridge.log_z - nested.log_z
+        print(f"{s.name:<12} {bridge.log_z:9.2f} ± {bridge.log_z_err:4.2f} {t_bridge:6.1f} "
+              f"{nested.log_z:9.2f} ± {nested.log_z_err:4.2f} {nested.seconds:6.0f} {diff:+6.2f} "
+              f"{math.hypot(bridge.log_z_err, nested.log_z_err):8.2f} {r.posterior.converged}",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,65 +1,54 @@
-"""Figures. The only part of bayesfo that imports matplotlib.
+"""Figures. The only part of bayesfo that imports matplotlib (and only when a figure is drawn).
 
-Plot functions take results (plain dicts or result objects), accept ``ax=``, and return what
-they drew.
+Plot functions take results (a :class:`~bayesfo.compare.Comparison`, a
+:class:`~bayesfo.compare.StructureResult` or plain dicts), accept ``fig=`` or ``ax=``, and
+return what they drew: a :class:`Drawn` with the figure, its axes, the plotted numbers and the
+artists, so that what a figure shows can be checked against an independent computation.
+
+Modules
+-------
+``style``
+    The one figure style (:func:`style`, a matplotlib ``rc_context``), colours by ranking.
+``response``
+    :func:`plot_bode`, :func:`plot_nyquist`, :func:`plot_residuals`: posterior response bands
+    against the data.
+``posterior``
+    :func:`plot_corner`, :func:`plot_trace` (one structure), :func:`plot_q_posteriors`.
+``ranking``
+    :func:`plot_ranking`: Δln Z and the information criteria.
+``output``
+    :func:`save_figure` (atomic) and :func:`write_figures` (every figure of a comparison).
+``studies``
+    :func:`plot_rmse_surface` (thesis Figure 3.2).
+
+Example
+-------
+>>> from bayesfo.plotting import plot_bode, write_figures        # doctest: +SKIP
+>>> drawn = plot_bode(comparison)                                # doctest: +SKIP
+>>> paths = write_figures(comparison, "out/figures")             # doctest: +SKIP
 """
 
 from __future__ import annotations
 
-import numpy as np
+from ._base import Drawn
+from .output import save_figure, write_figures
+from .posterior import plot_corner, plot_q_posteriors, plot_trace
+from .ranking import plot_ranking
+from .response import plot_bode, plot_nyquist, plot_residuals
+from .studies import plot_rmse_surface
+from .style import style
 
-
-def _axes(ax=None, projection=None):
-    import matplotlib.pyplot as plt
-
-    if ax is not None:
-        return ax.figure, ax
-    fig = plt.figure(figsize=(5.0, 3.8), constrained_layout=True)
-    return fig, fig.add_subplot(projection=projection)
-
-
-def plot_rmse_surface(surface: dict, ax=None):
-    """Thesis Figure 3.2: RMSE against G_noise over σ and q, as a colour map of log10 RMSE.
-
-    Parameters
-    ----------
-    surface : dict
-        The result of :func:`bayesfo.studies.rmse_surface`.
-    ax : matplotlib Axes, optional
-
-    Returns
-    -------
-    matplotlib.collections.QuadMesh
-        The drawn mesh (its array holds log10 RMSE, shape (n_sigma, n_q)).
-    """
-    fig, ax = _axes(ax)
-    q = np.asarray(surface["q"])
-    sigma = np.asarray(surface["sigma"])
-    z = np.log10(np.asarray(surface["rmse"]))
-    mesh = ax.pcolormesh(q, sigma * 1e3, z, shading="nearest", cmap="viridis")
-    fig.colorbar(mesh, ax=ax, label=r"$\log_{10}$ RMSE vs $G_\mathrm{noise}$")
-    ax.set_xlabel("commensurate order $q$")
-    ax.set_ylabel(r"noise level $\sigma$ [$10^{-3}$]")
-    ax.set_title(f"Method {surface['method']}, n = {surface['n']}, m = {surface['m']}")
-    return mesh
-
-
-def save_figure(fig, path) -> None:
-    """Save ``fig`` to ``path`` (format from the suffix) through a temporary file."""
-    import os
-    import tempfile
-    from pathlib import Path
-
-    from .._io import publish
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=200)
-        publish(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+__all__ = [
+    "Drawn",
+    "plot_bode",
+    "plot_corner",
+    "plot_nyquist",
+    "plot_q_posteriors",
+    "plot_ranking",
+    "plot_residuals",
+    "plot_rmse_surface",
+    "plot_trace",
+    "save_figure",
+    "style",
+    "write_figures",
+]

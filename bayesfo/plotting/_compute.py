@@ -1,0 +1,269 @@
+"""The numbers behind the figures, without matplotlib: posterior response bands, densities of
+the fractional order, sampling coordinates.
+
+Kept apart from the drawing code (as corner.py separates its computation from its wrapper) so
+that tests can recompute what a figure shows and compare it with what was drawn.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputError
+
+#: Upper bound on the posterior draws pushed through the model for bands.
+N_DRAWS = 400
+#: Points of the dense frequency grid of response curves.
+N_GRID = 300
+#: Structures drawn by default in the response figures (the best ones by the ranking).
+DEFAULT_N_STRUCTURES = 3
+#: Quantiles of the bands: 90 % (5–95 %) and 50 % (25–75 %) central intervals and the median.
+BAND_PROBS = (0.05, 0.25, 0.5, 0.75, 0.95)
+#: Names of the fractional order, in order of preference (``beta`` for the Maxwell model).
+ORDER_PARAMS = ("q", "beta")
+
+
+def ok_results(comparison) -> list:
+    """Results without ``error``, in the order of the ranking."""
+    by_name = {r.name: r for r in comparison.results if r.error is None}
+    return [by_name[n] for n in comparison.ranking if n in by_name]
+
+
+def select_results(comparison, structures, default_n: int | None = DEFAULT_N_STRUCTURES) -> list:
+    """The results to draw: the given names (or results), else the best ``default_n`` by the
+    ranking (every structure for ``None``).
+
+    Raises
+    ------
+    InputError
+        If a name is not in the comparison or names a structure that failed.
+    """
+    ranked = ok_results(comparison)
+    if structures is None:
+        return ranked if default_n is None else ranked[:default_n]
+    if isinstance(structures, str):
+        structures = [structures]
+    names = [getattr(s, "name", s) for s in structures]
+    known = {r.name: r for r in comparison.results}
+    out = []
+    for n in names:
+        if n not in known:
+            raise InputError(
+                f"argument 'structures': no structure '{n}' in the comparison; it has "
+                + ", ".join(known)
+            )
+        if known[n].error is not None:
+            raise InputError(f"argument 'structures': structure '{n}' failed: {known[n].error}")
+        out.append(known[n])
+    if not out:
+        raise InputError("argument 'structures' is empty")
+    return out
+
+
+def thin_indices(n_total: int, n_draws: int = N_DRAWS, seed: int = 0) -> np.ndarray:
+    """Sorted indices of at most ``n_draws`` of ``n_total`` draws, without replacement."""
+    if n_draws < 1:
+        raise InputError(f"argument 'n_draws' must be at least 1, got {n_draws}")
+    if n_total <= n_draws:
+        return np.arange(n_total)
+    rng = np.random.default_rng(seed)
+    return np.sort(rng.choice(n_total, size=n_draws, replace=False))
+
+
+def structure_draws(result, n_draws: int = N_DRAWS, seed: int = 0) -> np.ndarray:
+    """Posterior draws of the structure parameters (physical units, noise columns dropped),
+    thinned to at most ``n_draws`` with a seeded generator: shape (n, n_params)."""
+    samples = result.posterior.samples[:, : result.structure.n_params]
+    return samples[thin_indices(samples.shape[0], n_draws, seed)]
+
+
+def response_draws(result, omega, kind: str, n_draws: int = N_DRAWS, seed: int = 0) -> np.ndarray:
+    """The model response of thinned posterior draws at ``omega``: shape (n, n_freq), complex."""
+    theta = structure_draws(result, n_draws, seed)
+    return np.asarray(result.structure.response(theta, np.asarray(omega, float), kind))
+
+
+def omega_grid(comparison, n: int = N_GRID) -> np.ndarray:
+    """Log-spaced angular frequencies [rad/s] from the lowest to the highest measured one
+    (fitted and held-out points)."""
+    w = np.asarray(comparison.data.omega, float)
+    if comparison.holdout is not None:
+        w = np.concatenate([w, comparison.holdout.omega])
+    return np.logspace(math.log10(w.min()), math.log10(w.max()), n)
+
+
+def unwrapped_phase_deg(g: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Phase [deg] of ``g`` (..., n_freq), unwrapped along increasing ω and shifted by whole
+    turns so that the phase at the lowest frequency lies in (−180, 180]."""
+    order = np.argsort(omega)
+    phase = np.unwrap(np.angle(np.asarray(g)[..., order]), axis=-1)
+    first = phase[..., :1]
+    phase = phase - 2 * np.pi * np.round((first - np.angle(np.exp(1j * first))) / (2 * np.pi))
+    out = np.empty_like(phase)
+    out[..., order] = phase
+    return np.degrees(out)
+
+
+def quantiles(values: np.ndarray, probs=BAND_PROBS) -> dict[float, np.ndarray]:
+    """``{p: pointwise p-quantile over draws (axis 0)}``."""
+    q = np.quantile(values, probs, axis=0)
+    return {p: q[i] for i, p in enumerate(probs)}
+
+
+def order_parameter(result) -> str | None:
+    """Name of the free fractional order of a structure (``q`` or ``beta``), else None."""
+    post = result.posterior
+    names = post.param_names if post is not None else result.structure.param_names
+    return next((n for n in ORDER_PARAMS if n in names), None)
+
+
+def prior_density(prior: dict, x: np.ndarray) -> np.ndarray:
+    """Density of a prior given as its ``to_dict()`` form at ``x``."""
+    x = np.asarray(x, float)
+    kind = prior.get("prior")
+    if kind == "uniform":
+        lo, hi = prior["low"], prior["high"]
+        return np.where((x >= lo) & (x <= hi), 1.0 / (hi - lo), 0.0)
+    if kind == "log-uniform":
+        lo, hi = prior["low"], prior["high"]
+        inside = (x >= lo) & (x <= hi)
+        return np.where(inside, 1.0 / (np.where(inside, x, 1.0) * math.log(hi / lo)), 0.0)
+    if kind == "normal":
+        mu, sd = prior["mu"], prior["sd"]
+        return np.exp(-0.5 * ((x - mu) / sd) ** 2) / (sd * math.sqrt(2 * math.pi))
+    raise InputError(f"unknown prior type {kind!r}")
+
+
+def prior_range(prior: dict, samples: np.ndarray) -> tuple[float, float]:
+    """The prior's bounds, or for an unbounded prior the draws' range padded by 10 %."""
+    if "low" in prior and "high" in prior:
+        return float(prior["low"]), float(prior["high"])
+    lo, hi = float(np.min(samples)), float(np.max(samples))
+    pad = 0.1 * (hi - lo) if hi > lo else 1.0
+    return lo - pad, hi + pad
+
+
+def density_1d(samples: np.ndarray, lo: float, hi: float, n_grid: int = 400):
+    """Kernel density of ``samples`` on [lo, hi], reflected at both ends so that it integrates
+    to one over the interval.
+
+    The grid combines an even grid over [lo, hi] with a fine one over the draws (±4 bandwidths),
+    so that a sharply determined order is resolved as well as a broad one. Draws that are all
+    equal give a narrow triangle of unit area.
+
+    Returns
+    -------
+    grid, density : ndarray
+    """
+    from scipy import stats
+
+    x = np.asarray(samples, float)
+    if x.size == 0:
+        raise InputError("a density needs at least one draw")
+    if np.ptp(x) <= 0:
+        # All draws equal (a parameter pinned by its constraints): a narrow triangle of unit
+        # area instead of a kernel density, which needs spread.
+        c, h = float(x[0]), 1e-3 * (hi - lo)
+        grid = np.unique(np.clip(np.r_[np.linspace(lo, hi, n_grid), c - h, c, c + h], lo, hi))
+        return grid, np.maximum(0.0, 1.0 - np.abs(grid - c) / h) / h
+    kde = stats.gaussian_kde(x)
+    bw = float(np.sqrt(kde.covariance[0, 0]))
+    fine = np.linspace(max(lo, x.min() - 4 * bw), min(hi, x.max() + 4 * bw), n_grid)
+    grid = np.unique(np.concatenate([np.linspace(lo, hi, n_grid), fine]))
+    dens = kde(grid)
+    # Reflection keeps the mass that a kernel puts beyond a hard prior bound.
+    dens = dens + kde(2 * lo - grid) + kde(2 * hi - grid)
+    return grid, dens
+
+
+def sampling_coordinates(result):
+    """Posterior draws in the coordinates of the summaries: log10 of parameters with a
+    log-uniform prior, the parameter itself otherwise.
+
+    Returns
+    -------
+    values : ndarray, shape (n_draws, ndim)
+    labels : list of str
+        Mathtext labels (``log$_{10}$ a1`` for log coordinates).
+    is_log : ndarray of bool
+    """
+    post = result.posterior
+    priors = result.criteria.get("priors", {})
+    is_log = np.array([priors.get(n, {}).get("prior") == "log-uniform" for n in post.param_names])
+    values = to_coordinates(post.samples, is_log)
+    labels = [_label(n, log) for n, log in zip(post.param_names, is_log)]
+    return values, labels, is_log
+
+
+def to_coordinates(theta, is_log) -> np.ndarray:
+    """``theta`` (physical units) in the coordinates of :func:`sampling_coordinates`."""
+    theta = np.asarray(theta, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(is_log, np.log10(np.abs(theta)), theta)
+
+
+def decade_exponent(x) -> int:
+    """Power of ten to divide ``x`` by for readable tick labels: 0 when the bulk of |x| lies
+    between 0.01 and 1000, else the decade of its largest magnitude."""
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    if not x.size:
+        return 0
+    m = float(np.max(np.abs(np.quantile(x, [0.01, 0.99]))))
+    if m == 0.0:
+        return 0
+    e = math.floor(math.log10(m))
+    return 0 if -2 <= e <= 2 else e
+
+
+def scaled_label(label: str, exponent: int) -> str:
+    """``label`` with the factor of :func:`decade_exponent` (``b$_{0}$ (×10$^{-5}$)``)."""
+    return label if exponent == 0 else f"{label} (×10$^{{{exponent}}}$)"
+
+
+GREEK = {"alpha": r"\alpha", "beta": r"\beta", "sigma": r"\sigma", "sigma_rel": r"\sigma_{rel}"}
+
+
+def param_symbol(name: str) -> str:
+    """Mathtext of a parameter name: ``a1`` → ``$a_{1}$``, ``beta`` → ``$\\beta$``."""
+    if name in GREEK:
+        return f"${GREEK[name]}$"
+    head = name.rstrip("0123456789")
+    tail = name[len(head):]
+    return f"${head}_{{{tail}}}$" if tail and head else f"${name}$"
+
+
+def _label(name: str, log: bool) -> str:
+    sym = param_symbol(name)
+    return f"log$_{{10}}$ {sym}" if log else sym
+
+
+def loo_differences(results) -> dict[str, tuple[float, float]]:
+    """``{name: (Δelpd, se of Δelpd)}`` of PSIS-LOO relative to the structure with the highest
+    elpd, the standard error from the pointwise differences (as ``arviz.compare``'s ``dse``).
+
+    The draws are those of each result's InferenceData; all results must be on the same data.
+    Pareto-k warnings of arviz are not repeated here: :func:`bayesfo.compare.compare` has
+    already reported them and flagged the structures.
+    """
+    import warnings
+
+    from ..inference._arviz import arviz
+
+    az = arviz()
+    pointwise = {}
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Estimated shape parameter of Pareto",
+                                category=UserWarning)
+        for r in results:
+            pointwise[r.name] = np.asarray(az.loo(r.posterior.idata, pointwise=True).loo_i)
+    if not pointwise:
+        return {}
+    best = max(pointwise, key=lambda n: pointwise[n].sum())
+    out = {}
+    for name, lpd in pointwise.items():
+        diff = pointwise[best] - lpd
+        out[name] = (float(-diff.sum()), float(np.sqrt(diff.size * np.var(diff))))
+    return out

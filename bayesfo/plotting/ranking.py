@@ -1,0 +1,153 @@
+"""The ranking of a comparison as a figure: evidence and the information criteria."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ._base import Drawn, new_figure
+from ._compute import loo_differences
+from .style import COLUMN_WIDTH, FLAG_COLOR, colors_for, style
+
+#: Below this Δ (nats) the Δ axes switch to a symmetric-log scale, linear within ±SYMLOG_LINEAR.
+SYMLOG_FROM = -20.0
+SYMLOG_LINEAR = 1.0
+CRITERIA = (
+    # (value key, label, marker, face colour, dodge)
+    ("delta_loo", "elpd$_{LOO}$ ± se", "o", "black", 0.22),
+    ("delta_aic_half", "−AIC/2", "^", "0.55", 0.0),
+    ("delta_bic_half", "−BIC/2", "s", "white", -0.22),
+)
+
+
+def _nan(v) -> float:
+    return np.nan if v is None else float(v)
+
+
+def _format_p(p: float) -> str:
+    if not np.isfinite(p):
+        return "P n/a"
+    return "P < 0.001" if p < 0.001 else f"P = {p:.3f}"
+
+
+def _set_delta_scale(ax, values) -> None:
+    """Linear axis, or symmetric-log with ticks at 0, ±1, ±10, … labelled as plain numbers."""
+    from matplotlib.ticker import MaxNLocator, NullLocator
+
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    ax.axvline(0.0, color="0.3", lw=0.6, zorder=0)
+    if not (v.size and v.min() < SYMLOG_FROM):
+        # At least a nat in view: smaller differences are not worth a mention (Kass–Raftery).
+        x0, x1 = ax.get_xlim()
+        ax.set_xlim(min(x0, -1.0), max(x1, 0.25))
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+        return
+    ax.set_xscale("symlog", linthresh=SYMLOG_LINEAR, linscale=0.5)
+    low = int(np.ceil(np.log10(-v.min())))
+    high = int(np.ceil(np.log10(v.max()))) if v.max() > SYMLOG_LINEAR else -1
+    ticks = [-(10.0**k) for k in range(low, -1, -1)] + [0.0] + [10.0**k for k in range(high + 1)]
+    ax.set_xticks(ticks, [f"{t:,.0f}".replace("-", "−") for t in ticks])
+    ax.xaxis.set_minor_locator(NullLocator())
+
+
+def plot_ranking(comparison, fig=None) -> Drawn:
+    """The structures' log-evidence and information criteria relative to the best.
+
+    Top: Δln Z ± its error (bridge sampling) to the structure with the highest ln Z, with the
+    posterior model probability on the right. Bottom: the criteria on the same scale of nats,
+    higher is better: Δelpd (PSIS-LOO) ± the standard error of the difference (from the
+    pointwise differences, as ``arviz.compare``'s ``dse``; the standard error of each elpd
+    itself, ``loo_se`` of the table, is larger and not a measure of the difference), −ΔAIC/2
+    and −ΔBIC/2 (BIC/−2
+    approximates ln Z, AIC/−2 the expected log predictive density), each relative to its best
+    structure. Structures run from the best (top) down in the order of the ranking; a structure
+    whose posterior did not converge has a red label and a red marker. When differences exceed
+    20 nats the axes are symmetric-logarithmic (linear within ±2 nats).
+
+    Parameters
+    ----------
+    comparison : bayesfo.compare.Comparison
+    fig : matplotlib.figure.Figure, optional
+        Empty figure to draw in; default a new single-column figure.
+
+    Returns
+    -------
+    Drawn
+        ``axes`` = (evidence, criteria). ``values`` (one entry per ranked structure, top to
+        bottom): ``"structures"``, ``"y"``, ``"delta_log_evidence"``, ``"log_evidence_err"``,
+        ``"posterior_probability"``, ``"delta_loo"``, ``"delta_loo_se"``, ``"delta_aic_half"``,
+        ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing). ``artists``:
+        ``"<name>/log_evidence"`` (``ErrorbarContainer``) and one ``ErrorbarContainer`` per
+        criterion under its value key.
+
+    Raises
+    ------
+    InputError
+        If no structure of the comparison succeeded.
+    """
+    rows = [row for row in comparison.table() if row.get("rank") is not None]
+    if not rows:
+        raise InputError("the comparison has no structure that ran")
+    n = len(rows)
+    names = [row["structure"] for row in rows]
+    dse = loo_differences([comparison[name] for name in names])
+    y = np.arange(n - 1, -1, -1, dtype=float)
+    best_aic = min(row["aic"] for row in rows)
+    best_bic = min(row["bic"] for row in rows)
+    values = {
+        "structures": np.array(names), "y": y,
+        "delta_log_evidence": np.array([_nan(r["delta_log_evidence"]) for r in rows]),
+        "log_evidence_err": np.array([_nan(r["log_evidence_err"]) for r in rows]),
+        "posterior_probability": np.array([_nan(r["posterior_probability"]) for r in rows]),
+        "delta_loo": np.array([r["delta_loo"] for r in rows], float),
+        "delta_loo_se": np.array([dse[n][1] for n in names], float),
+        "delta_aic_half": np.array([-(r["aic"] - best_aic) / 2 for r in rows], float),
+        "delta_bic_half": np.array([-(r["bic"] - best_bic) / 2 for r in rows], float),
+        "converged": np.array([bool(r["converged"]) for r in rows]),
+    }
+    colors = colors_for(comparison.ranking)
+    artists = {}
+    with style():
+        fig = new_figure(fig, (COLUMN_WIDTH, min(9.0, 1.45 + 0.52 * n)))
+        ax_z, ax_c = fig.subplots(2, 1, sharey=True, height_ratios=[1, 1.15])
+        for i, name in enumerate(names):
+            dz = values["delta_log_evidence"][i]
+            ok = values["converged"][i]
+            c = colors.get(name, "0.4")
+            cont = ax_z.errorbar([dz], [y[i]], xerr=[values["log_evidence_err"][i]], fmt="o",
+                                 ms=4.5, color=c, mfc=c if ok else "white",
+                                 mec=c if ok else FLAG_COLOR, mew=1.1, elinewidth=1.0, zorder=4)
+            artists[f"{name}/log_evidence"] = cont
+            if not np.isfinite(dz):
+                ax_z.text(0.0, y[i], "no ln Z  ", ha="right", va="center", fontsize=6.5)
+        _set_delta_scale(ax_z, values["delta_log_evidence"])
+        ax_z.set_xlabel(r"$\Delta \ln Z$ to the best [nats]")
+        right = ax_z.twinx()
+        right.set_ylim(-0.6, n - 0.4)
+        right.set_yticks(y, [_format_p(p) for p in values["posterior_probability"]])
+        right.tick_params(axis="y", length=0, labelsize=6.5)
+        right.grid(False)
+        for spine in right.spines.values():
+            spine.set_visible(False)
+        for key, label, marker, face, dodge in CRITERIA:
+            err = values["delta_loo_se"] if key == "delta_loo" else None
+            cont = ax_c.errorbar(values[key], y + dodge, xerr=err, fmt=marker, ms=3.6,
+                                 color="black", mfc=face, mec="black", mew=0.7, elinewidth=0.8,
+                                 label=label, zorder=4)
+            artists[key] = cont
+        _set_delta_scale(ax_c, np.concatenate([values[k] for k, *_ in CRITERIA]
+                                              + [values["delta_loo"] + values["delta_loo_se"]]))
+        ax_c.set_xlabel(r"$\Delta$ to the best [nats], higher is better")
+        ax_c.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=3, borderaxespad=0.1,
+                    handletextpad=0.3, columnspacing=0.8)
+        for ax in (ax_z, ax_c):
+            ax.set_ylim(-0.6, n - 0.4)
+            ax.set_yticks(y, [nm if ok else f"{nm}\nnot converged"
+                              for nm, ok in zip(names, values["converged"])])
+            ax.grid(axis="y", visible=False)
+            for tick, ok in zip(ax.get_yticklabels(), values["converged"]):
+                if not ok:
+                    tick.set_color(FLAG_COLOR)
+        ax_c.tick_params(axis="y", labelleft=True)
+    return Drawn.build(fig, (ax_z, ax_c), values, artists)

@@ -1,0 +1,514 @@
+"""A self-contained HTML report of a comparison: the page a person reads first.
+
+From top to bottom: a plain-language verdict (which structure wins, by how much, whether the
+information criteria agree, how well the fractional order is determined, what did not
+converge), the data, the ranking table, the priors, the parameter summaries, warnings and
+convergence, and the figures with one-line captions. PNG figures are embedded as base64 data
+URIs and the style sheet is inline, so the file needs nothing else to be read or mailed. All
+text from data, files and results is escaped.
+
+This module does not draw: it takes the figure files written by
+:func:`bayesfo.plotting.write_figures` (and does not import matplotlib).
+
+References
+----------
+Kass, R. E. & Raftery, A. E. (1995). Bayes factors. *J. Am. Stat. Assoc.* 90, 773–795 (the
+verbal scale of the evidence).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+from pathlib import Path
+
+from ._io import atomic_write_text
+from .errors import InputError
+
+#: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
+EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
+                  (5.0, "strong"), (math.inf, "very strong"))
+CRITERIA_NAMES = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
+ORDER_PARAMS = ("q", "beta")
+HDI_PERCENT = 94
+
+CSS = """
+body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; color: #1a1a1a;
+       max-width: 62rem; margin: 2rem auto; padding: 0 1rem; line-height: 1.45; }
+h1 { font-size: 1.5rem; margin-bottom: 0.2rem; } h2 { font-size: 1.2rem; margin-top: 2rem;
+     border-bottom: 1px solid #ccc; } h3 { font-size: 1.0rem; margin-bottom: 0.3rem; }
+.verdict { background: #f3f7fb; border-left: 4px solid #0072B2; padding: 0.6rem 1rem; }
+.verdict p { margin: 0.4rem 0; }
+.flag { color: #b00000; font-weight: 600; }
+table { border-collapse: collapse; margin: 0.5rem 0 1rem; font-size: 0.88rem; }
+th, td { border: 1px solid #d0d0d0; padding: 0.2rem 0.5rem; text-align: right; }
+th { background: #f0f0f0; } td.text, th.text { text-align: left; }
+tr.failed td { color: #777; }
+figure { margin: 1.2rem 0; } figure img { max-width: 100%; height: auto; border: 1px solid #eee; }
+figcaption { font-size: 0.9rem; color: #333; }
+.small { font-size: 0.85rem; color: #555; }
+"""
+
+CAPTIONS = {
+    "ranking": "Log-evidence (top) and information criteria (bottom) relative to the best "
+               "structure, in nats, higher is better; posterior probabilities on the right; red "
+               "labels: posterior not converged.",
+    "bode": "Magnitude and phase of the data (± 1 sd where σ is known) with each structure's "
+            "posterior median response (line) and its 50 % and 90 % credible bands.",
+    "nyquist": "The same in the complex plane: posterior median curve and single posterior "
+               "draws (thin lines).",
+    "residuals": "Residuals of the data from the posterior median prediction, real and "
+                 "imaginary parts, normalised by the noise (or relative to |G|).",
+    "q_posteriors": "Posterior density of the fractional order per structure (best on top), "
+                    "with the prior (dashed), the 94 % HDI (bar) and the mean (tick).",
+}
+
+
+def _e(x) -> str:
+    return html.escape(str(x), quote=True)
+
+
+def _finite(x) -> bool:
+    if x is None or isinstance(x, (bool, str)):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except (TypeError, ValueError):
+        return False
+
+
+def _num(x, fmt: str = ".2f") -> str:
+    return format(x, fmt) if _finite(x) else "–"
+
+
+def _prob(p) -> str:
+    if not _finite(p):
+        return "–"
+    return "< 0.001" if p < 0.001 else f"{p:.3f}"
+
+
+def _cell(x, fmt: str = ".2f", text: str | None = None, cls: str = "") -> str:
+    """A numeric table cell; ``data-value`` carries the full-precision number."""
+    attr = f' data-value="{_e(repr(float(x)))}"' if _finite(x) else ""
+    c = f' class="{cls}"' if cls else ""
+    return f"<td{c}{attr}>{_e(text if text is not None else _num(x, fmt))}</td>"
+
+
+def _text_cell(x, cls: str = "text") -> str:
+    return f'<td class="{cls}">{_e(x)}</td>'
+
+
+def _bayes_factor(d: float) -> str:
+    if d < 30:
+        return f"{math.exp(d):.3g}"
+    return f"about 10^{d / math.log(10):.0f}"
+
+
+def _strength(d: float) -> str:
+    return next(label for bound, label in EVIDENCE_SCALE if d < bound)
+
+
+def _order(result):
+    names = result.posterior.param_names
+    p = next((n for n in ORDER_PARAMS if n in names), None)
+    return p, (result.posterior.summary.get(p) if p else None)
+
+
+def _digits(sd: float) -> int:
+    """Decimals that show a value to the second significant digit of its standard deviation."""
+    if not _finite(sd) or sd <= 0:
+        return 3
+    return min(8, max(0, 1 - math.floor(math.log10(sd))))
+
+
+def verdict(comparison) -> list[tuple[str, bool]]:
+    """The plain-language verdict, as sentences ``(text, flagged)``.
+
+    Parameters
+    ----------
+    comparison : bayesfo.compare.Comparison
+
+    Returns
+    -------
+    list of (str, bool)
+        Sentences in reading order; ``flagged`` marks cautions (no convergence, poorly
+        determined order, an evidence difference within its error).
+    """
+    rows = [r for r in comparison.table() if r.get("rank") is not None]
+    failed = [r for r in comparison.results if r.error is not None]
+    out: list[tuple[str, bool]] = []
+    if not rows:
+        return [("No structure could be run on these data.", True)]
+    best = rows[0]
+    name = best["structure"]
+    result = comparison[name]
+    if best["log_evidence"] is None:
+        out.append((f"No structure has a log-evidence; ranked by PSIS-LOO, {name} comes first.",
+                    True))
+    elif len(rows) == 1:
+        out.append((f"Only one structure was run: {name}, with ln Z = "
+                    f"{best['log_evidence']:.2f} ± {best['log_evidence_err']:.2f}.", False))
+    else:
+        second = rows[1]
+        n = len(rows)
+        if second["log_evidence"] is None:
+            out.append((f"{name} has the highest log-evidence (ln Z = "
+                        f"{best['log_evidence']:.2f}); {second['structure']} has none.", False))
+        else:
+            d = best["log_evidence"] - second["log_evidence"]
+            err = math.hypot(best["log_evidence_err"] or 0.0, second["log_evidence_err"] or 0.0)
+            out.append((
+                f"{name} is the best-supported structure: its log-evidence exceeds that of the "
+                f"runner-up, {second['structure']}, by Δln Z = {d:.2f} ± {err:.2f} (Bayes "
+                f"factor {_bayes_factor(d)}; on the Kass–Raftery scale the evidence is "
+                f"{_strength(d)}). Its posterior probability among the {n} structures compared is "
+                f"{_prob(best['posterior_probability'])} (equal prior odds unless others were "
+                "given).", False))
+            if d < 2 * err:
+                out.append((f"The difference from {second['structure']} is within twice its "
+                            "estimation error: the evidence does not separate the two.", True))
+        agree = [c for c in CRITERIA_NAMES if best.get(f"rank_{c}") == 1]
+        disagree = {}
+        for c in CRITERIA_NAMES:
+            if c not in agree:
+                top = next((r["structure"] for r in rows if r.get(f"rank_{c}") == 1), None)
+                disagree.setdefault(top, []).append(CRITERIA_NAMES[c])
+        if not disagree:
+            out.append(("The information criteria agree: PSIS-LOO, WAIC, AIC and BIC all rank "
+                        f"{name} first.", False))
+        else:
+            parts = [f"{_join(crit)} prefer{'s' if len(crit) == 1 else ''} {other}"
+                     for other, crit in disagree.items()]
+            lead = (f"{_join([CRITERIA_NAMES[c] for c in agree])} also rank {name} first, but "
+                    if agree else "The information criteria disagree with the evidence: ")
+            out.append((lead + "; ".join(parts) + ".", False))
+    p, s = _order(result)
+    if s is not None:
+        sym = "q" if p == "q" else "β"
+        digits = _digits(s.sd)
+        text = (f"The fractional order of {name} is {sym} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
+                f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}).")
+        if s.poorly_determined:
+            out.append((text + f" {sym} is poorly determined: its {HDI_PERCENT} % HDI covers "
+                        "more than half of the prior range.", True))
+        else:
+            out.append((text, False))
+        if s.multimodal:
+            out.append((f"The posterior of {sym} has several separated modes.", True))
+    elif result.structure.integer:
+        out.append((f"{name} is an integer-order structure (its exponents are fixed at 1).",
+                    False))
+    poor = [r["structure"] for r in rows[1:]
+            if (o := _order(comparison[r["structure"]]))[1] is not None and o[1].poorly_determined]
+    if poor:
+        out.append(("The fractional order is poorly determined (HDI wider than half the prior "
+                    f"range) for: {', '.join(poor)}.", True))
+    if not best["converged"]:
+        post = result.posterior
+        out.append((f"Caution: the posterior of {name} did not converge (R-hat "
+                    f"{post.rhat_max:.3f}, ESS {post.ess_min:.0f}); its log-evidence and the "
+                    "ranking that rests on it are unreliable.", True))
+    others = [r["structure"] for r in rows[1:] if not r["converged"]]
+    if others:
+        out.append((f"Posteriors that did not converge: {', '.join(others)}.", True))
+    if comparison.holdout is not None:
+        scored = [r for r in rows if _finite(r.get("holdout_lpd"))]
+        if scored:
+            top = max(scored, key=lambda r: r["holdout_lpd"])
+            out.append((f"On the {comparison.holdout.n_frequencies} held-out frequencies, "
+                        f"{top['structure']} predicts best (log predictive density "
+                        f"{top['holdout_lpd']:.2f}).", False))
+    if failed:
+        out.append(("Could not be run: " + "; ".join(f"{r.name} ({r.error})" for r in failed)
+                    + ".", True))
+    return out
+
+
+def _join(items) -> str:
+    items = list(items)
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _noise(comparison) -> list[tuple[str, str]]:
+    seen = []
+    for r in comparison.results:
+        if r.posterior is not None and (r.posterior.noise, r.posterior.noise_reason) not in seen:
+            seen.append((r.posterior.noise, r.posterior.noise_reason))
+    return seen
+
+
+def _data_section(comparison) -> str:
+    d = comparison.data
+    rows = [
+        ("name", d.label), ("source", d.source or "(not from a file)"), ("kind", d.kind),
+        ("units", d.units or "(not given)"), ("frequencies", str(d.n_frequencies)),
+        ("ω range", f"{d.omega.min():.4g} – {d.omega.max():.4g} rad/s"),
+        ("σ per point", "given by the data" if d.sigma is not None else "not given"),
+    ]
+    for noise, reason in _noise(comparison):
+        rows.append(("noise model", f"{noise}: {reason}"))
+    if comparison.holdout is not None:
+        rows.append(("held out", ", ".join(f"{w:.4g}" for w in comparison.holdout.omega)
+                     + " rad/s (not used in the fit)"))
+    rows.append(("seed", str(comparison.seed)))
+    for note in getattr(d, "notes", ()):
+        rows.append(("note", note))
+    body = "".join(f'<tr><th class="text">{_e(k)}</th>{_text_cell(v)}</tr>' for k, v in rows)
+    return f"<table>{body}</table>"
+
+
+RANKING_COLUMNS = (
+    # (key, header, format)
+    ("log_evidence", "ln Z", ".2f"), ("log_evidence_err", "± err", ".2f"),
+    ("delta_log_evidence", "Δln Z", ".2f"), ("posterior_probability", "P", None),
+    ("loo", "elpd LOO", ".2f"), ("loo_se", "± se", ".2f"), ("waic", "elpd WAIC", ".2f"),
+    ("aic", "AIC", ".2f"), ("bic", "BIC", ".2f"), ("rmse", "RMSE", ".3g"),
+    ("pareto_k_max", "Pareto k max", ".2f"), ("rhat_max", "R-hat", ".3f"),
+    ("ess_min", "ESS min", ".0f"),
+)
+
+
+def _ranking_table(comparison) -> str:
+    holdout = comparison.holdout is not None
+    cols = list(RANKING_COLUMNS)
+    if holdout:
+        cols.insert(10, ("holdout_lpd", "held-out lpd", ".2f"))
+    head = ('<tr><th>#</th><th class="text">structure</th><th>k</th>'
+            + "".join(f"<th>{_e(h)}</th>" for _, h, _ in cols)
+            + '<th>q (sd)</th><th class="text">converged</th></tr>')
+    body = []
+    for row in comparison.table():
+        name = row["structure"]
+        if row.get("rank") is None:
+            body.append(f'<tr class="failed" id="row-{_e(name)}"><td>–</td>{_text_cell(name)}'
+                        f'<td>{row["n_params"]}</td><td class="text" colspan="{len(cols) + 2}">'
+                        f'failed: {_e(row.get("error"))}</td></tr>')
+            continue
+        cells = [f'<td>{row["rank"]}</td>', _text_cell(name), f'<td>{row["n_params"]}</td>']
+        for key, _, fmt in cols:
+            v = row.get(key)
+            if key == "posterior_probability":
+                cells.append(_cell(v, text=_prob(v)))
+            elif key == "rhat_max" and _finite(v) and not row["converged"]:
+                cells.append(_cell(v, fmt, cls="flag"))
+            else:
+                cells.append(_cell(v, fmt))
+        q = row.get("q_mean")
+        cells.append(_cell(q, text=f"{q:.3f} ({row['q_sd']:.3f})" if _finite(q) else "–"))
+        ok = row["converged"]
+        cells.append(f'<td class="text{"" if ok else " flag"}">{"yes" if ok else "NO"}</td>')
+        body.append(f'<tr id="row-{_e(name)}">' + "".join(cells) + "</tr>")
+    note = ("<p class='small'>Ranked by ln Z (bridge sampling); Δln Z to the best; P: posterior "
+            "model probability; elpd: expected log pointwise predictive density (higher is "
+            "better) with the standard error of each estimate; AIC and BIC: lower is better; "
+            "RMSE at the posterior mode (thesis eq. (3.23)); q: posterior mean and sd of the "
+            "fractional order (β for the generalised Maxwell model).</p>")
+    return f"<table>{head}{''.join(body)}</table>{note}"
+
+
+def _families(comparison) -> str:
+    fams = comparison.families()
+    if not fams:
+        return ""
+    rows = "".join(
+        f"<tr>{_text_cell(f['family'])}{_text_cell(', '.join(f['members']))}"
+        f"{_cell(f['log_evidence'])}{_cell(f['log_evidence_err'])}"
+        f"{_cell(f['posterior_probability'], text=_prob(f['posterior_probability']))}</tr>"
+        for f in fams)
+    return ("<h3>Families</h3><p class='small'>Evidence of each family with several members, "
+            "equal prior weight on its members.</p><table><tr><th class='text'>family</th>"
+            "<th class='text'>members</th><th>ln Z</th><th>± err</th><th>P</th></tr>"
+            f"{rows}</table>")
+
+
+def _priors_section(comparison) -> str:
+    parts = []
+    for name in comparison.ranking:
+        r = comparison[name]
+        rows = []
+        for name, prior in r.criteria.get("priors", {}).items():
+            kind = prior.get("prior", "?")
+            if "low" in prior:
+                desc = f"[{prior['low']:.4g}, {prior['high']:.4g}]"
+            elif "mu" in prior:
+                desc = f"mean {prior['mu']:.4g}, sd {prior['sd']:.4g}"
+            else:
+                desc = ", ".join(f"{k} = {v}" for k, v in prior.items() if k != "prior")
+            rows.append(f"<tr>{_text_cell(name)}{_text_cell(kind)}{_text_cell(desc)}</tr>")
+        scale = ""
+        if r.fit is not None and getattr(r.fit, "scaling", None) is not None:
+            sc = r.fit.scaling
+            scale = (f" Scaled data: ω/ω_ref, G/g_ref with ω_ref = {sc.omega_ref:.4g} rad/s, "
+                     f"g_ref = {sc.g_ref:.4g}"
+                     + (" (structure compared with the reciprocal of the data)"
+                        if sc.reciprocal else "") + ".")
+        parts.append(f"<h3>{_e(r.name)}</h3><p class='small'>{_e(r.structure.formula)}."
+                     f"{_e(scale)}</p><table><tr><th class='text'>parameter</th>"
+                     f"<th class='text'>prior</th><th class='text'>range</th></tr>"
+                     f"{''.join(rows)}</table>")
+    return ("<p class='small'>Coefficient priors apply on the scaled data (so that they mean "
+            "the same for any units); exponents are unscaled. Every structure is also "
+            "restricted to stable, dissipative parameters (and its card's inequalities).</p>"
+            + "".join(parts))
+
+
+def _parameters_section(comparison) -> str:
+    parts = []
+    for name in comparison.ranking:
+        r = comparison[name]
+        rows = []
+        for p, s in r.posterior.summary.items():
+            flags = [f for f, on in (("poorly determined", s.poorly_determined),
+                                     ("multimodal", s.multimodal)) if on]
+            rows.append(
+                f"<tr>{_text_cell(p)}{_cell(s.mean, '.4g')}{_cell(s.sd, '.3g')}"
+                f"{_cell(s.hdi_low, '.4g')}{_cell(s.hdi_high, '.4g')}{_cell(s.median, '.4g')}"
+                f"{_cell(s.map, '.4g')}"
+                f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
+        parts.append(f"<h3>{_e(name)}</h3><table><tr><th class='text'>parameter</th>"
+                     f"<th>mean</th><th>sd</th><th>HDI low</th><th>HDI high</th><th>median</th>"
+                     f"<th>MAP</th><th class='text'>flags</th></tr>{''.join(rows)}</table>")
+    return (f"<p class='small'>Posterior summaries in physical units; HDI: {HDI_PERCENT} % "
+            "highest-density interval; MAP: the draw of highest posterior density. "
+            "'Poorly determined': the HDI covers more than half of the prior range.</p>"
+            + "".join(parts))
+
+
+def _diagnostics_section(comparison) -> str:
+    items = []
+    for r in comparison.results:
+        if r.error is not None:
+            items.append(f"<li><b>{_e(r.name)}</b>: <span class='flag'>failed</span>: "
+                         f"{_e(r.error)}</li>")
+            continue
+        post = r.posterior
+        status = ("converged" if post.converged
+                  else "<span class='flag'>not converged</span>")
+        tau = max(post.tau) if len(post.tau) else float("nan")
+        line = (f"<b>{_e(r.name)}</b>: {status}; R-hat {_num(post.rhat_max, '.3f')}, ESS bulk "
+                f"{_num(post.ess_bulk_min, '.0f')}, tail {_num(post.ess_tail_min, '.0f')}, "
+                f"{post.n_walkers} walkers × {post.n_steps} steps, τ max {_num(tau, '.0f')}, "
+                f"acceptance {_num(post.acceptance, '.2f')}")
+        if r.criteria.get("evidence_agree") is False:
+            line += "; <span class='flag'>bridge and nested ln Z disagree</span>"
+        notes = list(post.messages) + [w for w in r.criteria.get("warnings", [])
+                                       if w not in post.messages]
+        if notes:
+            line += "<ul>" + "".join(f"<li class='flag'>{_e(m)}</li>" for m in notes) + "</ul>"
+        items.append(f"<li>{line}</li>")
+    return f"<ul>{''.join(items)}</ul>"
+
+
+def _caption(name: str) -> str:
+    if name in CAPTIONS:
+        return CAPTIONS[name]
+    kind, _, structure = name.partition("_")
+    if kind == "corner":
+        return (f"Posterior of {structure}: marginal and pairwise distributions (log10 of "
+                "parameters with a log-uniform prior; contours hold 50 % and 90 %), with the "
+                "posterior mode and the least-squares optimum.")
+    if kind == "trace":
+        return (f"Walker traces of {structure} after burn-in: well-mixed walkers overlap and "
+                "show no trend.")
+    return name
+
+
+def _paths(value) -> list[Path]:
+    if isinstance(value, (str, Path)):
+        return [Path(value)]
+    return [Path(v) for v in value]
+
+
+def _figures_section(figures: dict) -> str:
+    parts = []
+    for name, value in figures.items():
+        paths = _paths(value)
+        png = next((p for p in paths if p.suffix.lower() == ".png"), None)
+        caption = _caption(name)
+        if png is None:
+            parts.append(f"<p class='small'>{_e(name)}: {_e(caption)} (not embedded: written as "
+                         f"{_e(', '.join(p.name for p in paths))})</p>")
+            continue
+        try:
+            data = png.read_bytes()
+        except OSError as exc:
+            raise InputError(f"argument 'figures': cannot read figure '{name}' from "
+                             f"'{png}': {exc.strerror}") from None
+        uri = "data:image/png;base64," + base64.b64encode(data).decode("ascii")
+        parts.append(f"<figure id='fig-{_e(name)}'><img src='{uri}' alt='{_e(caption)}'>"
+                     f"<figcaption><b>{_e(name)}</b>: {_e(caption)}</figcaption></figure>")
+    return "".join(parts)
+
+
+def render_report(comparison, figures: dict | None = None) -> str:
+    """The report of a comparison as one self-contained HTML document.
+
+    Parameters
+    ----------
+    comparison : bayesfo.compare.Comparison
+    figures : dict, optional
+        ``{figure name: path or list of paths}``, e.g. the result of
+        :func:`bayesfo.plotting.write_figures`; the PNG of each is embedded (figures without
+        a PNG are listed by file name). Names such as ``bode`` or ``corner_<structure>`` get
+        their captions.
+
+    Returns
+    -------
+    str
+        The HTML text.
+
+    Raises
+    ------
+    InputError
+        If a figure file cannot be read.
+
+    Examples
+    --------
+    >>> text = render_report(comparison)                    # doctest: +SKIP
+    >>> "report" in text                                     # doctest: +SKIP
+    True
+    """
+    title = f"bayesfo: which structure do the data '{comparison.data.label}' support?"
+    sentences = "".join(f"<p class='flag'>{_e(t)}</p>" if flagged else f"<p>{_e(t)}</p>"
+                        for t, flagged in verdict(comparison))
+    sections = [
+        f"<div class='verdict' id='verdict'>{sentences}</div>",
+        f"<h2 id='data'>Data</h2>{_data_section(comparison)}",
+        f"<h2 id='ranking'>Ranking</h2>{_ranking_table(comparison)}{_families(comparison)}",
+        f"<h2 id='priors'>Priors</h2>{_priors_section(comparison)}",
+        f"<h2 id='parameters'>Parameters</h2>{_parameters_section(comparison)}",
+        f"<h2 id='diagnostics'>Warnings and convergence</h2>{_diagnostics_section(comparison)}",
+    ]
+    if figures:
+        sections.append(f"<h2 id='figures'>Figures</h2>{_figures_section(figures)}")
+    from . import __version__
+
+    return (
+        "<!DOCTYPE html>\n<html lang='en'>\n<head>\n<meta charset='utf-8'>\n"
+        "<meta name='viewport' content='width=device-width, initial-scale=1'>\n"
+        f"<title>{_e(title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n"
+        f"<h1>{_e(title)}</h1>\n<p class='small'>bayesfo {_e(__version__)}, seed "
+        f"{_e(comparison.seed)}, ranked by {_e(comparison.ranked_by.replace('_', ' '))}.</p>\n"
+        + "\n".join(sections) + "\n</body>\n</html>\n"
+    )
+
+
+def write_report(comparison, out_dir, figures: dict | None = None) -> Path:
+    """Write ``report.html`` (see :func:`render_report`) into ``out_dir`` atomically.
+
+    Parameters
+    ----------
+    comparison : bayesfo.compare.Comparison
+    out_dir : str or path-like
+        Directory, created when missing.
+    figures : dict, optional
+        As for :func:`render_report`.
+
+    Returns
+    -------
+    Path
+        The path of the report.
+    """
+    text = render_report(comparison, figures)
+    return atomic_write_text(Path(out_dir) / "report.html", text)

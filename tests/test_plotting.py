@@ -1,0 +1,363 @@
+"""Figures of a comparison: what is drawn equals an independent computation from the results."""
+
+from __future__ import annotations
+
+import struct
+import warnings
+from dataclasses import replace
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
+from scipy.integrate import trapezoid  # noqa: E402
+
+from bayesfo.compare import PredictiveWarning, StructureResult, compare  # noqa: E402
+from bayesfo.data import FrequencyResponse  # noqa: E402
+from bayesfo.errors import InputError  # noqa: E402
+from bayesfo.inference._arviz import arviz  # noqa: E402
+from bayesfo.plotting import (  # noqa: E402
+    plot_bode,
+    plot_corner,
+    plot_nyquist,
+    plot_q_posteriors,
+    plot_ranking,
+    plot_residuals,
+    plot_trace,
+    write_figures,
+)
+from bayesfo.plotting.style import FLAG_COLOR  # noqa: E402
+from bayesfo.structures import get_structure  # noqa: E402
+
+W = np.logspace(-1, 3, 24)
+HOLDOUT = [W[5], W[15]]
+ALL = 10**6  # more than the stored draws: the bands use every draw
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    """Noisy fractional-Zener compliance (5 % noise, σ known), two frequencies held out."""
+    rng = np.random.default_rng(0)
+    g = get_structure("zener").response([1.0, 1e-3, 2e-4, 0.6], W, "compliance")
+    sd = 0.05 * np.abs(g)
+    noisy = g + sd / np.sqrt(2) * (rng.normal(size=W.size) + 1j * rng.normal(size=W.size))
+    data = FrequencyResponse(W, noisy, sd, kind="compliance", units="1/Pa", name="zener sim")
+    structures = [get_structure(n) for n in ("voigt", "zener", "zener-int")]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = compare(data, structures, seed=0, progress=False, holdout=HOLDOUT)
+    # The misspecified structures may get unreliable PSIS-LOO; nothing else may warn.
+    assert all(w.category is PredictiveWarning for w in caught), [str(w.message) for w in caught]
+    return result
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
+
+
+def _draws(result):
+    return result.posterior.samples[:, : result.structure.n_params]
+
+
+def test_bode_median_and_bands_equal_the_quantiles_of_the_draws(comparison):
+    drawn = plot_bode(comparison, n_draws=ALL)
+    omega = drawn.values["omega"]
+    w_all = np.r_[comparison.data.omega, comparison.holdout.omega]
+    assert omega[0] == pytest.approx(w_all.min()) and omega[-1] == pytest.approx(w_all.max())
+    assert np.allclose(np.diff(np.log(omega)), np.log(omega[1] / omega[0]))
+    assert [k.split("/")[0] for k in drawn.artists if k.endswith("/magnitude_median")] == \
+        comparison.ranking[:3]
+    for name in comparison.ranking:
+        r = comparison[name]
+        g = r.structure.response(_draws(r), omega, "compliance")
+        line = drawn.artists[f"{name}/magnitude_median"]
+        np.testing.assert_allclose(line.get_xdata(), omega)
+        np.testing.assert_allclose(line.get_ydata(), np.median(np.abs(g), axis=0), rtol=1e-12)
+        np.testing.assert_allclose(drawn.values[f"{name}/magnitude_q05"],
+                                   np.quantile(np.abs(g), 0.05, axis=0), rtol=1e-12)
+        np.testing.assert_allclose(drawn.values[f"{name}/magnitude_q75"],
+                                   np.quantile(np.abs(g), 0.75, axis=0), rtol=1e-12)
+        # A compliance has its phase in (−90°, 0°]: no unwrapping needed to compare.
+        phase = np.degrees(np.angle(g))
+        np.testing.assert_allclose(drawn.artists[f"{name}/phase_median"].get_ydata(),
+                                   np.median(phase, axis=0), atol=1e-9)
+        # The 90 % band drawn is the one between the 5 % and 95 % quantiles.
+        band = drawn.artists[f"{name}/magnitude_band90"].get_paths()[0].vertices
+        assert band[:, 1].min() == pytest.approx(np.quantile(np.abs(g), 0.05, axis=0).min())
+        assert band[:, 1].max() == pytest.approx(np.quantile(np.abs(g), 0.95, axis=0).max())
+
+
+def test_bode_default_thinning_stays_close_to_all_draws(comparison):
+    full = plot_bode(comparison, n_draws=ALL)
+    thin = plot_bode(comparison)
+    for name in comparison.ranking:
+        width = full.values[f"{name}/magnitude_q95"] - full.values[f"{name}/magnitude_q05"]
+        diff = np.abs(thin.values[f"{name}/magnitude_median"]
+                      - full.values[f"{name}/magnitude_median"])
+        assert np.all(diff <= 0.25 * width)
+    # Same seed, same figure; another seed, other draws.
+    again = plot_bode(comparison)
+    other = plot_bode(comparison, seed=5)
+    name = comparison.ranking[0]
+    key = f"{name}/magnitude_q95"
+    np.testing.assert_array_equal(thin.values[key], again.values[key])
+    assert not np.array_equal(thin.values[key], other.values[key])
+
+
+def test_bode_draws_the_data_and_the_held_out_points(comparison):
+    drawn = plot_bode(comparison, structures=["zener"])
+    data = comparison.data
+    order = np.argsort(data.omega)
+    line = drawn.artists["data/magnitude"].lines[0]
+    np.testing.assert_allclose(line.get_xdata(), data.omega[order])
+    np.testing.assert_allclose(line.get_ydata(), np.abs(data.response[order]))
+    # One-sd error bars: σ/√2 in |G| (segments from y − e to y + e).
+    segs = drawn.artists["data/magnitude"].lines[2][0].get_segments()
+    half = np.array([(s[1, 1] - s[0, 1]) / 2 for s in segs])
+    np.testing.assert_allclose(half, data.sigma[order] / np.sqrt(2), rtol=1e-12)
+    held = comparison.holdout
+    np.testing.assert_allclose(drawn.values["holdout/omega"], np.sort(held.omega))
+    np.testing.assert_allclose(drawn.values["holdout/magnitude"],
+                               np.abs(held.response[np.argsort(held.omega)]))
+    labels = [t.get_text() for t in drawn.figure.legends[0].get_texts()]
+    assert labels == ["zener", "data ± 1 sd", "held out"]
+    mag_ax, phase_ax = drawn.axes
+    assert mag_ax.get_xscale() == "log" and mag_ax.get_yscale() == "log"
+    assert mag_ax.get_ylabel().endswith("[1/Pa]") and "rad/s" in phase_ax.get_xlabel()
+    assert "deg" in phase_ax.get_ylabel()
+
+
+def test_structures_argument_is_checked(comparison):
+    with pytest.raises(InputError, match="'structures'.*'maxwell'.*voigt"):
+        plot_bode(comparison, structures=["maxwell"])
+    with pytest.raises(InputError, match="n_draws"):
+        plot_nyquist(comparison, n_draws=0)
+
+
+def test_nyquist_median_curve_and_data(comparison):
+    drawn = plot_nyquist(comparison, structures=["zener", "voigt"], n_draws=ALL, n_lines=10)
+    omega = drawn.values["omega"]
+    for name in ("zener", "voigt"):
+        r = comparison[name]
+        g = r.structure.response(_draws(r), omega, "compliance")
+        line = drawn.artists[f"{name}/median"]
+        np.testing.assert_allclose(line.get_xdata(), np.median(g.real, axis=0), rtol=1e-12)
+        np.testing.assert_allclose(line.get_ydata(), np.median(g.imag, axis=0), rtol=1e-12)
+        assert len(drawn.artists[f"{name}/draws"].get_segments()) == 10
+    pts = drawn.artists["data"].lines[0]
+    order = np.argsort(comparison.data.omega)
+    np.testing.assert_allclose(pts.get_xdata(), comparison.data.response.real[order])
+    np.testing.assert_allclose(pts.get_ydata(), comparison.data.response.imag[order])
+    assert drawn.axes[0].get_aspect() == 1.0
+
+
+def test_residuals_are_normalised_by_the_noise(comparison):
+    drawn = plot_residuals(comparison, n_draws=ALL)
+    data = comparison.data
+    order = np.argsort(data.omega)
+    w, g, s = data.omega[order], data.response[order], data.sigma[order] / np.sqrt(2)
+    for name in comparison.ranking:
+        r = comparison[name]
+        pred = r.structure.response(_draws(r), w, "compliance")
+        median = np.median(pred.real, axis=0) + 1j * np.median(pred.imag, axis=0)
+        np.testing.assert_allclose(drawn.artists[f"{name}/real"].get_ydata(),
+                                   (g - median).real / s, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(drawn.artists[f"{name}/imag"].get_ydata(),
+                                   (g - median).imag / s, rtol=1e-9, atol=1e-12)
+    # The structure that made the data leaves standard-normal residuals; the misspecified
+    # ones do not.
+    z = np.r_[drawn.values["zener/real"], drawn.values["zener/imag"]]
+    assert 0.4 < np.mean(z**2) < 2.0
+    v = np.r_[drawn.values["voigt/real"], drawn.values["voigt/imag"]]
+    assert np.mean(v**2) > 4.0
+    assert drawn.values["zener/holdout_real"].shape == (2,)
+
+
+def test_residuals_relative_without_sigma_and_on_one_axes(comparison):
+    data = replace(comparison.data, sigma=None)
+    no_sigma = replace(comparison, data=data, holdout=None)
+    fig, ax = plt.subplots()
+    drawn = plot_residuals(no_sigma, structures=["zener"], ax=ax, n_draws=ALL)
+    assert drawn.axes[0] is drawn.axes[1] is ax
+    pred = drawn.values["zener/prediction"]
+    g = data.response[np.argsort(data.omega)]
+    np.testing.assert_allclose(drawn.values["zener/real"], 100 * (g - pred).real / np.abs(g))
+    assert "%" in ax.get_ylabel()
+
+
+def test_q_densities_integrate_to_one_in_ranking_order(comparison):
+    drawn = plot_q_posteriors(comparison)
+    names = list(drawn.values["structures"])
+    # zener-int has no free order; the others keep the order of the ranking.
+    assert names == [n for n in comparison.ranking if n != "zener-int"]
+    for name in names:
+        grid = drawn.values[f"{name}/grid"]
+        dens = drawn.values[f"{name}/density"]
+        assert grid[0] == 0.0 and grid[-1] == 1.0  # the prior range of q
+        assert trapezoid(dens, grid) == pytest.approx(1.0, abs=0.01)
+        np.testing.assert_allclose(drawn.values[f"{name}/prior_density"], 1.0)
+        q = comparison[name].posterior.summary["q"]
+        assert abs(grid[np.argmax(dens)] - q.median) < 2 * q.sd
+        hdi = drawn.artists[f"{name}/hdi"].get_xdata()
+        np.testing.assert_allclose(hdi, [q.hdi_low, q.hdi_high])
+    baselines = [float(drawn.values[f"{n}/baseline"]) for n in names]
+    assert baselines == sorted(baselines, reverse=True)  # best on top
+
+
+def test_q_posteriors_show_a_poorly_determined_order(comparison):
+    # Draws of q spread over the prior, as for a high-order structure: the ridge is no higher
+    # than the prior line, and the label is flagged.
+    r = comparison["voigt"]
+    post = r.posterior
+    samples = post.samples.copy()
+    samples[:, post.param_names.index("q")] = np.random.default_rng(1).uniform(0, 1, len(samples))
+    q = replace(post.summary["q"], poorly_determined=True)
+    wide = StructureResult(r.structure, r.fit, replace(post, samples=samples,
+                                                       summary={**post.summary, "q": q}),
+                           r.criteria)
+    results = tuple(wide if x.name == "voigt" else x for x in comparison.results)
+    drawn = plot_q_posteriors(replace(comparison, results=results), ridge_height=0.8)
+    dens = drawn.values["voigt/density"]
+    prior_line = drawn.artists["voigt/prior"].get_ydata() - drawn.values["voigt/baseline"]
+    assert np.median(prior_line) > 0.8 * 0.8  # the prior reaches most of the ridge's height
+    assert dens.max() < 1.3  # against 1 for the prior
+    label = drawn.artists["voigt/label"]
+    assert "poorly determined" in label.get_text()
+    assert to_rgba(label.get_color()) == to_rgba(FLAG_COLOR)
+    sharp = drawn.artists["zener/prior"].get_ydata() - drawn.values["zener/baseline"]
+    assert np.max(sharp) < 0.1  # a well-determined order towers over its prior
+
+
+def test_q_posteriors_need_a_free_order(comparison):
+    only_int = replace(comparison, results=(comparison["zener-int"],))
+    with pytest.raises(InputError, match="fractional order"):
+        plot_q_posteriors(only_int)
+
+
+def test_ranking_bars_equal_the_table(comparison):
+    drawn = plot_ranking(comparison)
+    table = comparison.table()
+    assert list(drawn.values["structures"]) == [row["structure"] for row in table]
+    for row, y in zip(table, drawn.values["y"]):
+        cont = drawn.artists[f"{row['structure']}/log_evidence"]
+        assert cont.lines[0].get_xdata()[0] == pytest.approx(row["delta_log_evidence"], abs=1e-12)
+        assert cont.lines[0].get_ydata()[0] == y
+    np.testing.assert_allclose(drawn.values["log_evidence_err"],
+                               [row["log_evidence_err"] for row in table])
+    best_bic = min(row["bic"] for row in table)
+    np.testing.assert_allclose(drawn.values["delta_bic_half"],
+                               [-(row["bic"] - best_bic) / 2 for row in table])
+    loo = drawn.artists["delta_loo"].lines[0]
+    np.testing.assert_allclose(loo.get_xdata(), [row["delta_loo"] for row in table])
+    right = drawn.axes[0].figure.axes[-1]
+    p_labels = [t.get_text() for t in right.get_yticklabels()]
+    assert p_labels[0] == f"P = {table[0]['posterior_probability']:.3f}"
+
+
+def test_ranking_loo_error_is_that_of_the_difference(comparison):
+    drawn = plot_ranking(comparison)
+    idata = {n: comparison[n].posterior.idata for n in comparison.ranking}
+    with warnings.catch_warnings():
+        # arviz repeats the Pareto-k warnings that compare() already turned into flags, and
+        # its use of pandas is deprecated upstream.
+        warnings.filterwarnings("ignore", message="Estimated shape parameter of Pareto")
+        warnings.filterwarnings("ignore", message="The inplace keyword")
+        ref = arviz().compare(idata, ic="loo")
+    for name, se in zip(drawn.values["structures"], drawn.values["delta_loo_se"]):
+        assert se == pytest.approx(float(ref.loc[name, "dse"]), rel=1e-6, abs=1e-9)
+
+
+def test_ranking_flags_a_posterior_that_did_not_converge(comparison):
+    bad = comparison["zener"]
+    flagged = StructureResult(bad.structure, bad.fit, replace(bad.posterior, converged=False),
+                              bad.criteria)
+    results = tuple(flagged if r.name == "zener" else r for r in comparison.results)
+    drawn = plot_ranking(replace(comparison, results=results))
+    ticks = {t.get_text(): t for t in drawn.axes[0].get_yticklabels()}
+    assert "zener\nnot converged" in ticks
+    assert to_rgba(ticks["zener\nnot converged"].get_color()) == to_rgba(FLAG_COLOR)
+    assert to_rgba(ticks["voigt"].get_color()) != to_rgba(FLAG_COLOR)
+
+
+def test_corner_marks_the_mode_and_the_optimum(comparison):
+    r = comparison["zener"]
+    drawn = plot_corner(r)
+    names = r.posterior.param_names
+    ndim = len(names)
+    assert len(drawn.axes) == ndim * ndim
+    log = np.array([r.criteria["priors"][n]["prior"] == "log-uniform" for n in names])
+    coords = np.where(log, np.log10(r.posterior.samples), r.posterior.samples)
+    np.testing.assert_allclose(drawn.values["samples"] * drawn.values["factor"], coords)
+    expected_map = np.where(log, np.log10(r.posterior.map_theta), r.posterior.map_theta)
+    np.testing.assert_allclose(drawn.values["map"] * drawn.values["factor"], expected_map)
+    expected_fit = np.where(log, np.log10(r.fit.theta), r.fit.theta)
+    np.testing.assert_allclose(drawn.values["fit"] * drawn.values["factor"], expected_fit)
+    for i in range(ndim):
+        diag = drawn.axes[i * ndim + i]
+        xs = {round(float(line.get_xdata()[0]), 12) for line in diag.lines}
+        assert round(float(drawn.values["map"][i]), 12) in xs
+        counts, _ = np.histogram(drawn.values["samples"][:, i], bins=30,
+                                 range=tuple(drawn.values["range"][i]))
+        heights = np.concatenate([p.get_xy()[:, 1] for p in diag.patches])
+        assert heights.max() == counts.max()
+    labels = [t.get_text() for t in drawn.artists["legend"].get_texts()]
+    assert labels == ["posterior mode (MAP draw)", "least-squares optimum"]
+    assert drawn.axes[ndim * (ndim - 1)].get_xlabel().startswith("log$_{10}$")
+    with pytest.raises(InputError, match="'fig'.*layout"):
+        plot_corner(r, fig=plt.figure(layout="constrained"))
+
+
+def test_trace_shows_every_walker(comparison):
+    r = comparison["voigt"]
+    drawn = plot_trace(r)
+    post = r.posterior
+    n_kept = post.samples.shape[0] // post.n_walkers
+    for j, name in enumerate(post.param_names):
+        walkers = post.samples[:, j].reshape(post.n_walkers, n_kept)  # walker-major draws
+        np.testing.assert_allclose(drawn.values[name], walkers)
+        lines = drawn.artists[name]
+        assert len(lines) == post.n_walkers
+        shown = np.log10(walkers[3]) if name in ("a1", "b0") else walkers[3]
+        label = drawn.axes[j].get_ylabel()
+        factor = 1.0 if "×" not in label else 10.0 ** int(label.split("{")[-1].split("}")[0])
+        np.testing.assert_allclose(lines[3].get_ydata() * factor, shown, rtol=1e-12)
+    assert len(drawn.axes) == len(post.param_names) + 1  # and the log posterior
+
+
+def _png_size(path):
+    head = path.read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", head[16:24])
+
+
+def test_write_figures_skips_failed_structures_and_closes_figures(comparison, tmp_path):
+    failed = StructureResult(get_structure("maxwell"), error="could not be run (test)")
+    with_failure = replace(comparison, results=comparison.results + (failed,))
+    before = plt.get_fignums()
+    written = write_figures(with_failure, tmp_path, formats=("png",))
+    assert plt.get_fignums() == before
+    expected = ["ranking", "bode", "nyquist", "residuals", "q_posteriors"]
+    for name in comparison.ranking:
+        expected += [f"corner_{name}", f"trace_{name}"]
+    assert list(written) == expected
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{n}.png" for n in expected)
+    width, height = _png_size(written["bode"][0])
+    assert width == 700  # 3.5 in at 200 dpi: one journal column
+    assert width < height
+
+
+def test_write_figures_single_structure_and_formats(comparison, tmp_path):
+    single = replace(comparison, results=(comparison["zener-int"],))
+    written = write_figures(single, tmp_path, formats=("png", "svg"))
+    # No free order: no q figure.
+    assert list(written) == ["ranking", "bode", "nyquist", "residuals", "corner_zener-int",
+                             "trace_zener-int"]
+    assert all([p.suffix for p in paths] == [".png", ".svg"] for paths in written.values())
+    with pytest.raises(InputError, match="'formats'.*'xyz'"):
+        write_figures(single, tmp_path, formats=("png", "xyz"))

@@ -1,0 +1,208 @@
+"""The HTML report: verdict, numbers, embedded figures, escaping, no external resources."""
+
+from __future__ import annotations
+
+import base64
+import math
+import re
+import subprocess
+import sys
+import warnings
+from dataclasses import replace
+from html.parser import HTMLParser
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from bayesfo.compare import PredictiveWarning, StructureResult, compare  # noqa: E402
+from bayesfo.data import FrequencyResponse  # noqa: E402
+from bayesfo.plotting import plot_bode, plot_ranking, save_figure  # noqa: E402
+from bayesfo.report import render_report, verdict, write_report  # noqa: E402
+from bayesfo.structures import get_structure  # noqa: E402
+
+W = np.logspace(-1, 2.5, 20)
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    """Fractional Voigt compliance with 3 % noise (σ known); Voigt, Zener and the integer
+    Voigt compared."""
+    rng = np.random.default_rng(3)
+    g = get_structure("voigt").response([1.0, 1e-3, 0.5], W, "compliance")
+    sd = 0.03 * np.abs(g)
+    noisy = g + sd / np.sqrt(2) * (rng.normal(size=W.size) + 1j * rng.normal(size=W.size))
+    data = FrequencyResponse(W, noisy, sd, kind="compliance", units="1/Pa",
+                             name="voigt sim", source="sim/voigt.csv")
+    structures = [get_structure(n) for n in ("voigt", "zener", "voigt-int")]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = compare(data, structures, seed=2, progress=False)
+    assert all(w.category is PredictiveWarning for w in caught), [str(w.message) for w in caught]
+    return result
+
+
+@pytest.fixture(scope="module")
+def figures(comparison, tmp_path_factory):
+    out = tmp_path_factory.mktemp("figures")
+    paths = {}
+    for name, drawn in (("ranking", plot_ranking(comparison)),
+                        ("bode", plot_bode(comparison))):
+        paths[name] = [out / f"{name}.png", out / f"{name}.pdf"]
+        for p in paths[name]:
+            save_figure(drawn.figure, p)
+        plt.close(drawn.figure)
+    return paths
+
+
+class _Cells(HTMLParser):
+    """Rows of the tables by their id: ``{row id: [(text, data-value or None), ...]}``."""
+
+    def __init__(self):
+        super().__init__()
+        self.rows, self._row, self._cell = {}, None, None
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "tr" and attrs.get("id"):
+            self._row = attrs["id"]
+            self.rows[self._row] = []
+        elif tag == "td" and self._row is not None:
+            self._cell = ["", attrs.get("data-value")]
+
+    def handle_endtag(self, tag):
+        if tag == "td" and self._cell is not None:
+            self.rows[self._row].append(tuple(self._cell))
+            self._cell = None
+        elif tag == "tr":
+            self._row = None
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell[0] += data
+
+
+def _verdict_text(text: str) -> str:
+    block = re.search(r"<div class='verdict' id='verdict'>(.*?)</div>", text, re.S).group(1)
+    return re.sub(r"<[^>]+>", " ", block)
+
+
+def test_verdict_names_the_structure_with_the_highest_evidence(comparison):
+    z = {r.name: r.criteria["evidence"].log_z for r in comparison.results}
+    best = max(z, key=z.get)
+    second = sorted(z, key=z.get)[-2]
+    sentences = verdict(comparison)
+    first = sentences[0][0]
+    assert first.startswith(f"{best} is the best-supported structure")
+    assert f"runner-up, {second}," in first
+    assert f"Δln Z = {z[best] - z[second]:.2f}" in first
+    p = comparison[best].criteria["posterior_probability"]
+    assert (f"{p:.3f}" if p >= 0.001 else "< 0.001") in first
+    q = comparison[best].posterior.summary["q"]
+    digits = 1 - math.floor(math.log10(q.sd))
+    assert any(f"q = {q.mean:.{digits}f} (sd {q.sd:.2g}, 94 % HDI {q.hdi_low:.{digits}f}–"
+               f"{q.hdi_high:.{digits}f})" in t for t, _ in sentences)
+    html = render_report(comparison)
+    assert html.index("id='verdict'") < html.index("id='data'") < html.index("id='ranking'")
+    assert f"{best} is the best-supported structure" in _verdict_text(html)
+
+
+def test_verdict_says_whether_the_criteria_agree(comparison):
+    best = comparison.table()[0]
+    ranks = [best[f"rank_{c}"] for c in ("loo", "waic", "aic", "bic")]
+    text = " ".join(t for t, _ in verdict(comparison))
+    if ranks == [1, 1, 1, 1]:
+        assert "The information criteria agree" in text
+    else:
+        assert "prefer" in text
+
+
+def test_ranking_table_numbers_match_the_comparison(comparison):
+    parser = _Cells()
+    parser.feed(render_report(comparison))
+    table = comparison.table()
+    columns = {"log_evidence": 3, "log_evidence_err": 4, "delta_log_evidence": 5,
+               "posterior_probability": 6, "loo": 7, "loo_se": 8, "waic": 9, "aic": 10,
+               "bic": 11, "rmse": 12, "rhat_max": 14}
+    for rank, row in enumerate(table, start=1):
+        cells = parser.rows[f"row-{row['structure']}"]
+        assert cells[0][0] == str(rank) and cells[1][0] == row["structure"]
+        assert cells[2][0] == str(row["n_params"])
+        for key, i in columns.items():
+            text, value = cells[i]
+            assert float(value) == row[key], key
+            if key in ("log_evidence", "loo", "bic"):
+                assert text == f"{row[key]:.2f}"
+        assert cells[-1][0] == ("yes" if row["converged"] else "NO")
+
+
+def test_parameter_summaries_and_priors_are_listed(comparison):
+    text = render_report(comparison)
+    for r in comparison.results:
+        assert f"<h3>{r.name}</h3>" in text
+        for name, s in r.posterior.summary.items():
+            assert f'data-value="{float(s.mean)!r}">{s.mean:.4g}<' in text
+        assert r.structure.formula in text
+    assert "log-uniform" in text and "[0, 1]" in text  # the prior of q
+    assert "known: the data give sigma per point" in text
+    assert "sim/voigt.csv" in text and "1/Pa" in text
+
+
+def test_figures_are_embedded_and_nothing_is_external(comparison, figures):
+    text = render_report(comparison, figures)
+    uris = re.findall(r"<img src='data:image/png;base64,([A-Za-z0-9+/=]+)'", text)
+    assert len(uris) == 2
+    assert base64.b64decode(uris[1]) == figures["bode"][0].read_bytes()
+    assert "Magnitude and phase of the data" in text
+    # No resource from elsewhere: every src/href is a data URI, no scripts or style links.
+    assert not re.search(r"(?:src|href)\s*=\s*['\"](?!data:)", text)
+    assert not re.search(r"https?://", text)
+    assert "<script" not in text and "<link" not in text
+
+
+def test_text_is_escaped(comparison):
+    data = replace(comparison.data, name="<b>bold & 'quoted'</b>")
+    text = render_report(replace(comparison, data=data))
+    assert "<b>bold" not in text
+    assert "&lt;b&gt;bold &amp; &#x27;quoted&#x27;&lt;/b&gt;" in text
+
+
+def test_flags_poor_order_non_convergence_and_failures(comparison):
+    best = comparison.ranking[0]
+    r = comparison[best]
+    q = replace(r.posterior.summary["q"], poorly_determined=True)
+    post = replace(r.posterior, summary={**r.posterior.summary, "q": q}, converged=False)
+    flagged = StructureResult(r.structure, r.fit, post, r.criteria)
+    failed = StructureResult(get_structure("maxwell"), error="nothing admissible (test)")
+    results = tuple(flagged if x.name == best else x for x in comparison.results) + (failed,)
+    sentences = verdict(replace(comparison, results=results))
+    flagged_text = " ".join(t for t, f in sentences if f)
+    assert "poorly determined" in flagged_text
+    assert f"Caution: the posterior of {best} did not converge" in flagged_text
+    assert "maxwell (nothing admissible (test))" in flagged_text
+    text = render_report(replace(comparison, results=results))
+    assert "failed: nothing admissible (test)" in text
+
+
+def test_write_report_is_atomic_and_complete(comparison, figures, tmp_path):
+    path = write_report(comparison, tmp_path / "out", figures)
+    assert path == tmp_path / "out" / "report.html"
+    assert path.read_text(encoding="utf-8") == render_report(comparison, figures)
+    assert [p.name for p in path.parent.iterdir()] == ["report.html"]
+
+
+def test_report_module_does_not_import_matplotlib():
+    code = "import sys, bayesfo.report; sys.exit(int('matplotlib' in sys.modules))"
+    assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
+
+
+def test_bayes_factor_wording():
+    from bayesfo.report import _bayes_factor, _strength
+
+    assert _strength(0.5).startswith("not worth") and _strength(2.0) == "positive"
+    assert _strength(4.0) == "strong" and _strength(7.0) == "very strong"
+    assert _bayes_factor(1.0) == f"{math.e:.3g}" and _bayes_factor(1431.3) == "about 10^622"

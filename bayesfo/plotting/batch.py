@@ -1,0 +1,206 @@
+"""Figures of a batch of comparisons (``bayesfo batch``).
+
+Both functions take the rows of ``batch_summary.csv`` / ``temperature_summary.csv`` as plain
+dicts (see :mod:`bayesfo.batch`), draw on a new :class:`matplotlib.figure.Figure` (no pyplot
+state) unless ``fig=`` is given, and return the figure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+HDI_LABEL = "94 % HDI"
+
+
+def _structure_colours(names):
+    from matplotlib import colormaps
+
+    cmap = colormaps["tab10"]
+    return {name: cmap(i % 10) for i, name in enumerate(names)}
+
+
+def _figure(fig, width, height):
+    if fig is not None:
+        fig.clear()
+        return fig
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width, height), layout="constrained")
+
+
+def _structures_in_order(rows):
+    names = []
+    for r in rows:
+        name = r.get("structure")
+        if name and name not in names and r.get("rank") is not None:
+            names.append(name)
+    return names
+
+
+def _has_q(row) -> bool:
+    return all(row.get(k) is not None for k in ("q_mean", "q_hdi_low", "q_hdi_high"))
+
+
+def _q_errorbar(ax, x, rows, colour, filled_mask, marker="o"):
+    """q means with HDI bars; filled markers where ``filled_mask`` (the best structure)."""
+    mean = np.array([r["q_mean"] for r in rows], dtype=float)
+    low = np.array([r["q_hdi_low"] for r in rows], dtype=float)
+    high = np.array([r["q_hdi_high"] for r in rows], dtype=float)
+    yerr = np.vstack([np.clip(mean - low, 0, None), np.clip(high - mean, 0, None)])
+    ax.errorbar(x, mean, yerr=yerr, fmt="none", ecolor=colour, elinewidth=1.2, capsize=2.5)
+    filled = np.asarray(filled_mask, dtype=bool)
+    ax.plot(x[filled], mean[filled], marker, color=colour, markersize=6, linestyle="none")
+    ax.plot(x[~filled], mean[~filled], marker, markerfacecolor="white", color=colour,
+            markersize=6, linestyle="none")
+
+
+def _q_legend(ax, labels, colours, **kwargs):
+    """One entry per structure, and what filled and hollow markers mean."""
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], marker="o", color=c, linestyle="none", markersize=6)
+               for c in colours]
+    handles += [Line2D([], [], marker="o", color="0.3", linestyle="none", markersize=6),
+                Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
+                       linestyle="none", markersize=6)]
+    ax.legend(handles, [*labels, "best structure", "not the best"], frameon=False, **kwargs)
+
+
+def plot_batch_summary(rows, fig=None):
+    """Best structure and posterior q per data set.
+
+    Top: the posterior model probabilities of the structures on each data set, stacked (equal
+    prior odds; the name of the best structure above each bar). Bottom: the posterior mean of
+    q (``beta`` for the generalised Maxwell model) with its 94 % HDI for every fractional
+    structure, filled where the structure is the best on that data set. Data sets that failed
+    are marked on the axis.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Rows of ``batch_summary.csv`` (:attr:`bayesfo.batch.BatchResult.rows`).
+    fig : matplotlib Figure, optional
+        Drawn on (cleared first); default: a new figure sized for the number of data sets.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        With two axes: probabilities, then q.
+    """
+    rows = list(rows)
+    datasets = list(dict.fromkeys(r["dataset"] for r in rows))
+    failed = {r["dataset"] for r in rows if r.get("status") != "ok"}
+    structures = _structures_in_order(rows)
+    colours = _structure_colours(structures)
+    n = len(datasets)
+    fig = _figure(fig, min(max(6.0, 0.5 * n + 2.5), 30.0), 6.0)
+    ax_p, ax_q = fig.subplots(2, 1, sharex=True, height_ratios=[1, 1.4])
+    x = np.arange(n, dtype=float)
+    index = {d: i for i, d in enumerate(datasets)}
+
+    bottom = np.zeros(n)
+    for name in structures:
+        p = np.zeros(n)
+        for r in rows:
+            if r.get("structure") == name and r.get("posterior_probability") is not None:
+                p[index[r["dataset"]]] = r["posterior_probability"]
+        ax_p.bar(x, p, bottom=bottom, color=colours[name], width=0.75, label=name)
+        bottom += p
+    for r in rows:
+        if r.get("best"):
+            ax_p.annotate(r["structure"], (index[r["dataset"]], 1.0), xytext=(0, 3),
+                          textcoords="offset points", ha="center", va="bottom", fontsize=7,
+                          rotation=90 if n > 8 else 0)
+    for d in failed:
+        ax_p.annotate("failed", (index[d], 0.5), ha="center", va="center", fontsize=7,
+                      color="tab:red", rotation=90)
+    ax_p.set_ylim(0, 1.3 if n > 8 else 1.15)
+    ax_p.set_yticks([0, 0.5, 1])
+    ax_p.set_ylabel("posterior probability")
+    ax_p.set_title("Best structure (equal prior odds) and posterior of q per data set",
+                   fontsize=10)
+
+    with_q = [s for s in structures if any(r.get("structure") == s and _has_q(r) for r in rows)]
+    width = 0.6
+    offsets = (np.linspace(-width / 2, width / 2, len(with_q)) if len(with_q) > 1
+               else np.zeros(len(with_q)))
+    labels = []
+    for name, off in zip(with_q, offsets):
+        sel = [r for r in rows if r.get("structure") == name and _has_q(r)]
+        xs = np.array([index[r["dataset"]] + off for r in sel])
+        qname = sel[0].get("q_parameter") or "q"
+        labels.append(name if qname == "q" else f"{name} ({qname})")
+        _q_errorbar(ax_q, xs, sel, colours[name], [bool(r.get("best")) for r in sel])
+    ax_q.set_ylabel(f"q: posterior mean, {HDI_LABEL}")
+    ax_q.set_xticks(x)
+    ax_q.set_xticklabels([d + (" (failed)" if d in failed else "") for d in datasets],
+                         rotation=45 if n > 4 else 0, ha="right" if n > 4 else "center",
+                         fontsize=8)
+    for label, d in zip(ax_q.get_xticklabels(), datasets):
+        if d in failed:
+            label.set_color("tab:red")
+    handles = [ax_p.containers[i] for i in range(len(structures))]
+    fig.legend(handles, structures, loc="outside right upper", fontsize=8, frameon=False,
+               title="structure", title_fontsize=8)
+    if with_q:
+        _q_legend(ax_q, labels, [colours[s] for s in with_q], fontsize=7, loc="best")
+    ax_q.set_xlim(-0.7, n - 0.3)
+    return fig
+
+
+def plot_q_temperature(rows, fig=None):
+    """Posterior q against temperature per structure, and the best structure per temperature.
+
+    Top: the posterior mean of q (``beta`` for the generalised Maxwell model) with its 94 % HDI
+    against temperature, one colour per structure, filled where the structure is the best at
+    that temperature. Bottom: the posterior probability of each structure against temperature
+    (equal prior odds), so the best structure per temperature is the top curve.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Rows of ``temperature_summary.csv`` (:func:`bayesfo.batch.temperature_rows`).
+    fig : matplotlib Figure, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        With two axes: q, then probabilities.
+    """
+    rows = [r for r in rows if r.get("temperature_C") is not None]
+    structures = _structures_in_order(rows)
+    colours = _structure_colours(structures)
+    fig = _figure(fig, 6.5, 6.0)
+    ax_q, ax_p = fig.subplots(2, 1, sharex=True, height_ratios=[1.6, 1])
+    temps = sorted({float(r["temperature_C"]) for r in rows})
+    span = (temps[-1] - temps[0]) if len(temps) > 1 else 1.0
+    with_q = [s for s in structures if any(r.get("structure") == s and _has_q(r) for r in rows)]
+    offsets = (np.linspace(-0.006, 0.006, len(with_q)) * span if len(with_q) > 1
+               else np.zeros(len(with_q)))
+    labels = []
+    for name, off in zip(with_q, offsets):
+        sel = sorted((r for r in rows if r.get("structure") == name and _has_q(r)),
+                     key=lambda r: r["temperature_C"])
+        t = np.array([float(r["temperature_C"]) for r in sel]) + off
+        ax_q.plot(t, [r["q_mean"] for r in sel], "-", color=colours[name], linewidth=0.8,
+                  alpha=0.6)
+        qname = sel[0].get("q_parameter") or "q"
+        labels.append(name if qname == "q" else f"{name} ({qname})")
+        _q_errorbar(ax_q, t, sel, colours[name], [bool(r.get("best")) for r in sel])
+    ax_q.set_ylabel(f"q: posterior mean, {HDI_LABEL}")
+    if with_q:
+        _q_legend(ax_q, labels, [colours[s] for s in with_q], fontsize=8, loc="best")
+    ax_q.set_title("Posterior of the fractional order against temperature", fontsize=10)
+
+    for name in structures:
+        sel = sorted((r for r in rows if r.get("structure") == name
+                      and r.get("posterior_probability") is not None),
+                     key=lambda r: r["temperature_C"])
+        if sel:
+            ax_p.plot([r["temperature_C"] for r in sel], [r["posterior_probability"] for r in sel],
+                      "o-", color=colours[name], markersize=4, linewidth=1, label=name)
+    ax_p.set_ylim(-0.05, 1.05)
+    ax_p.set_ylabel("posterior probability")
+    ax_p.set_xlabel("temperature [°C]")
+    ax_p.legend(fontsize=8, frameon=False, ncols=min(len(structures), 3) or 1)
+    return fig

@@ -1,0 +1,391 @@
+"""bayesfo batch: inputs and manifests, failures, resume, executors, temperature series.
+
+The comparisons run on two bundled adhesive isotherms (17 frequencies, voigt and zener) and one
+broken file; the reference run is in-process, and the process pool and the Dask cluster must
+give the same numbers bit for bit.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bayesfo import batch
+from bayesfo.batch import (DataSet, add_parser, cmd_batch, expand_inputs, parse_temperature,
+                           run_batch, temperature_from_stem, temperature_of_file)
+from bayesfo.errors import InputError
+
+ADHESIVE = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp"
+NREL = Path(__file__).parents[1] / "examples" / "data" / "nrel_dma_master.csv"
+STRUCTURES = "voigt,zener"
+GOOD = ("Tm010C", "Tp150C")
+BAD_TEXT = "omega,real,imag\n1,2,3\n2,x,4\n"
+
+
+def _read_csv(path) -> list[dict]:
+    with open(path, newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _numbers(rows) -> dict:
+    """ln Z, its error, q and the criteria of every (data set, structure), as stored."""
+    keys = ("log_evidence", "log_evidence_err", "posterior_probability", "q_mean", "q_sd",
+            "q_hdi_low", "q_hdi_high", "loo", "bic", "rmse")
+    return {(r["dataset"], r["structure"]): tuple(r[k] for k in keys)
+            for r in rows if r["status"] == "ok"}
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("inputs")
+    for name in GOOD:
+        shutil.copy(ADHESIVE / f"{name}.csv", d / f"{name}.csv")
+    (d / "broken.csv").write_text(BAD_TEXT, encoding="utf-8")
+    return d
+
+
+@pytest.fixture(scope="module")
+def reference(inputs, tmp_path_factory):
+    """The in-process run (workers=1) of the two isotherms and the broken file."""
+    out = tmp_path_factory.mktemp("reference")
+    datasets = expand_inputs([inputs], options={"structures": STRUCTURES}, seed=3)
+    result = run_batch(datasets, out, workers=1, progress=False)
+    return datasets, result, out
+
+
+def _parser():
+    from bayesfo.cli import _Parser
+
+    parser = _Parser(prog="bayesfo")
+    parser.add_argument("--models", action="append", default=[])
+    add_parser(parser.add_subparsers(dest="command", parser_class=_Parser))
+    return parser
+
+
+def _run_cli(capsys, *argv):
+    """``bayesfo batch ...`` in-process: through bayesfo.cli once it registers the command,
+    else through a parser built here; returns (status, stdout, stderr)."""
+    from bayesfo import cli
+
+    argv = [str(a) for a in argv]
+    if "batch" in getattr(cli, "COMMANDS", {}):
+        status = cli.main(argv)
+    else:
+        try:
+            status = cmd_batch(_parser().parse_args(argv))
+        except InputError as exc:
+            print(f"bayesfo: error: {exc}", file=sys.stderr)
+            status = 2
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+# ---------------------------------------------------------------------- inputs
+def test_inputs_files_directories_globs_and_clashing_stems(tmp_path):
+    for sub in ("run1", "run2"):
+        (tmp_path / sub).mkdir()
+        shutil.copy(ADHESIVE / "Tp020C.csv", tmp_path / sub / "Tp020C.csv")
+    shutil.copy(ADHESIVE / "Tm010C.csv", tmp_path / "run2" / "Tm010C.csv")
+    (tmp_path / "other").mkdir()
+    shutil.copy(ADHESIVE / "Tp100C.csv", tmp_path / "other" / "sample.csv")
+    shutil.copy(ADHESIVE / "Tp100C.csv", tmp_path / "other" / "tp020c.csv")
+
+    datasets = expand_inputs(
+        [tmp_path / "run1", str(tmp_path / "run2" / "*.csv"), tmp_path / "other" / "sample.csv",
+         tmp_path / "run2" / "Tm010C.csv"],  # named twice: counted once
+        options={"structures": STRUCTURES})
+    assert [d.id for d in datasets] == ["run1-Tp020C", "Tm010C", "run2-Tp020C", "sample"]
+    assert [d.temperature for d in datasets] == [20.0, -10.0, 20.0, 100.0]  # stem; name comment
+    assert all(d.options["structures"] == ("voigt", "zener") and d.seed == 0 for d in datasets)
+
+    # Stems that differ only in case clash too (case-insensitive file systems).
+    ids = [d.id for d in expand_inputs([tmp_path / "run1" / "Tp020C.csv",
+                                        tmp_path / "other" / "tp020c.csv"])]
+    assert ids == ["run1-Tp020C", "other-tp020c"]
+    # The same file with other options: numbered.
+    again = expand_inputs([tmp_path / "run1" / "Tp020C.csv"], options={"kind": "generic"})
+    assert again[0].id == "Tp020C" and again[0].options["kind"] == "generic"
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda p: [p / "missing.csv"], "INPUT '.*missing.csv': no such file or directory"),
+    (lambda p: [str(p / "*.nothing")], "matches no file"),
+    (lambda p: [p], "directory holds no .csv data file"),
+    (lambda p: [], "no data set"),
+])
+def test_inputs_that_name_nothing_are_errors(tmp_path, make, message):
+    with pytest.raises(InputError, match=message):
+        expand_inputs(make(tmp_path))
+
+
+def test_bad_options_are_errors_before_any_work(tmp_path):
+    shutil.copy(ADHESIVE / "Tp020C.csv", tmp_path / "a.csv")
+    with pytest.raises(InputError, match="unknown structure 'voigtt'"):
+        expand_inputs([tmp_path], options={"structures": "voigtt"})
+    with pytest.raises(InputError, match="prior 'alpha' names a parameter no selected structure"):
+        expand_inputs([tmp_path], options={"structures": "voigt", "priors": ["alpha=uniform:0:1"]})
+    with pytest.raises(InputError, match="--seed: the seed must be a non-negative integer"):
+        expand_inputs([tmp_path], seed=-1)
+    ds = expand_inputs([tmp_path])
+    with pytest.raises(InputError, match="--workers applies to local processes"):
+        run_batch(ds, tmp_path / "out", workers=2, scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(InputError, match="--workers must be a positive integer"):
+        run_batch(ds, tmp_path / "out", workers=0)
+
+
+def _manifest(tmp_path, text, name="manifest.csv"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_manifest_with_per_file_options(tmp_path):
+    data = tmp_path / "data"
+    data.mkdir()
+    for name in ("Tp020C", "Tm010C"):
+        shutil.copy(ADHESIVE / f"{name}.csv", data / f"{name}.csv")
+    m = _manifest(tmp_path, (
+        "# per-file options; empty cells take the command line's values\n"
+        "path,id,kind,invert,structures,seed,temperature,prior,holdout\n"
+        "data/Tp020C.csv,warm,,yes,\"voigt,zener-inv\",7,293.15 K,q=uniform:0.2:1,1.2;10\n"
+        "data/Tm010C.csv,,generic,,,,,,\n"
+        "data/Tm010C.csv,,,,,,,,\n"))
+    defaults = {"structures": "zener", "priors": ["sigma_rel=log-uniform:1e-4:0.1"]}
+    datasets = expand_inputs([m], options=defaults, seed=1)
+    a, b, c = datasets
+    assert (a.id, a.seed, a.temperature) == ("warm", 7, 20.0)
+    assert a.options["reciprocal"] is True and a.options["structures"] == ("voigt", "zener-inv")
+    assert a.options["priors"] == ("q=uniform:0.2:1",) and a.options["holdout"] == (1.2, 10.0)
+    assert a.options["kind"] is None
+    assert (b.options["kind"], b.seed, b.temperature) == ("generic", 1, -10.0)  # stem
+    assert b.options["structures"] == ("zener",)
+    assert b.options["priors"] == ("sigma_rel=log-uniform:1e-4:0.1",)
+    assert c.options["kind"] is None
+    # The same file twice with different options: distinct ids, stable from run to run.
+    assert (b.id, c.id) == ("Tm010C-1", "Tm010C-2")
+    assert [d.id for d in expand_inputs([], manifests=[m], options={"structures": "zener"})] == \
+        ["warm", "Tm010C-1", "Tm010C-2"]
+
+
+@pytest.mark.parametrize("text, message", [
+    ("path,colour\na.csv,red\n", r"line 1: unknown column 'colour'"),
+    ("kind\nmodulus\n", r"line 1: no 'path' column"),
+    ("# c\npath,kind\na.csv,modulus,extra\n", r"line 3: expected 2 cells as in the header, got 3"),
+    ("path,kind\na.csv,stress\n", r"line 2, column 'kind': kind must be one of"),
+    ("path,invert\na.csv,maybe\n", r"line 2, column 'invert': expected true or false"),
+    ("path,seed\na.csv,1.5\n", r"line 2, column 'seed': the seed must be an integer"),
+    ("path,temperature\na.csv,warm\n", r"line 2, column 'temperature': expected a temperature"),
+    ("path\nmissing.csv\n", r"line 2, column 'path': file '.*missing.csv' does not exist"),
+    ("path,structures\na.csv,zenner\n", r"line 2: unknown structure 'zenner'"),
+    ("path,holdout\na.csv,1;x\n", r"line 2, column 'holdout': expected numbers"),
+    ("path,id\na.csv,x/y\n", r"line 2, column 'id': an id may hold only"),
+    ("path,id,seed\na.csv,same,1\na.csv,same,2\n",
+     r"line 3, column 'id': the id 'same' is already used"),
+    ("path\n", r"line 1: a header but no data sets"),
+])
+def test_bad_manifests_name_file_line_and_column(tmp_path, text, message):
+    shutil.copy(ADHESIVE / "Tp020C.csv", tmp_path / "a.csv")
+    m = _manifest(tmp_path, text, "runs.csv")
+    with pytest.raises(InputError, match=r"manifest '.*runs.csv'.*" + message):
+        expand_inputs([], manifests=[m], options={"structures": STRUCTURES})
+
+
+# ---------------------------------------------------------------------- temperatures
+def test_temperatures_from_comments_stems_and_names(tmp_path):
+    assert [temperature_from_stem(s) for s in ("Tm010C", "Tp020C", "T020C", "run_T20p5C",
+                                               "T-5C", "Test", "sample3")] == \
+        [-10.0, 20.0, 20.0, 20.5, -5.0, None, None]
+    assert [parse_temperature(s) for s in ("20", "-10 °C", "20 C", "293.15 K", "\u22125 °C",
+                                           "warm")] == [20.0, -10.0, 20.0, 20.0, -5.0, None]
+    f = tmp_path / "Tp020C.csv"
+    f.write_text("# name: sample at 30 °C\n# temperature: 25 C\nomega,real,imag\n1,1,1\n")
+    assert temperature_of_file(f) == 25.0  # the comment first
+    f.write_text("# name: sample at 30 °C\nomega,real,imag\n1,1,1\n")
+    assert temperature_of_file(f) == 20.0  # then the stem
+    g = tmp_path / "sample.csv"
+    g.write_text("# name: sample at \u221230 °C\nomega,real,imag\n1,1,1\n")
+    assert temperature_of_file(g) == -30.0  # then the name
+    g.write_text("# temperature: warm\nomega,real,imag\n1,1,1\n")
+    with pytest.raises(InputError, match=r"sample.csv', line 1: '# temperature:' expects"):
+        expand_inputs([g])
+    # The bundled isotherms: -40 °C to 150 °C in steps of 10 from their file names; the NREL
+    # master curve from its name (its reference temperature).
+    datasets = expand_inputs([ADHESIVE, NREL])
+    assert sorted(d.temperature for d in datasets[:-1]) == [float(t) for t in range(-40, 151, 10)]
+    assert datasets[-1].temperature == -5.0
+
+
+# ---------------------------------------------------------------------- the runs
+def test_bad_file_is_recorded_and_the_others_finish(reference):
+    datasets, result, out = reference
+    assert [d.id for d in datasets] == ["Tm010C", "Tp150C", "broken"]
+    assert [o.status for o in result.outcomes] == ["ok", "ok", "input_error"]
+    assert result.exit_status == 2 and result.executor == "in-process"
+    err = (out / "broken" / "error.txt").read_text()
+    assert "broken.csv', line 3, column 'real': 'x' is not a number" in err
+    record = json.loads((out / "broken" / "batch.json").read_text())
+    assert record["status"] == "input_error" and record["files"] == []
+    assert not (out / "broken" / "summary.json").exists()
+
+    rows = _read_csv(out / "batch_summary.csv")
+    assert [(r["dataset"], r["structure"], r["rank"]) for r in rows] == [
+        ("Tm010C", "zener", "1"), ("Tm010C", "voigt", "2"),
+        ("Tp150C", "zener", "1"), ("Tp150C", "voigt", "2"), ("broken", "", "")]
+    assert rows[-1]["status"] == "input_error" and "'x' is not a number" in rows[-1]["error"]
+    for name in GOOD:
+        summary = json.loads((out / name / "summary.json").read_text())
+        assert summary["seed"] == 3
+        mine = {r["structure"]: r for r in rows if r["dataset"] == name}
+        for s in summary["structures"]:
+            assert float(mine[s["name"]]["log_evidence"]) == s["log_evidence"]
+            assert float(mine[s["name"]]["q_mean"]) == s["parameters"]["q"]["mean"]
+            assert float(mine[s["name"]]["q_hdi_high"]) == s["parameters"]["q"]["hdi_high"]
+            assert (out / name / f"{s['name']}.nc").is_file()
+        best = [r for r in mine.values() if r["best"] == "True"]
+        assert [b["structure"] for b in best] == [summary["ranking"][0]]
+        record = json.loads((out / name / "batch.json").read_text())
+        assert record["status"] == "ok" and record["task"]["seed"] == 3
+        assert record["compare_seconds"] > 0
+    for name in ("batch_summary.png", "batch_summary.pdf", "temperature_q.png"):
+        assert (out / name).read_bytes()[:4] in (b"\x89PNG", b"%PDF")
+
+
+def test_temperature_table_and_figure(reference):
+    _, result, out = reference
+    rows = _read_csv(out / "temperature_summary.csv")
+    assert [(r["temperature_C"], r["dataset"], r["rank"]) for r in rows] == [
+        ("-10.0", "Tm010C", "1"), ("-10.0", "Tm010C", "2"),
+        ("150.0", "Tp150C", "1"), ("150.0", "Tp150C", "2")]
+    by_set = {}
+    for r in rows:
+        by_set.setdefault(r["dataset"], []).append(r)
+    for name, group in by_set.items():
+        best = [r["structure"] for r in group if r["best"] == "True"]
+        assert len(best) == 1 and all(r["best_structure"] == best[0] for r in group)
+        p = [float(r["posterior_probability"]) for r in group]
+        assert abs(sum(p) - 1) < 1e-12 and p[0] == max(p)
+        for r in group:
+            assert float(r["q_hdi_low"]) < float(r["q_mean"]) < float(r["q_hdi_high"])
+    # The isotherm at -10 °C is stiffer and more elastic-like than at 150 °C: larger q.
+    q_best = {r["dataset"]: float(r["q_mean"]) for r in rows if r["best"] == "True"}
+    assert q_best["Tm010C"] > q_best["Tp150C"] + 0.1
+
+    from bayesfo.batch import temperature_rows
+    from bayesfo.plotting.batch import plot_q_temperature
+
+    trows = temperature_rows(result.rows)
+    fig = plot_q_temperature(trows)
+    ax_q, ax_p = fig.axes[:2]
+    # Filled markers are the best structure at each temperature, at its posterior mean of q.
+    filled = [(x, y) for line in ax_q.lines if line.get_marker() == "o"
+              and line.get_markerfacecolor() != "white"
+              for x, y in zip(line.get_xdata(), line.get_ydata())]
+    expected = sorted((r["temperature_C"], r["q_mean"]) for r in trows if r["best"])
+    got = sorted(filled)
+    assert len(got) == len(expected)
+    np.testing.assert_allclose([y for _, y in got], [y for _, y in expected], rtol=0, atol=0)
+    np.testing.assert_allclose([x for x, _ in got], [x for x, _ in expected], atol=0.02 * 160)
+
+
+def test_resume_skips_complete_and_redoes_incomplete(reference, tmp_path, monkeypatch):
+    datasets, result, out = reference
+    out2 = tmp_path / "out"
+    shutil.copytree(out, out2)
+    # Tp150C was interrupted after writing its outputs but before batch.json.
+    (out2 / "Tp150C" / "batch.json").unlink()
+    kept = {f: f.stat().st_mtime_ns for f in (out2 / "Tm010C").iterdir()}
+    calls = []
+    real = batch.run_task
+    monkeypatch.setattr(batch, "run_task", lambda task: calls.append(task["id"]) or real(task))
+    again = run_batch(datasets, out2, workers=1, progress=False)
+    assert sorted(calls) == ["Tp150C", "broken"]  # failed data sets are retried too
+    assert [o.reused for o in again.outcomes] == [True, False, False]
+    assert {f: f.stat().st_mtime_ns for f in (out2 / "Tm010C").iterdir()} == kept
+    # Redone with the same seed: the same numbers; the combined table is the same file.
+    assert (out2 / "batch_summary.csv").read_text() == (out / "batch_summary.csv").read_text()
+    assert again.exit_status == 2
+
+    # Another seed, or changed data, invalidate a complete result; nothing else does.
+    calls.clear()
+    monkeypatch.setattr(batch, "run_task", lambda task: calls.append(task["id"]) or {
+        "id": task["id"], "status": "input_error", "error": "not run", "files": {}})
+    changed = [DataSet(d.id, d.path, d.options, 4 if d.id == "Tm010C" else d.seed,
+                       d.temperature) for d in datasets]
+    run_batch(changed, out2, workers=1, progress=False, write_combined=False)
+    assert calls == ["Tm010C", "broken"]
+    assert not (out2 / "Tm010C" / "summary.json").exists()  # stale results are removed
+    assert (out2 / "Tp150C" / "summary.json").exists()
+
+
+def test_two_workers_give_the_same_numbers(reference, tmp_path):
+    datasets, result, out = reference
+    two = run_batch(datasets, tmp_path / "two", workers=2, progress=False)
+    assert two.executor == "processes (2)"
+    assert [o.status for o in two.outcomes] == ["ok", "ok", "input_error"]
+    assert _numbers(_read_csv(tmp_path / "two" / "batch_summary.csv")) == \
+        _numbers(_read_csv(out / "batch_summary.csv"))
+
+
+def test_dask_local_cluster_gives_the_same_numbers(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    datasets, result, out = reference
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None) as cluster:
+        res = run_batch(datasets, tmp_path / "dask", scheduler=cluster.scheduler_address,
+                        progress=False)
+    assert res.executor == f"dask ({cluster.scheduler_address})"
+    assert [o.status for o in res.outcomes] == ["ok", "ok", "input_error"]
+    assert res.exit_status == 2
+    assert _numbers(_read_csv(tmp_path / "dask" / "batch_summary.csv")) == \
+        _numbers(_read_csv(out / "batch_summary.csv"))
+    assert all(o.compare_seconds > 0 for o in res.outcomes if o.status == "ok")
+
+
+def test_dask_errors_are_input_errors(reference, tmp_path, monkeypatch):
+    datasets = [d for d in reference[0] if d.id == "broken"]
+    monkeypatch.setattr(batch, "SCHEDULER_TIMEOUT", 0.5)
+    with pytest.raises(InputError, match="cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'"):
+        run_batch(datasets, tmp_path / "x", scheduler="tcp://127.0.0.1:9")
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(InputError, match=r"needs dask.distributed: pip install 'bayesfo\[cl"):
+        run_batch(datasets, tmp_path / "x", scheduler="tcp://127.0.0.1:9")
+
+
+def test_internal_error_is_recorded_with_traceback(inputs, tmp_path, monkeypatch):
+    import bayesfo.compare
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("solver exploded")
+
+    monkeypatch.setattr(bayesfo.compare, "compare", boom)
+    datasets = expand_inputs([inputs / "Tm010C.csv"], options={"structures": STRUCTURES})
+    res = run_batch(datasets, tmp_path, workers=1, progress=False)
+    assert res.outcomes[0].status == "internal_error" and res.exit_status == 1
+    text = (tmp_path / "Tm010C" / "error.txt").read_text()
+    assert text.startswith("RuntimeError: solver exploded") and "Traceback" in text
+    assert not (tmp_path / "batch_summary.png").exists()  # nothing to draw
+
+
+def test_command_line(reference, tmp_path, capsys):
+    datasets, result, out = reference
+    # Everything but the broken file is complete: nothing is recomputed.
+    status, stdout, stderr = _run_cli(capsys, "batch", Path(datasets[0].path).parent, "--out",
+                                      out, "--structures", STRUCTURES, "--seed", 3, "--quiet")
+    assert status == 2
+    assert stderr.strip().startswith("bayesfo: error: broken: file '")
+    assert stdout.count("\n") == 1
+    assert stdout.startswith("batch: 3 data sets, 2 compared (2 complete from an earlier run), "
+                             "1 failed; in-process")
+
+    status, stdout, stderr = _run_cli(capsys, "batch", "--out", tmp_path, "--manifest",
+                                      tmp_path / "none.csv")
+    assert status == 2 and "manifest '" in stderr and "does not exist" in stderr
+    status, _, stderr = _run_cli(capsys, "batch", ADHESIVE / "Tp020C.csv", "--out", tmp_path,
+                                 "--workers", "2", "--scheduler", "tcp://127.0.0.1:9")
+    assert status == 2 and "--workers applies to local processes" in stderr

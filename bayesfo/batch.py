@@ -698,10 +698,13 @@ def run_task(task: dict) -> dict:
             structures = resolve_structures(list(opts["structures"]), library)
             priors = _parse_priors(opts["priors"])
             t1, c1 = time.perf_counter(), time.process_time()
+            # One process per data set: the batch runs data sets side by side (and a Dask
+            # worker, a daemonic process, could not start compare's own process pool).
             comparison = compare(data, structures, noise=opts["noise"], seed=task["seed"],
                                  priors=priors, progress=False,
                                  evidence_check=opts["evidence_check"],
-                                 holdout=list(opts["holdout"]) if opts["holdout"] else None)
+                                 holdout=list(opts["holdout"]) if opts["holdout"] else None,
+                                 workers=1)
             out["compare_seconds"] = time.perf_counter() - t1
             out["compare_cpu_seconds"] = time.process_time() - c1
             with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
@@ -1080,8 +1083,10 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
     out_dir : path-like
         Output directory (created); one sub-directory per data set.
     workers : int, optional
-        Local worker processes (default: the available CPUs, at most one per data set to run);
-        1 runs in this process. Not with ``scheduler``.
+        Local worker processes, each running one data set at a time (default, or 0: one per
+        available CPU), at most one per data set to run; 1 runs in this process. Not with
+        ``scheduler``. A script that calls this with several workers needs the usual
+        ``if __name__ == "__main__":`` guard (the workers are spawned).
     scheduler : str or distributed.Client, optional
         Address of a Dask scheduler (``tcp://host:8786``), or a connected client, to run the
         tasks on a Dask cluster instead.
@@ -1113,8 +1118,8 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
         raise InputError("--workers applies to local processes; with --scheduler the Dask "
                          "cluster's workers run the tasks")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
-        raise InputError(f"--workers must be a positive integer, got {workers!r}")
+                                or workers < 0):
+        raise InputError(f"--workers must be a non-negative integer, got {workers!r}")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
 
@@ -1150,7 +1155,7 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
                     if own:
                         client.close()
         else:
-            n = workers if workers is not None else _available_cpus()
+            n = workers if workers else _available_cpus()
             n = max(1, min(n, len(todo)))
             if n == 1:
                 executor = "in-process"
@@ -1216,7 +1221,8 @@ def add_parser(subparsers):
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="local worker processes (default: the available CPUs; 1: in-process)")
+                   help="processes running data sets side by side (default 0: one per CPU; "
+                        "1: in this process); the numbers do not depend on it")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on a Dask cluster (e.g. tcp://10.0.0.5:8786); needs bayesfo[cluster]")
     p.add_argument("--quiet", action="store_true",

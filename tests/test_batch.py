@@ -135,8 +135,8 @@ def test_bad_options_are_errors_before_any_work(tmp_path):
     ds = expand_inputs([tmp_path])
     with pytest.raises(InputError, match="--workers applies to local processes"):
         run_batch(ds, tmp_path / "out", workers=2, scheduler="tcp://127.0.0.1:1")
-    with pytest.raises(InputError, match="--workers must be a positive integer"):
-        run_batch(ds, tmp_path / "out", workers=0)
+    with pytest.raises(InputError, match="--workers must be a non-negative integer"):
+        run_batch(ds, tmp_path / "out", workers=-1)
 
 
 def _manifest(tmp_path, text, name="manifest.csv"):

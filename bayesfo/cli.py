@@ -73,6 +73,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, default=0, metavar="N",
                    help="processes running structures side by side (default 0: one per CPU); "
                         "the numbers do not depend on it")
+    p.add_argument("--no-figures", action="store_true",
+                   help="skip the figures and report.html (faster; summary, table and NetCDF only)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
 
     p = sub.add_parser("identify", help="deterministic fit of one structure (methods 1-5 or optimisation)")
@@ -242,7 +244,7 @@ def cmd_compare(args) -> int:
                      progress=progress, evidence_check=args.evidence_check,
                      holdout=_parse_floats(args.holdout, "--holdout") if args.holdout else None,
                      workers=args.workers)
-    write_outputs(result, out)
+    write_outputs(result, out, figures=not args.no_figures)
     if not args.quiet:
         print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; ranked by "
               "log-evidence ln Z (bridge sampling); P = posterior probability, equal prior odds")
@@ -283,7 +285,11 @@ def cmd_compare(args) -> int:
                 if not row.get("error"):
                     print(f"   {row['structure']:<16} log predictive density {row['holdout_lpd']:10.2f}, "
                           f"RMSE {row['holdout_rmse']:.4g} (in-sample RMSE {row['rmse']:.4g})")
-        print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
+        if args.no_figures:
+            print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
+        else:
+            print(f"report: {out / 'report.html'} (figures in {out / 'figures'}; summary.json, "
+                  "ranking.csv and one NetCDF per structure beside it)")
     return 0
 
 

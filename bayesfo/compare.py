@@ -524,11 +524,30 @@ def _finite(obj):
     return obj
 
 
-def write_outputs(comparison: Comparison, out_dir) -> dict[str, Path]:
-    """Write ``summary.json``, ``ranking.csv`` and one NetCDF per structure into ``out_dir``.
+def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
+                  formats=("png", "pdf")) -> dict[str, Path]:
+    """Write everything a comparison produced into ``out_dir``.
 
-    The NetCDF files come first and ``summary.json`` last, each through a temporary file and a
-    rename, so an interrupted run never leaves a half-written summary.
+    One NetCDF per structure, the figures (``formats``; see
+    :func:`bayesfo.plotting.write_figures`), ``report.html`` (self-contained, figures embedded),
+    ``ranking.csv`` and ``summary.json``, in that order, each through a temporary file and a
+    rename, so an interrupted run never leaves a half-written file and a ``summary.json`` means
+    the rest is complete.
+
+    Parameters
+    ----------
+    comparison : Comparison
+    out_dir : path
+        Created if missing; existing files of the same names are replaced.
+    figures : bool
+        Draw the figures and the report (matplotlib; a few seconds per structure).
+    formats : sequence of str
+        Figure file formats.
+
+    Returns
+    -------
+    dict
+        ``{name: path}`` of the files written (figures: ``{name: [paths]}``).
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -536,6 +555,14 @@ def write_outputs(comparison: Comparison, out_dir) -> dict[str, Path]:
     for r in comparison.results:
         if r.posterior is not None:
             written[r.name] = save_netcdf(r.posterior.idata, out_dir / f"{r.name}.nc")
+    if figures:
+        from .plotting import write_figures
+        from .report import write_report
+
+        drawn = write_figures(comparison, out_dir / "figures", formats=formats,
+                              seed=comparison.seed)
+        written.update(drawn)
+        written["report.html"] = write_report(comparison, out_dir, drawn)
     written["ranking.csv"] = atomic_write_text(out_dir / "ranking.csv", ranking_csv(comparison))
     text = json.dumps(_finite(comparison.to_summary()), indent=2, default=_json_default,
                       allow_nan=False)

@@ -35,7 +35,7 @@ def voigt_comparison(tmp_path_factory):
     assert all("voigt-int" in str(w.message) for w in record if w.category is PredictiveWarning)
     assert result["voigt-int"].criteria["pareto_k_max"] > 0.7
     out = tmp_path_factory.mktemp("cmp")
-    write_outputs(result, out)
+    write_outputs(result, out, figures=False)  # figures: tests/test_plotting.py and the CLI test
     return result, out
 
 
@@ -118,6 +118,12 @@ def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
     assert summary["ranked_by"] == "log_evidence" and voigt["evidence_method"] == "bridge"
     assert voigt["log_evidence"] < voigt["max_log_likelihood"]
     assert sum(s["posterior_probability"] for s in summary["structures"]) == pytest.approx(1.0)
+    # The report names the winner by ln Z, and the figures it embeds are on disk.
+    report = (out / "report.html").read_text()
+    assert f"{summary['ranking'][0]} is the best-supported structure" in report
+    assert report.count("data:image/png;base64,") == len(list((out / "figures").glob("*.png")))
+    assert (out / "figures" / "bode.pdf").stat().st_size > 0
+    assert str(out / "report.html") in stdout
 
 
 @pytest.mark.parametrize(

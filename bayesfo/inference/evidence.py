@@ -24,6 +24,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import logsumexp
 
 from ..errors import InputError
 from .likelihood import Likelihood
@@ -138,20 +139,29 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
     # The draws are autocorrelated: their effective number enters the weights and the error.
     ess = max(2.0, min(float(n1), _ess(l1.reshape(n_walkers, -1))))
     s1, s2 = ess / (ess + n2), n2 / (ess + n2)
-    lstar = float(np.median(l1))
-    e1 = np.exp(l1 - lstar)
-    e2 = np.exp(np.where(np.isfinite(l2), l2 - lstar, -np.inf))
-    r = 1.0
+    if not np.any(np.isfinite(l2)):
+        raise InputError(
+            f"bridge sampling for '{lik.structure.name}': none of {n2} proposal draws lies in "
+            "the support (the posterior is far from Gaussian in the sampling coordinates)")
+    # Meng & Wong's fixed-point iteration in log space: the ratios span hundreds of decades
+    # when the posterior is far from the Gaussian proposal.
+    l1c = l1 - float(np.median(l1))
+    l2c = np.where(np.isfinite(l2), l2 - float(np.median(l1)), -np.inf)
+    log_s1, log_s2 = math.log(s1), math.log(s2)
+    log_r = 0.0
     for _ in range(max_iter):
-        r_new = np.mean(e2 / (s1 * e2 + s2 * r)) / np.mean(1.0 / (s1 * e1 + s2 * r))
-        if abs(math.log(r_new) - math.log(r)) < tol:
-            r = r_new
+        num = logsumexp(l2c - np.logaddexp(log_s1 + l2c, log_s2 + log_r)) - math.log(n2)
+        den = logsumexp(-np.logaddexp(log_s1 + l1c, log_s2 + log_r)) - math.log(n1)
+        log_r_new = float(num - den)
+        if abs(log_r_new - log_r) < tol:
+            log_r = log_r_new
             break
-        r = r_new
-    log_z_support = math.log(r) + lstar
-    # Relative mean-squared error (Frühwirth-Schnatter 2004), draws' autocorrelation via ESS.
-    f1 = e2 / (s1 * e2 + s2 * r)         # on proposal draws
-    f2 = 1.0 / (s1 * e1 + s2 * r)        # on posterior draws
+        log_r = log_r_new
+    log_z_support = log_r + float(np.median(l1))
+    # Relative mean-squared error (Frühwirth-Schnatter 2004), draws' autocorrelation via ESS;
+    # both ratios are invariant to a common factor, so they are computed relative to r.
+    f1 = np.exp(l2c - log_r - np.logaddexp(log_s1 + l2c - log_r, log_s2))  # proposal draws
+    f2 = np.exp(-np.logaddexp(log_s1 + l1c - log_r, log_s2))                 # posterior draws
     re2 = np.var(f1) / np.mean(f1) ** 2 / n2 + np.var(f2) / np.mean(f2) ** 2 / ess
     log_s, log_s_err = log_support_fraction(lik, rng)
     return Evidence(

@@ -4,9 +4,9 @@
 patterns, manifests) into data sets, runs the comparison of each in a worker, and writes
 
 * ``DIR/<id>/`` per data set: what ``bayesfo compare`` writes (``summary.json``, ``ranking.csv``,
-  one NetCDF per structure), plus ``batch.json`` (the task: data-file hash, options, seed,
-  bayesfo version; the status, warnings and timings) or, for a data set that failed,
-  ``error.txt``;
+  one NetCDF per structure, and unless ``--no-figures`` the figures and ``report.html``), plus
+  ``batch.json`` (the task: data-file hash, options, seed, bayesfo version; the status,
+  warnings and timings) and, for a data set that failed, ``error.txt``;
 * ``DIR/batch_summary.csv``: one row per data set and structure (ln Z, posterior probability,
   criteria, posterior of q), and one row with the error for a data set that failed;
 * ``DIR/batch_summary.png`` and ``.pdf``: the posterior model probabilities and the posterior of
@@ -85,6 +85,7 @@ DEFAULT_OPTIONS = {
     "holdout": None,         # angular frequencies [rad/s] left out of the fit
     "evidence_check": False,
     "models": (),            # extra structure cards (paths)
+    "figures": True,         # per-data-set figures and report.html, as bayesfo compare
 }
 
 KINDS = ("compliance", "modulus", "generic")
@@ -243,7 +244,7 @@ def check_options(options: dict, where: str) -> dict:
     return {"kind": opts["kind"], "reciprocal": bool(opts["reciprocal"]),
             "structures": tuple(s.name for s in structures), "noise": opts["noise"],
             "priors": priors, "holdout": holdout, "evidence_check": bool(opts["evidence_check"]),
-            "models": models}
+            "models": models, "figures": bool(opts["figures"])}
 
 
 def _check_seed(seed, where: str) -> int:
@@ -672,7 +673,8 @@ def run_task(task: dict) -> dict:
     dict
         ``id``; ``status`` (``"ok"``, ``"input_error"``, ``"internal_error"``); ``error`` (the
         message, or None); ``traceback`` (internal errors); ``files`` ({file name: bytes}, empty on
-        failure); ``warnings`` (messages raised during the comparison, each once);
+        failure; names relative to the data set's directory, e.g. ``figures/bode.png``);
+        ``warnings`` (messages raised during the comparison, each once);
         ``compare_seconds`` (wall time of the comparison alone), ``compare_cpu_seconds`` (CPU
         time of the worker process during it: much less than the wall time means the worker
         waited for a core), ``task_seconds`` (the whole task), ``host`` and ``pid``.
@@ -708,9 +710,9 @@ def run_task(task: dict) -> dict:
             out["compare_seconds"] = time.perf_counter() - t1
             out["compare_cpu_seconds"] = time.process_time() - c1
             with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
-                write_outputs(comparison, tmp)
-                out["files"] = {f.name: f.read_bytes() for f in sorted(Path(tmp).iterdir())
-                                if f.is_file()}
+                write_outputs(comparison, tmp, figures=opts["figures"])
+                out["files"] = {f.relative_to(tmp).as_posix(): f.read_bytes()
+                                for f in sorted(Path(tmp).rglob("*")) if f.is_file()}
     except InputError as exc:
         out.update(status=INPUT_ERROR, error=str(exc), files={})
     except Exception as exc:  # recorded per data set: one failure never stops the batch
@@ -904,24 +906,48 @@ def _stored_rows(ds: DataSet, out_dir: Path, fingerprint: dict) -> tuple | None:
         return None
 
 
+def _known_files(sub: Path) -> set[str]:
+    """Output files of an earlier run in ``sub``: those its ``batch.json`` lists, and any of the
+    names ``write_outputs`` uses (in case ``batch.json`` was never written)."""
+    known = set()
+    try:
+        known.update(json.loads((sub / _BATCH_JSON).read_text(encoding="utf-8"))["files"])
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    known.update(n for n in ("summary.json", "ranking.csv", "report.html") if (sub / n).is_file())
+    known.update(f.name for f in sub.glob("*.nc"))
+    if (sub / "figures").is_dir():
+        known.update(f.relative_to(sub).as_posix() for f in (sub / "figures").rglob("*")
+                     if f.is_file())
+    return known
+
+
 def _store(ds: DataSet, result: dict, out_dir: Path, fingerprint: dict) -> Outcome:
-    """Write a worker's result into ``out_dir/<id>/``; ``batch.json`` goes last."""
+    """Write a worker's result into ``out_dir/<id>/``, ``summary.json`` after the other outputs
+    and ``batch.json`` last; remove outputs of an earlier run that this one did not write."""
     sub = out_dir / ds.id
     sub.mkdir(parents=True, exist_ok=True)
+    stale = _known_files(sub)
     for name in (_BATCH_JSON, _ERROR_TXT):  # no longer valid, whatever happens next
         (sub / name).unlink(missing_ok=True)
-    files = result.get("files") or {}
-    stale = {f.name for f in sub.glob("*.nc")} | {"summary.json", "ranking.csv"}
+    files = (result.get("files") or {}) if result["status"] == OK else {}
+    for name in files:
+        parts = Path(name).parts
+        if Path(name).is_absolute() or ".." in parts or not parts:
+            raise ValueError(f"output file name {name!r} leaves the data set's directory")
+    for name in sorted(files, key=lambda n: n == "summary.json"):  # summary.json last
+        target = sub / name
+        target.parent.mkdir(parents=True, exist_ok=True)
+        _atomic_write_bytes(target, files[name])
+    for name in stale - set(files):
+        (sub / name).unlink(missing_ok=True)
+    for d in sorted((p for p in sub.rglob("*") if p.is_dir()), key=lambda p: -len(p.parts)):
+        if not any(d.iterdir()):
+            d.rmdir()
     if result["status"] == OK:
-        for name in sorted(files, key=lambda n: n == "summary.json"):  # summary.json last
-            _atomic_write_bytes(sub / name, files[name])
-        for name in stale - set(files):
-            (sub / name).unlink(missing_ok=True)
         summary = json.loads(files["summary.json"].decode("utf-8"))
         rows = _dataset_rows(ds, OK, None, summary_rows(summary))
     else:
-        for name in stale:
-            (sub / name).unlink(missing_ok=True)
         text = f"{result['error']}\n"
         if result.get("traceback"):
             text += "\n" + result["traceback"]
@@ -1022,12 +1048,13 @@ def _run_processes(todo, workers, on_result):
         while pending:
             done, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in done:
-                ds = futures[fut]
+                ds = futures.pop(fut)  # drop the future and its output files once stored
                 try:
                     result = fut.result()
                 except Exception as exc:  # the worker died (BrokenProcessPool) or similar
                     result = _lost(ds, exc)
                 on_result(ds, result)
+            del done
     except BaseException:
         pool.shutdown(wait=False, cancel_futures=True)
         raise
@@ -1061,11 +1088,12 @@ def _run_dask(todo, client, on_result):
         futures[fut] = ds
     try:
         for fut in as_completed(list(futures), loop=client.loop):
-            ds = futures[fut]
+            ds = futures.pop(fut)
             try:
                 result = fut.result()
             except Exception as exc:  # KilledWorker, lost connection
                 result = _lost(ds, exc)
+            fut.release()  # the cluster may forget the output files
             on_result(ds, result)
     except BaseException:
         client.cancel(list(futures))
@@ -1220,6 +1248,9 @@ def add_parser(subparsers):
                    help="angular frequencies [rad/s] left out of every fit for validation")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
+    p.add_argument("--no-figures", action="store_true",
+                   help="skip each data set's figures and report.html (the combined figures "
+                        "are still drawn)")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes running data sets side by side (default 0: one per CPU; "
                         "1: in this process); the numbers do not depend on it")
@@ -1240,7 +1271,8 @@ def cmd_batch(args) -> int:
                "noise": args.noise, "priors": tuple(args.prior),
                "holdout": _parse_floats(args.holdout, "--holdout") if args.holdout else None,
                "evidence_check": args.evidence_check,
-               "models": tuple(getattr(args, "models", None) or ())}
+               "models": tuple(getattr(args, "models", None) or ()),
+               "figures": not args.no_figures}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,
                              seed=args.seed, exclude=args.out)
     progress = not args.quiet and sys.stderr.isatty()

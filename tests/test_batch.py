@@ -54,7 +54,8 @@ def inputs(tmp_path_factory):
 def reference(inputs, tmp_path_factory):
     """The in-process run (workers=1) of the two isotherms and the broken file."""
     out = tmp_path_factory.mktemp("reference")
-    datasets = expand_inputs([inputs], options={"structures": STRUCTURES}, seed=3)
+    datasets = expand_inputs([inputs], options={"structures": STRUCTURES, "figures": False},
+                             seed=3)
     result = run_batch(datasets, out, workers=1, progress=False)
     return datasets, result, out
 
@@ -357,6 +358,41 @@ def test_dask_errors_are_input_errors(reference, tmp_path, monkeypatch):
         run_batch(datasets, tmp_path / "x", scheduler="tcp://127.0.0.1:9")
 
 
+def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch):
+    import bayesfo.compare
+
+    shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
+    summary = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"],
+               "structures": [{"name": "voigt", "n_params": 3, "log_evidence": -1.5,
+                               "posterior_probability": 1.0, "parameters": {"q": {
+                                   "mean": 0.5, "sd": 0.1, "hdi_low": 0.3, "hdi_high": 0.7,
+                                   "map": 0.5}}}]}
+
+    def fake_outputs(comparison, out, figures=True):
+        out = Path(out)
+        (out / "voigt.nc").write_bytes(b"nc")
+        if figures:
+            (out / "figures").mkdir()
+            (out / "figures" / "bode.png").write_bytes(b"png")
+            (out / "report.html").write_text("<html>")
+        (out / "summary.json").write_text(json.dumps(summary))
+
+    monkeypatch.setattr(bayesfo.compare, "compare", lambda *args, **kwargs: None)
+    monkeypatch.setattr(bayesfo.compare, "write_outputs", fake_outputs)
+    sub = tmp_path / "out" / "a"
+    res = run_batch(expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"}),
+                    tmp_path / "out", workers=1, progress=False, write_combined=False)
+    assert (sub / "figures" / "bode.png").read_bytes() == b"png"
+    assert json.loads((sub / "batch.json").read_text())["files"] == [
+        "figures/bode.png", "report.html", "summary.json", "voigt.nc"]
+    assert res.rows[0]["log_evidence"] == -1.5 and res.rows[0]["q_hdi_high"] == 0.7
+    # Run again without figures: the earlier figures and report do not linger.
+    run_batch(expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt",
+                                                           "figures": False}),
+              tmp_path / "out", workers=1, progress=False, write_combined=False)
+    assert sorted(p.name for p in sub.iterdir()) == ["batch.json", "summary.json", "voigt.nc"]
+
+
 def test_internal_error_is_recorded_with_traceback(inputs, tmp_path, monkeypatch):
     import bayesfo.compare
 
@@ -376,7 +412,8 @@ def test_command_line(reference, tmp_path, capsys):
     datasets, result, out = reference
     # Everything but the broken file is complete: nothing is recomputed.
     status, stdout, stderr = _run_cli(capsys, "batch", Path(datasets[0].path).parent, "--out",
-                                      out, "--structures", STRUCTURES, "--seed", 3, "--quiet")
+                                      out, "--structures", STRUCTURES, "--seed", 3, "--quiet",
+                                      "--no-figures")
     assert status == 2
     assert stderr.strip().startswith("bayesfo: error: broken: file '")
     assert stdout.count("\n") == 1

@@ -168,3 +168,25 @@ def test_poorly_determined_flag_follows_the_prior_width():
     summary = _summaries(lik, tr, phys, u, phys[0])
     assert summary["q"].poorly_determined and not summary["q"].multimodal
     assert not summary["a1"].poorly_determined and not summary["b0"].poorly_determined
+
+
+def test_seed_just_outside_the_stability_boundary_is_repaired():
+    # Integrator with a lag, 1/(s (1 + 0.2 s)): the truth has b0 = 0, on the boundary, so a
+    # least-squares optimum often has b0 slightly negative (an unstable pole). Walkers must
+    # start at that mode, moved onto the boundary, not at prior draws far from the data.
+    from bayesfo.inference.posterior import initial_walkers
+
+    w = np.logspace(np.log10(0.03), 1, 16)
+    s = get_structure("max-n0m2-inv-int")
+    truth = np.array([0.0, 1.0, 0.2])
+    g = s.response(truth, w, "generic")
+    data = FrequencyResponse(w, g, 0.03 * np.abs(g), kind="generic")
+    lik = Likelihood(s, data, noise="known")
+    outside = s.to_scaled(np.array([-0.002, 1.0, 0.2]), lik.scaling)
+    on_boundary = s.to_scaled(truth, lik.scaling)
+    assert not lik.in_support(outside[None, :])[0] and lik.in_support(on_boundary[None, :])[0]
+    walkers = initial_walkers(lik, outside[None, :], 16, np.random.default_rng(0))
+    assert lik.in_support(walkers).all()
+    # Noise-free data: the boundary point fits exactly; the walkers are within the jitter of it.
+    best = float(lik(on_boundary[None, :])[0])
+    assert np.all(lik(walkers) > best - 10.0) and np.median(lik(walkers)) > best - 3.0

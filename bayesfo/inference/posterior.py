@@ -215,7 +215,9 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
     u = np.clip(tr.to_u(seeds), tr.lo_u + margin, tr.hi_u - margin)
     seeds = tr.to_theta(u)
     ok = lik.in_support(seeds)
-    if not ok.any():
+    if ok.any():
+        anchor = seeds[ok][np.argmax(lik(seeds[ok]))]
+    else:
         draws = np.column_stack([p.sample(rng, 2000) for p in lik.prior_list])
         draws = draws[lik.in_support(draws)]
         if not draws.size:
@@ -223,7 +225,16 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
                 f"no starting point of structure '{lik.structure.name}' lies in the prior "
                 "support (stable, dissipative, within the prior ranges)"
             )
-        seeds, ok = draws[np.argsort(-lik(draws))[:8]], np.ones(min(8, len(draws)), dtype=bool)
+        best = draws[np.argsort(-lik(draws))[:8]]
+        anchor = best[0]
+    # A seed just outside the support (e.g. an optimum with a slightly unstable root when the
+    # truth lies on the stability boundary) is moved onto the boundary, along the segment from
+    # the best admissible point, so its mode is not lost.
+    repaired = [_into_support(lik, tr, theta, anchor) for theta in seeds[~ok]]
+    seeds = np.vstack([seeds[ok], *[r[None, :] for r in repaired if r is not None]])
+    if not ok.any():
+        seeds = np.vstack([seeds, best])
+    ok = np.ones(len(seeds), dtype=bool)
     seeds = seeds[ok]
     ll = lik(seeds)
     keep = ll >= ll.max() - mode_window
@@ -241,6 +252,34 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
             theta = tr.to_theta(base)
         out[i] = theta
     return out
+
+
+def _into_support(lik: Likelihood, tr: _Transform, theta, anchor, *, steps: int = 40):
+    """A point in the support near ``theta`` (outside it): ``theta`` with one coordinate set to
+    zero (or to the lower bound of a log-uniform prior), the most likely of those that are in
+    the support; else the point of the segment from ``anchor`` (in the support) to ``theta``
+    nearest to ``theta`` and still in the support, by bisection in the sampling coordinates.
+    None if ``theta`` is not finite."""
+    u_out, u_in = tr.to_u(np.asarray(theta, float)[None, :])[0], tr.to_u(anchor[None, :])[0]
+    if not np.all(np.isfinite(u_out)):
+        return None
+    # First the simplest repairs: one coordinate set to zero (or its smallest allowed value),
+    # which puts a root that crossed the boundary back on it (an integrator when b0 = 0).
+    small = np.where(tr.log, tr.lo_u, np.clip(0.0, tr.lo_u, tr.hi_u))
+    cand = np.repeat(u_out[None, :], len(u_out), axis=0)
+    cand[np.arange(len(u_out)), np.arange(len(u_out))] = small
+    cand = tr.to_theta(cand[np.all(np.isfinite(cand), axis=1)])
+    cand = cand[lik.in_support(cand)] if len(cand) else cand
+    if len(cand):
+        return cand[np.argmax(lik(cand))]
+    lo, hi = 0.0, 1.0  # fraction of the way from the anchor towards theta
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        if lik.in_support(tr.to_theta((u_in + mid * (u_out - u_in))[None, :]))[0]:
+            lo = mid
+        else:
+            hi = mid
+    return tr.to_theta((u_in + lo * (u_out - u_in))[None, :])[0]
 
 
 def sample_posterior(

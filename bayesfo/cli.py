@@ -246,7 +246,9 @@ def cmd_compare(args) -> int:
                      workers=args.workers)
     write_outputs(result, out, figures=not args.no_figures)
     if not args.quiet:
-        print(f"{data.label}: {data.n_frequencies} frequencies, kind {data.kind}; ranked by "
+        n_fit = result.data.n_frequencies
+        held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
+        print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "
               "log-evidence ln Z (bridge sampling); P = posterior probability, equal prior odds")
         print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>16} {'dlnZ':>8} {'P':>6} "
               f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3}")

@@ -300,7 +300,8 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
         "max_log_likelihood": max_ll, "aic": aic, "aicc": aicc, "bic": bic,
         "waic": float(waic.elpd_waic), "waic_se": float(waic.se),
         "loo": float(loo.elpd_loo), "loo_se": float(loo.se), "pareto_k_max": k_max,
-        "pareto_k": pareto_k.tolist(), "rmse": rmse, "warnings": warn,
+        "pareto_k": pareto_k.tolist(), "loo_pointwise": np.asarray(loo.loo_i).tolist(),
+        "rmse": rmse, "warnings": warn,
         "priors": lik.describe_priors(),
     }
 

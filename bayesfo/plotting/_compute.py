@@ -257,8 +257,11 @@ def loo_differences(results) -> dict[str, tuple[float, float]]:
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Estimated shape parameter of Pareto",
                                 category=UserWarning)
+        warnings.filterwarnings("ignore", category=RuntimeWarning)  # overflow in arviz' PSIS
         for r in results:
-            pointwise[r.name] = np.asarray(az.loo(r.posterior.idata, pointwise=True).loo_i)
+            stored = r.criteria.get("loo_pointwise")
+            pointwise[r.name] = (np.asarray(stored) if stored is not None else
+                                 np.asarray(az.loo(r.posterior.idata, pointwise=True).loo_i))
     if not pointwise:
         return {}
     best = max(pointwise, key=lambda n: pointwise[n].sum())

@@ -17,9 +17,9 @@ patterns, manifests) into data sets, runs the comparison of each in a worker, an
 
 Design
 ------
-*Tasks are plain data.* A task is a dict of the absolute data path, the options and the seed;
-the worker (:func:`run_task`) reads the CSV itself, runs the comparison, writes its outputs into
-a private temporary directory and returns their bytes. Only the client process writes into
+*Tasks are plain data.* A task is a dict of the data file's path and bytes, the options and the
+seed; the worker (:func:`run_task`) reads the CSV itself, runs the comparison, writes its outputs
+into a private temporary directory and returns their bytes. Only the client process writes into
 ``DIR``, each file through a temporary file and a rename, ``summary.json`` after the NetCDF files
 and ``batch.json`` last, so workers need no shared file system and an interrupted run never
 leaves a data set that looks complete but is not.
@@ -66,7 +66,7 @@ import traceback
 import warnings
 from concurrent.futures import FIRST_COMPLETED, wait
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -153,8 +153,13 @@ class DataSet:
     origin: str = ""
 
     def task(self) -> dict:
-        """The picklable task of :func:`run_task`."""
-        return {"id": self.id, "path": str(Path(self.path).resolve()),
+        """The picklable task of :func:`run_task`, carrying the data file's bytes (a few kB)
+        so that a worker on another machine needs no access to the file."""
+        try:
+            content = Path(self.path).read_bytes()
+        except OSError:
+            content = None  # the worker reports the problem
+        return {"id": self.id, "path": str(Path(self.path).resolve()), "content": content,
                 "options": dict(self.options), "seed": self.seed}
 
     def fingerprint(self) -> dict:
@@ -655,6 +660,22 @@ def _assign_ids(entries: list[_Entry]) -> list[DataSet]:
 
 
 # ====================================================================== the task
+def _read_task_data(task: dict, read_csv):
+    """The data of a task, from the bytes it carries (through a private copy with the file's
+    name), with the original path as its source and in error messages."""
+    kind = task["options"]["kind"]
+    if task.get("content") is None:
+        return read_csv(task["path"], kind=kind)
+    with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
+        copy = Path(tmp) / Path(task["path"]).name
+        copy.write_bytes(task["content"])
+        try:
+            data = read_csv(copy, kind=kind)
+        except InputError as exc:
+            raise InputError(str(exc).replace(str(copy), task["path"])) from None
+    return replace(data, source=task["path"])
+
+
 def run_task(task: dict) -> dict:
     """Compare the structures on one data set: the function a worker runs.
 
@@ -665,8 +686,9 @@ def run_task(task: dict) -> dict:
     Parameters
     ----------
     task : dict
-        ``{"id", "path" (absolute), "options" (see :func:`check_options`), "seed"}``: plain,
-        picklable data, as made by :meth:`DataSet.task`.
+        ``{"id", "path" (absolute), "content" (the file's bytes, or None to read ``path``),
+        "options" (see :func:`check_options`), "seed"}``: plain, picklable data, as made by
+        :meth:`DataSet.task`.
 
     Returns
     -------
@@ -693,7 +715,7 @@ def run_task(task: dict) -> dict:
             from .data import read_csv
             from .structures import default_library, load_library, resolve_structures
 
-            data = read_csv(task["path"], kind=opts["kind"])
+            data = _read_task_data(task, read_csv)
             if opts["reciprocal"]:
                 data = data.reciprocal()
             library = load_library(extra=opts["models"]) if opts["models"] else default_library()
@@ -770,7 +792,8 @@ class BatchResult:
     outcomes : tuple of Outcome
         In the order of the data sets.
     executor : str
-        ``"in-process"``, ``"processes (N)"`` or ``"dask (ADDRESS)"``.
+        ``"in-process"``, ``"processes (N)"``, ``"dask (ADDRESS)"``, or
+        ``"none (every data set complete)"``.
     wall_seconds : float
         Wall time of the run, combined outputs included.
     written : dict
@@ -974,12 +997,12 @@ def _lost(ds: DataSet, exc: BaseException) -> dict:
             "error": f"the worker failed: {type(exc).__name__}: {exc}", "traceback": None}
 
 
-def write_batch_outputs(result_rows, out_dir) -> dict[str, Path]:
+def write_batch_outputs(result_rows, out_dir, structures=None) -> dict[str, Path]:
     """Write the combined outputs: ``batch_summary.csv`` and its figure, and, when data sets have
     temperatures, ``temperature_summary.csv`` and the figure of q against temperature.
 
-    Each file is written through a temporary file and a rename. Returns the written files by
-    name.
+    Each file is written through a temporary file and a rename; ``structures`` orders the
+    structures in the figures. Returns the written files by name.
     """
     out_dir = Path(out_dir)
     rows = list(result_rows)
@@ -994,12 +1017,12 @@ def write_batch_outputs(result_rows, out_dir) -> dict[str, Path]:
     from .plotting import save_figure
     from .plotting.batch import plot_batch_summary, plot_q_temperature
 
-    fig = plot_batch_summary(rows)
+    fig = plot_batch_summary(rows, structures)
     for suffix in ("png", "pdf"):
         save_figure(fig, out_dir / f"batch_summary.{suffix}")
         written[f"batch_summary.{suffix}"] = out_dir / f"batch_summary.{suffix}"
     if trows:
-        fig = plot_q_temperature(trows)
+        fig = plot_q_temperature(trows, structures)
         for suffix in ("png", "pdf"):
             save_figure(fig, out_dir / f"temperature_q.{suffix}")
             written[f"temperature_q.{suffix}"] = out_dir / f"temperature_q.{suffix}"
@@ -1172,19 +1195,18 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
         bar.update(1)
 
     try:
-        if scheduler is not None:
-            executor = f"dask ({scheduler if isinstance(scheduler, str) else 'client'})"
-            if todo:
-                client, own = _dask_client(scheduler)
-                try:
-                    executor = f"dask ({client.scheduler.address})"
-                    _run_dask(todo, client, on_result)
-                finally:
-                    if own:
-                        client.close()
+        if not todo:
+            executor = "none (every data set complete)"
+        elif scheduler is not None:
+            client, own = _dask_client(scheduler)
+            try:
+                executor = f"dask ({client.scheduler.address})"
+                _run_dask(todo, client, on_result)
+            finally:
+                if own:
+                    client.close()
         else:
-            n = workers if workers else _available_cpus()
-            n = max(1, min(n, len(todo)))
+            n = min(workers or _available_cpus(), len(todo))
             if n == 1:
                 executor = "in-process"
                 _run_in_process(todo, on_result)
@@ -1197,7 +1219,8 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
     ordered = tuple(outcomes[ds.id] for ds in datasets)
     written = {}
     if write_combined:
-        written = write_batch_outputs([r for o in ordered for r in o.rows], out_dir)
+        order = list(dict.fromkeys(n for ds in datasets for n in ds.options["structures"]))
+        written = write_batch_outputs([r for o in ordered for r in o.rows], out_dir, order)
     return BatchResult(out_dir, ordered, executor, time.perf_counter() - t0, written)
 
 

@@ -393,6 +393,23 @@ def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch)
     assert sorted(p.name for p in sub.iterdir()) == ["batch.json", "summary.json", "voigt.nc"]
 
 
+def test_tasks_carry_the_data_so_workers_need_no_shared_files(tmp_path):
+    from bayesfo.batch import _read_task_data
+    from bayesfo.data import read_csv
+
+    shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "Tp150C.csv")
+    (tmp_path / "broken.csv").write_text(BAD_TEXT)
+    task = expand_inputs([tmp_path / "Tp150C.csv"])[0].task()
+    assert task["content"] == (ADHESIVE / "Tp150C.csv").read_bytes()
+    elsewhere = dict(task, path="/nowhere/Tp150C.csv")  # as seen by a worker on another machine
+    data = _read_task_data(elsewhere, read_csv)
+    assert data.source == "/nowhere/Tp150C.csv" and data.n_frequencies == 17
+    np.testing.assert_array_equal(data.response, read_csv(ADHESIVE / "Tp150C.csv").response)
+    bad = dict(expand_inputs([tmp_path / "broken.csv"])[0].task(), path="/nowhere/broken.csv")
+    with pytest.raises(InputError, match=r"^file '/nowhere/broken.csv', line 3, column 'real'"):
+        _read_task_data(bad, read_csv)
+
+
 def test_internal_error_is_recorded_with_traceback(inputs, tmp_path, monkeypatch):
     import bayesfo.compare
 

@@ -28,13 +28,12 @@ def _figure(fig, width, height):
     return Figure(figsize=(width, height), layout="constrained")
 
 
-def _structures_in_order(rows):
-    names = []
-    for r in rows:
-        name = r.get("structure")
-        if name and name not in names and r.get("rank") is not None:
-            names.append(name)
-    return names
+def _structures_in_order(rows, order=None):
+    """Structures with results in ``rows``: in ``order``, then the others alphabetically (so a
+    structure has the same colour in every figure of a batch)."""
+    present = {r["structure"] for r in rows if r.get("structure") and r.get("rank") is not None}
+    order = list(order or [])
+    return [n for n in order if n in present] + sorted(present - set(order))
 
 
 def _has_q(row) -> bool:
@@ -42,7 +41,8 @@ def _has_q(row) -> bool:
 
 
 def _q_errorbar(ax, x, rows, colour, filled_mask, marker="o"):
-    """q means with HDI bars; filled markers where ``filled_mask`` (the best structure)."""
+    """q means with HDI bars; filled markers where ``filled_mask`` (the best structure), a
+    cross where the posterior did not converge."""
     mean = np.array([r["q_mean"] for r in rows], dtype=float)
     low = np.array([r["q_hdi_low"] for r in rows], dtype=float)
     high = np.array([r["q_hdi_high"] for r in rows], dtype=float)
@@ -52,6 +52,10 @@ def _q_errorbar(ax, x, rows, colour, filled_mask, marker="o"):
     ax.plot(x[filled], mean[filled], marker, color=colour, markersize=6, linestyle="none")
     ax.plot(x[~filled], mean[~filled], marker, markerfacecolor="white", color=colour,
             markersize=6, linestyle="none")
+    unconverged = np.array([r.get("converged") is False for r in rows], dtype=bool)
+    if unconverged.any():
+        ax.plot(x[unconverged], mean[unconverged], "x", color="0.15", markersize=4,
+                linestyle="none")
 
 
 def _q_legend(ax, labels, colours, **kwargs):
@@ -62,23 +66,27 @@ def _q_legend(ax, labels, colours, **kwargs):
                for c in colours]
     handles += [Line2D([], [], marker="o", color="0.3", linestyle="none", markersize=6),
                 Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
-                       linestyle="none", markersize=6)]
-    ax.legend(handles, [*labels, "best structure", "not the best"], frameon=False, **kwargs)
+                       linestyle="none", markersize=6),
+                Line2D([], [], marker="x", color="0.15", linestyle="none", markersize=4)]
+    ax.legend(handles, [*labels, "best structure", "not the best", "not converged"],
+              frameon=False, **kwargs)
 
 
-def plot_batch_summary(rows, fig=None):
+def plot_batch_summary(rows, structures=None, fig=None):
     """Best structure and posterior q per data set.
 
     Top: the posterior model probabilities of the structures on each data set, stacked (equal
     prior odds; the name of the best structure above each bar). Bottom: the posterior mean of
     q (``beta`` for the generalised Maxwell model) with its 94 % HDI for every fractional
-    structure, filled where the structure is the best on that data set. Data sets that failed
-    are marked on the axis.
+    structure, filled where the structure is the best on that data set, crossed where its
+    posterior did not converge. Data sets that failed are marked on the axis.
 
     Parameters
     ----------
     rows : sequence of dict
         Rows of ``batch_summary.csv`` (:attr:`bayesfo.batch.BatchResult.rows`).
+    structures : sequence of str, optional
+        Order of the structures (legend, colours); others follow alphabetically.
     fig : matplotlib Figure, optional
         Drawn on (cleared first); default: a new figure sized for the number of data sets.
 
@@ -90,7 +98,7 @@ def plot_batch_summary(rows, fig=None):
     rows = list(rows)
     datasets = list(dict.fromkeys(r["dataset"] for r in rows))
     failed = {r["dataset"] for r in rows if r.get("status") != "ok"}
-    structures = _structures_in_order(rows)
+    structures = _structures_in_order(rows, structures)
     colours = _structure_colours(structures)
     n = len(datasets)
     fig = _figure(fig, min(max(6.0, 0.5 * n + 2.5), 30.0), 6.0)
@@ -148,18 +156,21 @@ def plot_batch_summary(rows, fig=None):
     return fig
 
 
-def plot_q_temperature(rows, fig=None):
+def plot_q_temperature(rows, structures=None, fig=None):
     """Posterior q against temperature per structure, and the best structure per temperature.
 
     Top: the posterior mean of q (``beta`` for the generalised Maxwell model) with its 94 % HDI
     against temperature, one colour per structure, filled where the structure is the best at
-    that temperature. Bottom: the posterior probability of each structure against temperature
-    (equal prior odds), so the best structure per temperature is the top curve.
+    that temperature, crossed where its posterior did not converge. Bottom: the posterior
+    probability of each structure against temperature (equal prior odds), so the best structure
+    per temperature is the top curve.
 
     Parameters
     ----------
     rows : sequence of dict
         Rows of ``temperature_summary.csv`` (:func:`bayesfo.batch.temperature_rows`).
+    structures : sequence of str, optional
+        Order of the structures (legend, colours); others follow alphabetically.
     fig : matplotlib Figure, optional
 
     Returns
@@ -168,7 +179,7 @@ def plot_q_temperature(rows, fig=None):
         With two axes: q, then probabilities.
     """
     rows = [r for r in rows if r.get("temperature_C") is not None]
-    structures = _structures_in_order(rows)
+    structures = _structures_in_order(rows, structures)
     colours = _structure_colours(structures)
     fig = _figure(fig, 6.5, 6.0)
     ax_q, ax_p = fig.subplots(2, 1, sharex=True, height_ratios=[1.6, 1])

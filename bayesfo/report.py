@@ -209,6 +209,12 @@ def verdict(comparison) -> list[tuple[str, bool]]:
         out.append((f"Caution: the posterior of {name} did not converge (R-hat "
                     f"{post.rhat_max:.3f}, ESS {post.ess_min:.0f}); its log-evidence and the "
                     "ranking that rests on it are unreliable.", True))
+        conv = next((r for r in rows if r["converged"]), None)
+        if conv is not None and conv["log_evidence"] is not None and best["log_evidence"] is not None:
+            out.append((f"The best-supported structure whose posterior converged is "
+                        f"{conv['structure']} (Δln Z = {conv['log_evidence'] - best['log_evidence']:.2f}"
+                        f" to {name}, posterior probability {_prob(conv['posterior_probability'])}).",
+                        True))
     others = [r["structure"] for r in rows[1:] if not r["converged"]]
     if others:
         out.append((f"Posteriors that did not converge: {', '.join(others)}.", True))

@@ -183,6 +183,8 @@ def test_flags_poor_order_non_convergence_and_failures(comparison):
     flagged_text = " ".join(t for t, f in sentences if f)
     assert "poorly determined" in flagged_text
     assert f"Caution: the posterior of {best} did not converge" in flagged_text
+    runner_up = comparison.ranking[1]
+    assert f"whose posterior converged is {runner_up} " in flagged_text
     assert "maxwell (nothing admissible (test))" in flagged_text
     text = render_report(replace(comparison, results=results))
     assert "failed: nothing admissible (test)" in text

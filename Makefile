@@ -36,7 +36,7 @@ DEMO_STRUCTURES ?= voigt,zener,maxwell,voigt-int,zener-int,maxwell-int
 demo: $(STAMP)
 	@echo "Comparing $(DEMO_STRUCTURES) on $(DEMO_DATA) (3M 468MP adhesive, 20 C, storage and loss modulus)"
 	MPLBACKEND=Agg $(BIN)/bayesfo compare $(DEMO_DATA) --structures $(DEMO_STRUCTURES) --out $(DEMO_OUT)
-	@echo "Results: $(DEMO_OUT)/summary.json (all numbers), $(DEMO_OUT)/ranking.csv, one NetCDF posterior per structure"
+	@echo "Open $(DEMO_OUT)/report.html first (verdict, ranking, figures); all numbers in $(DEMO_OUT)/summary.json"
 
 bench: $(STAMP)
 	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done

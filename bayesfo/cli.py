@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from . import __version__, batch
 from .errors import InputError
 
 
@@ -107,6 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--harmonics", type=int, default=5, help="highest harmonic reported (default 5)")
     p.add_argument("--threshold", type=float, default=0.05,
                    help="harmonic ratio above which a record is flagged as nonlinear (default 0.05)")
+    batch.add_parser(sub)
     return parser
 
 
@@ -390,6 +391,7 @@ def cmd_simulate(args) -> int:
 
 
 COMMANDS = {
+    "batch": batch.cmd_batch,
     "compare": cmd_compare,
     "inspect": cmd_inspect,
     "structures": cmd_structures,

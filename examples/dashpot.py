@@ -28,7 +28,8 @@ each; the CSV holds the ten series (column ``series``) and bayesfo averages them
 standard error of the mean (about 3 %). The noise seed is fixed; for this truth, whose integrator
 sits on the stability boundary (b0 = 0), about a third of the noise realisations put the
 least-squares optimum of the inverted members just outside the stable region (b0 < 0, as in the
-thesis' own fit with a0 < 0); seed 7 is one whose optimum is stable (see examples/README.md).
+thesis' own fit with a0 < 0); bayesfo moves such an optimum onto the boundary before it starts
+the sampler, so the posterior still starts at the mode of the data (checked on noise seeds 0–5).
 
 Usage: python examples/dashpot.py [--quick] [--out DIR] [--seed N] [--regenerate]
 """

@@ -38,6 +38,14 @@ def thesis_noise(rng: np.random.Generator, runs: int, sigma: float = SIGMA, n: i
     return np.fft.fft(rng.normal(0.0, sigma, size=(runs, n)), axis=-1)
 
 
+def g_spec_data(seed: int = 0, kind: str = "compliance") -> FrequencyResponse:
+    """One noisy realisation of the thesis set-up as a data set: G_spec + Ξ (σ = 0.001 per time
+    sample), with the known complex standard deviation sqrt(25)·σ = 0.005 at every point."""
+    noise = thesis_noise(np.random.default_rng(seed), 1)[0]
+    return FrequencyResponse(OMEGA, g_spec() + noise, np.full(OMEGA.size, 5.0 * SIGMA),
+                             kind=kind, name=f"G_spec + thesis noise (seed {seed})")
+
+
 def rmse(reference, fitted) -> np.ndarray:
     """(1/N)·sqrt(Σ_k |G_ref − Ĝ|²) over the last axis (thesis eq. (3.23))."""
     reference = np.asarray(reference)

@@ -19,8 +19,7 @@ import numpy as np
 from bayesfo.compare import compare
 from bayesfo.inference._arviz import arviz
 from bayesfo.structures import resolve_structures
-from bayesfo.data import FrequencyResponse
-from bayesfo.studies import OMEGA, g_spec, thesis_noise
+from bayesfo.studies import g_spec_data
 
 STRUCTURES = "voigt,zener,maxwell,max3,voigt-int,zener-int,maxwell-int,max3-int"
 
@@ -33,9 +32,7 @@ def main(argv=None):
     warnings.simplefilter("ignore")
     arviz()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}")
-    noise = thesis_noise(np.random.default_rng(args.seed), 1)[0]
-    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance",
-                             name="G_spec + thesis noise")
+    data = g_spec_data(args.seed)
     structures = resolve_structures(STRUCTURES)
     t0 = time.perf_counter()
     result = compare(data, structures, seed=args.seed, progress=False, workers=args.workers)

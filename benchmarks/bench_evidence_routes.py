@@ -20,13 +20,12 @@ import warnings
 import numpy as np
 
 from bayesfo.compare import compare
-from bayesfo.data import FrequencyResponse
 from bayesfo.errors import InputError
 from bayesfo.inference import Likelihood
 from bayesfo.inference._arviz import arviz
 from bayesfo.inference.evidence import nested_evidence
 from bayesfo.structures import resolve_structures
-from bayesfo.studies import OMEGA, g_spec, thesis_noise
+from bayesfo.studies import g_spec_data
 
 
 def main(argv=None):
@@ -38,9 +37,7 @@ def main(argv=None):
     warnings.simplefilter("ignore")
     arviz()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}")
-    noise = thesis_noise(np.random.default_rng(args.seed), 1)[0]
-    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance",
-                             name="G_spec + thesis noise")
+    data = g_spec_data(args.seed)
     print(f"{'structure':<12} {'bridge ln Z':>16} {'t [s]':>6} {'nested ln Z':>16} {'t [s]':>6} "
           f"{'diff':>6} {'comb.err':>8} converged", flush=True)
     for s in resolve_structures(args.structures):

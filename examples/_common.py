@@ -180,3 +180,17 @@ def comment_lines(path) -> list[str]:
             break
         lines.append(line[1:].strip())
     return lines
+
+
+def check_or_write_csv(path: Path, text: str, regenerate: bool, seed: int) -> Path:
+    """Write ``text`` to the data file ``path`` (``regenerate``, or when it is missing), or check
+    that the bundled file is exactly what the generator produces."""
+    if regenerate or not path.exists():
+        path.write_text(text, encoding="utf-8")
+        print(f"wrote {path}")
+    elif path.read_text(encoding="utf-8") != text:
+        raise SystemExit(f"{path} differs from what the generator produces; "
+                         "run with --regenerate to rewrite it")
+    else:
+        print(f"{path.relative_to(path.parents[2])} is what the generator produces (seed {seed})")
+    return path

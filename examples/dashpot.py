@@ -40,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 from _common import (
+    check_or_write_csv as _check_or_write_csv,
     comment_lines,
     make_parser,
     print_orders,
@@ -115,17 +116,8 @@ def csv_text(seed: int = GENERATOR_SEED) -> str:
 
 
 def check_or_write_csv(regenerate: bool) -> Path:
-    text = csv_text()
-    if regenerate or not CSV.exists():
-        CSV.write_text(text, encoding="utf-8")
-        print(f"wrote {CSV}")
-    elif CSV.read_text(encoding="utf-8") != text:
-        raise SystemExit(f"{CSV} differs from what the generator produces; "
-                         "run with --regenerate to rewrite it")
-    else:
-        print(f"{CSV.relative_to(HERE.parent)} is what the generator produces (seed "
-              f"{GENERATOR_SEED})")
-    return CSV
+    """Write the CSV (``regenerate``), or check that the bundled file is the generator's."""
+    return _check_or_write_csv(CSV, csv_text(), regenerate, GENERATOR_SEED)
 
 
 def main(argv=None) -> int:

@@ -23,8 +23,10 @@ SCENARIOS = {
     "voigt": ("voigt", [1.0, 1e-3, 0.5], "compliance", 0.02, "voigt,zener,max-n2m1"),
     "zener": ("zener", [20.0, 1e-3, 2e-4, 0.6], "compliance", 0.02, "voigt,zener,maxwell"),
     "integer": ("zener-int", [0.05, 1e-3, 1e-5], "compliance", 0.02, "zener,zener-int,voigt"),
-    # A dashpot-like response: (1 + a1 λ)/(b0 + b1 λ) with b0 → 0, an integrator with a zero.
-    "inverted": ("zener-inv", [2.0, 1e-6, 0.5, 0.9], "generic", 0.02, "voigt,zener,zener-inv"),
+    # A dashpot-like response (thesis §4.3.4, Table A.12): 1/(b0 + b1 λ + b2 λ²) with b0 → 0,
+    # an integrator with a lag; its phase passes −90°, which no non-inverted candidate reaches.
+    "inverted": ("max-n0m2-inv", [1e-3, 1.0, 0.2, 0.9], "generic", 0.02,
+                 "voigt,zener,maxwell,zener-inv,max-n0m2-inv"),
 }
 
 

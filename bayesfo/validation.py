@@ -53,8 +53,9 @@ def hit(scenario: str, result) -> bool:
     return best == SCENARIOS[scenario][0]
 
 
-def hit_rate(scenario: str, seeds) -> tuple[float, list[str]]:
-    """Share of seeds for which the comparison picks the truth, and the winner of each seed."""
+def hit_rate(scenario: str, seeds, *, workers: int = 1) -> tuple[float, list[str]]:
+    """Share of seeds for which the comparison picks the truth, and the winner of each seed
+    (``workers``: processes per comparison, see :func:`~bayesfo.compare.compare`)."""
     winners = []
     hits = 0
     candidates = resolve_structures(SCENARIOS[scenario][4])
@@ -62,7 +63,7 @@ def hit_rate(scenario: str, seeds) -> tuple[float, list[str]]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = compare(simulate(scenario, seed), candidates, seed=seed, progress=False,
-                             predictive=False)
+                             predictive=False, workers=workers)
         winners.append(result.ranking[0])
         hits += hit(scenario, result)
     return hits / len(winners), winners

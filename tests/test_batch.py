@@ -443,3 +443,18 @@ def test_command_line(reference, tmp_path, capsys):
     status, _, stderr = _run_cli(capsys, "batch", ADHESIVE / "Tp020C.csv", "--out", tmp_path,
                                  "--workers", "2", "--scheduler", "tcp://127.0.0.1:9")
     assert status == 2 and "--workers applies to local processes" in stderr
+
+
+def test_batch_figure_orders_isotherms_by_temperature():
+    import matplotlib.pyplot as plt
+
+    from bayesfo.plotting.batch import plot_batch_summary
+
+    rows = [{"dataset": d, "temperature_C": t, "status": "ok", "structure": "voigt",
+             "posterior_probability": 1.0, "best": True, "converged": True,
+             "q_mean": q, "q_hdi_low": q - 0.01, "q_hdi_high": q + 0.01}
+            for d, t, q in (("Tm010C", -10.0, 0.4), ("Tm040C", -40.0, 0.1), ("Tp020C", 20.0, 0.5))]
+    fig = plot_batch_summary(rows)
+    ax_q = fig.axes[1]
+    assert [t.get_text() for t in ax_q.get_xticklabels()] == ["Tm040C", "Tm010C", "Tp020C"]
+    plt.close(fig)

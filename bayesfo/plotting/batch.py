@@ -79,7 +79,8 @@ def plot_batch_summary(rows, structures=None, fig=None):
     prior odds; the name of the best structure above each bar). Bottom: the posterior mean of
     q (``beta`` for the generalised Maxwell model) with its 94 % HDI for every fractional
     structure, filled where the structure is the best on that data set, crossed where its
-    posterior did not converge. Data sets that failed are marked on the axis.
+    posterior did not converge. Data sets that failed are marked on the axis. Data sets are in
+    the order given, or in order of temperature when every one has a temperature.
 
     Parameters
     ----------
@@ -97,6 +98,10 @@ def plot_batch_summary(rows, structures=None, fig=None):
     """
     rows = list(rows)
     datasets = list(dict.fromkeys(r["dataset"] for r in rows))
+    temps = {r["dataset"]: r.get("temperature_C") for r in rows}
+    if all(temps[d] not in (None, "") for d in datasets):
+        # Isotherms: in order of temperature, not of name (Tm010C would precede Tm040C).
+        datasets.sort(key=lambda d: float(temps[d]))
     failed = {r["dataset"] for r in rows if r.get("status") != "ok"}
     structures = _structures_in_order(rows, structures)
     colours = _structure_colours(structures)

@@ -9,8 +9,12 @@ nested sampling, with a flag when the two disagree by more than twice their comb
 Structures are ranked by ln Z; posterior model probabilities assume equal prior odds unless
 given.
 
-Outputs (:func:`write_outputs`, each file written atomically): ``summary.json`` (the contract of
-DESIGN.md), ``ranking.csv``, and one ``<structure>.nc`` (arviz InferenceData) per structure.
+Structures run one after the other or side by side in worker processes (``workers``); each runs
+with the same seed, so the numbers do not depend on how many.
+
+Outputs (:func:`write_outputs`, each file written atomically): one ``<structure>.nc`` (arviz
+InferenceData) per structure, ``figures/`` and ``report.html`` (:mod:`bayesfo.plotting`,
+:mod:`bayesfo.report`), ``ranking.csv`` and ``summary.json`` (the contract of DESIGN.md), last.
 """
 
 from __future__ import annotations

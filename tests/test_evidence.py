@@ -83,14 +83,14 @@ def test_routes_agree_on_the_thesis_set_up():
 
     from bayesfo.compare import compare
     from bayesfo.structures import resolve_structures
-    from bayesfo.studies import OMEGA, g_spec, thesis_noise
+    from bayesfo.studies import g_spec_data
 
-    noise = thesis_noise(np.random.default_rng(0), 1)[0]
-    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+    data = g_spec_data(0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = compare(data, resolve_structures("voigt,zener,voigt-int,zener-int"), seed=0,
-                         progress=False, evidence_check=True)
+        result = compare(data, resolve_structures("voigt,zener,voigt-int,zener-int,max-n1m0,"
+                                                  "max-n1m1"), seed=0, progress=False,
+                         evidence_check=True, workers=2)
     for r in result.results:
         bridge, nested = r.criteria["evidence"], r.criteria["evidence_check"]
         assert abs(bridge.log_z - nested.log_z) < 0.3, r.name

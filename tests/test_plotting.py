@@ -311,6 +311,36 @@ def test_corner_marks_the_mode_and_the_optimum(comparison):
     assert drawn.axes[ndim * (ndim - 1)].get_xlabel().startswith("log$_{10}$")
     with pytest.raises(InputError, match="'fig'.*layout"):
         plot_corner(r, fig=plt.figure(layout="constrained"))
+    plt.close(drawn.figure)
+
+
+def test_corner_marks_the_linear_methods(comparison):
+    from bayesfo.identify.optimize import linear_fits
+
+    r = comparison["zener"]
+    fits = linear_fits(r.structure, comparison.data)
+    assert sorted(fits) == [f"method {k}" for k in range(1, 6)]
+    # Method 2 at a fixed q is an independent linear least-squares problem: check one entry.
+    assert 0.0 < fits["method 2"][-1] <= 1.0
+    drawn = plot_corner(r, linear=fits)
+    names = r.posterior.param_names
+    log = np.array([r.criteria["priors"][n]["prior"] == "log-uniform" for n in names])
+    k = r.structure.n_params
+    for row, label in zip(drawn.values["linear"], drawn.values["linear_labels"]):
+        theta = fits[label]
+        with np.errstate(invalid="ignore"):
+            expected = np.where(log[:k], np.log10(theta), theta)
+        np.testing.assert_allclose(row[:k] * drawn.values["factor"][:k], expected)
+        assert np.all(np.isnan(row[k:]))  # noise parameters have no linear fit
+    # The crosses are drawn in the lower-left panel of the first two parameters.
+    ndim = len(names)
+    panel = drawn.axes[1 * ndim + 0]
+    xy = np.concatenate([np.column_stack(line.get_data()) for line in panel.lines
+                         if line.get_marker() == "x"])
+    np.testing.assert_allclose(xy, drawn.values["linear"][:, [0, 1]])
+    labels = [t.get_text() for t in drawn.artists["legend"].get_texts()]
+    assert labels[-1] == "linear methods (5, best q each)"
+    plt.close(drawn.figure)
 
 
 def test_trace_shows_every_walker(comparison):

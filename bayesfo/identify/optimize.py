@@ -358,3 +358,39 @@ def linear_seeds(structure: Structure, data: FrequencyResponse, q_values=None,
             if np.all(np.isfinite(theta)):
                 seeds.append(theta)
     return np.array(seeds).reshape(-1, structure.n_params)
+
+
+def linear_fits(structure: Structure, data: FrequencyResponse) -> dict[str, np.ndarray]:
+    """The thesis' linear methods 1–5 on ``data``, each at its best stable q of the q grid
+    (thesis §4.3.2; q fixed for structures that fix it), as parameter vectors of ``structure``
+    in physical units: ``{"method 1": theta, ...}``. Methods without a stable fit are left
+    out; empty for structures that are not of the thesis form (e.g. the generalised Maxwell).
+    """
+    from .scan import fit_linear, q_grid_scan
+
+    degrees = thesis_degrees(structure)
+    if degrees is None:
+        return {}
+    n, m = degrees
+    out = {}
+    for method in (1, 2, 3, 4, 5):
+        if n == 0 and method != 1:
+            continue
+        try:
+            if "q" in structure.fixed:
+                fits = fit_linear(data, n, m, method, [float(structure.fixed["q"])],
+                                  inverted=structure.inverted)
+                best = fits[0] if fits and fits[0].stable else None
+            else:
+                best = q_grid_scan(data, n, m, method, inverted=structure.inverted).best
+        except InputError:
+            continue
+        if best is None:
+            continue
+        vals = {f"a{k}": best.a[k] for k in range(1, n + 1)}
+        vals.update({f"b{k}": best.b[k] for k in range(m + 1)})
+        vals["q"] = best.q
+        theta = np.array([vals[name] for name in structure.param_names], dtype=float)
+        if np.all(np.isfinite(theta)):
+            out[f"method {method}"] = theta
+    return out

@@ -8,6 +8,7 @@ import tempfile
 from pathlib import Path
 
 from ..errors import InputError
+from ..identify.optimize import linear_fits
 from ._compute import ok_results, order_parameter
 from .posterior import plot_corner, plot_q_posteriors, plot_trace
 from .ranking import plot_ranking
@@ -67,7 +68,8 @@ def figure_jobs(comparison, *, seed: int = 0) -> list[tuple[str, object]]:
     colors = colors_for(comparison.ranking)
     for r in ranked:
         stem = _file_stem(r.name)
-        jobs.append((f"corner_{stem}", lambda r=r: plot_corner(r, color=colors[r.name])))
+        jobs.append((f"corner_{stem}", lambda r=r: plot_corner(
+            r, color=colors[r.name], linear=linear_fits(r.structure, comparison.data))))
         jobs.append((f"trace_{stem}", lambda r=r: plot_trace(r, color=colors[r.name])))
     return jobs
 

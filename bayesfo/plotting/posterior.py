@@ -35,9 +35,10 @@ def _check_result(result, what: str = "result"):
         raise InputError(f"argument '{what}' has no posterior")
 
 
-def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30) -> Drawn:
-    """Corner plot (``corner.corner``) of one structure's posterior, with the posterior mode and
-    the least-squares optimum marked.
+def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
+                linear: dict | None = None) -> Drawn:
+    """Corner plot (``corner.corner``) of one structure's posterior, with the posterior mode,
+    the least-squares optimum and, when given, the linear methods' fits marked.
 
     Parameters are shown in the coordinates of the summaries' flags: log10 of parameters with
     a log-uniform prior (axis labels say so), the parameter itself otherwise, divided by a
@@ -55,6 +56,11 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30) -
         Colour of the draws (default the first of the palette).
     bins : int
         Histogram bins per parameter.
+    linear : dict, optional
+        ``{label: theta}`` of deterministic fits in physical units (e.g.
+        :func:`bayesfo.identify.optimize.linear_fits`: methods 1–5 at their best q), drawn as
+        small crosses in the two-dimensional panels; fits outside the plotted range (or with a
+        non-positive value of a log-uniform parameter) are not visible.
 
     Returns
     -------
@@ -63,8 +69,9 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30) -
         ``"samples"`` (n_draws, ndim) in the plotted coordinates, ``"map"`` (the draw of
         highest posterior density), ``"fit"`` (the least-squares optimum; NaN for noise
         parameters or when no admissible optimum was found), ``"range"`` (ndim, 2) and
-        ``"factor"`` (the divisor of each column: plotted = coordinate / factor).
-        ``artists``: ``"legend"``.
+        ``"factor"`` (the divisor of each column: plotted = coordinate / factor), and with
+        ``linear`` ``"linear"`` (k, ndim) in the plotted coordinates (NaN for noise
+        parameters) and ``"linear_labels"``. ``artists``: ``"legend"``.
 
     Raises
     ------
@@ -88,6 +95,12 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30) -
     if result.fit is not None and result.fit.admissible:
         k = result.structure.n_params
         fit[:k] = to_coordinates(result.fit.theta, is_log[:k]) / factor[:k]
+    lin_labels = list(linear or {})
+    lin = np.full((len(lin_labels), ndim), np.nan)
+    k = result.structure.n_params
+    for row, label in zip(lin, lin_labels):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            row[:k] = to_coordinates(np.asarray(linear[label], float), is_log[:k]) / factor[:k]
     ranges = []
     for i in range(ndim):
         lo, hi = np.quantile(samples[:, i], [0.0005, 0.9995])
@@ -120,6 +133,10 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30) -
                 pts = np.where(np.isfinite(x), x, np.nan)[None, :]
                 corner.overplot_points(fig, pts, marker=m, color=c, ms=4, mec="white", mew=0.4)
             handles.append(Line2D([], [], color=c, ls=ls, lw=0.9, marker=m, ms=4, label=label))
+        if lin_labels and ndim > 1:
+            corner.overplot_points(fig, lin, marker="x", color=FIT_COLOR, ms=3.5, mew=0.8)
+            handles.append(Line2D([], [], color=FIT_COLOR, ls="", marker="x", ms=3.5, mew=0.8,
+                                  label=f"linear methods ({len(lin_labels)}, best q each)"))
         # corner's margins scale with its 2-inch panels; ticks and labels need fixed room.
         w, h = fig.get_size_inches()
         fig.subplots_adjust(left=0.72 / w, bottom=0.72 / h, right=1 - 0.08 / w,
@@ -133,9 +150,11 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30) -
                             title=title, alignment="left")
         if not post.converged:
             legend.get_title().set_color(FLAG_COLOR)
-    return Drawn.build(fig, fig.axes, {"samples": samples, "map": mode, "fit": fit,
-                                       "range": np.array(ranges), "factor": factor},
-                       {"legend": legend})
+    values = {"samples": samples, "map": mode, "fit": fit, "range": np.array(ranges),
+              "factor": factor}
+    if lin_labels:
+        values.update(linear=lin, linear_labels=tuple(lin_labels))
+    return Drawn.build(fig, fig.axes, values, {"legend": legend})
 
 
 def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:

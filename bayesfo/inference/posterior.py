@@ -201,8 +201,8 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
 
     ``seeds_scaled`` holds structure parameters (without noise) on the scaled problem. Seeds whose
     best log-likelihood is more than ``mode_window`` below the best seed are dropped; the rest
-    share the walkers round-robin, each walker a Gaussian jitter of relative size ``jitter`` in
-    the sampling coordinates, redrawn until it lies in the support.
+    share the walkers round-robin, each walker a Gaussian jitter of relative size up to
+    ``jitter`` in the sampling coordinates that lies in the support.
     """
     seeds = np.atleast_2d(np.asarray(seeds_scaled, dtype=float))
     if lik.noise_param:
@@ -240,17 +240,23 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
     keep = ll >= ll.max() - mode_window
     seeds = seeds[keep][np.argsort(-ll[keep])]
     u_seeds = tr.to_u(seeds)
+    # Jittered copies of every seed, the jitter shrinking from ``jitter`` to 1e-4 of it: a seed
+    # on the boundary of the support (a coefficient at zero, q at its bound) keeps only the
+    # copies on the inner side, so many are drawn at once and the walkers take distinct ones.
+    n_try = 64 * (n_walkers // len(u_seeds) + 1)
+    pools = []
+    for base in u_seeds:
+        scale = jitter * np.logspace(0, -4, n_try)[:, None] * (1.0 + np.abs(base))
+        cand = tr.to_theta(base + scale * rng.normal(size=(n_try, base.size)))
+        pools.append(cand[lik.in_support(cand)])
+    pools = [p for p in pools if len(p)] or [tr.to_theta(u_seeds)]
     out = np.empty((n_walkers, lik.ndim))
+    used = [0] * len(pools)
     for i in range(n_walkers):
-        base = u_seeds[i % len(u_seeds)]
-        for _ in range(100):
-            u = base + jitter * (1.0 + np.abs(base)) * rng.normal(size=base.size)
-            theta = tr.to_theta(u)
-            if lik.in_support(theta[None, :])[0]:
-                break
-        else:
-            theta = tr.to_theta(base)
-        out[i] = theta
+        k = i % len(pools)
+        pool = pools[k]
+        out[i] = pool[used[k] % len(pool)]
+        used[k] += 1
     return out
 
 

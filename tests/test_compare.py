@@ -103,6 +103,9 @@ def test_interrupted_write_leaves_no_summary(voigt_comparison, tmp_path, monkeyp
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
+# Whether PSIS-LOO flags the lowest frequency of these 17 points (Pareto k near 0.7) depends on
+# the draws; this test is about the command's outputs, so that warning is not an error here.
+@pytest.mark.filterwarnings("ignore::bayesfo.compare.PredictiveWarning")
 def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
     out = tmp_path / "adhesive"
     status, stdout, err = run_cli("compare", ADHESIVE, "--structures", "voigt,zener-int",

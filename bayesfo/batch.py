@@ -65,7 +65,6 @@ import time
 import traceback
 import warnings
 from concurrent.futures import FIRST_COMPLETED, wait
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -122,7 +121,6 @@ _FORMAT = 1  # version of batch.json
 
 # BLAS/OpenMP thread pools of the worker processes: one thread each, as the workers already use
 # the cores (set before the worker imports numpy, unless the user set them).
-_WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
 # ====================================================================== data sets
@@ -1030,29 +1028,6 @@ def write_batch_outputs(result_rows, out_dir, structures=None) -> dict[str, Path
 
 
 # ====================================================================== executors
-@contextmanager
-def _worker_environment():
-    """Single-threaded BLAS in the worker processes spawned inside this block."""
-    saved = {k: os.environ.get(k) for k in _WORKER_ENV}
-    for k, v in _WORKER_ENV.items():
-        os.environ.setdefault(k, v)
-    try:
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
-def _available_cpus() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
 def _run_in_process(todo, on_result):
     for ds in todo:
         on_result(ds, run_task(ds.task()))
@@ -1065,7 +1040,9 @@ def _run_processes(todo, workers, on_result):
     pool = ProcessPoolExecutor(max_workers=workers,
                                mp_context=multiprocessing.get_context("spawn"))
     try:
-        with _worker_environment():  # processes are spawned while tasks are submitted
+        from .compare import worker_environment
+
+        with worker_environment():  # processes are spawned while tasks are submitted
             futures = {pool.submit(run_task, ds.task()): ds for ds in todo}
         pending = set(futures)
         while pending:
@@ -1206,7 +1183,9 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
                 if own:
                     client.close()
         else:
-            n = min(workers or _available_cpus(), len(todo))
+            from .compare import available_cpus
+
+            n = min(workers or available_cpus(), len(todo))
             if n == 1:
                 executor = "in-process"
                 _run_in_process(todo, on_result)

@@ -26,6 +26,7 @@ import math
 import os
 import sys
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -41,6 +42,34 @@ from .inference._arviz import arviz
 from .structures import Structure
 
 PARETO_K_WARN = 0.7
+
+#: Environment of worker processes: one BLAS thread each (the processes share the cores).
+WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+def available_cpus() -> int:
+    """CPUs this process may run on (its affinity where the system tells it)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+@contextmanager
+def worker_environment():
+    """Single-threaded BLAS in the worker processes spawned inside this block (a variable the
+    user has set is kept)."""
+    saved = {k: os.environ.get(k) for k in WORKER_ENV}
+    for k, v in WORKER_ENV.items():
+        os.environ.setdefault(k, v)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 class PredictiveWarning(UserWarning):
@@ -362,7 +391,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         data, test = data.split(holdout)
     if progress is None:
         progress = sys.stderr.isatty()
-    n_proc = min(os.cpu_count() or 1, len(structures)) if workers == 0 else min(workers, len(structures))
+    n_proc = min(workers or available_cpus(), len(structures))
     options = {"noise": noise, "priors": priors, "seed": seed, "evidence_check": evidence_check,
                "test": test, "sampler_kwargs": sampler_kwargs}
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
@@ -378,7 +407,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         # spawn: no fork of a process that may hold threads (BLAS, tqdm); each structure gets
         # the same seed whatever the worker count, so the numbers do not depend on it.
         ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(n_proc, mp_context=ctx) as pool:
+        with worker_environment(), ProcessPoolExecutor(n_proc, mp_context=ctx) as pool:
             # Larger structures first (they take longest); results keep the order given.
             order = sorted(range(len(structures)), key=lambda i: -structures[i].n_params)
             futures = {i: pool.submit(_run_structure, structures[i], data, options) for i in order}

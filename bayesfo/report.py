@@ -8,7 +8,7 @@ URIs and the style sheet is inline, so the file needs nothing else to be read or
 text from data, files and results is escaped.
 
 This module does not draw: it takes the figure files written by
-:func:`bayesfo.plotting.write_figures` (and does not import matplotlib).
+:func:`bayesfo.plotting.write_figures`, so it needs no plotting library.
 
 References
 ----------

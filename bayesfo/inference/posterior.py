@@ -228,14 +228,12 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
         best = draws[np.argsort(-lik(draws))[:8]]
         anchor = best[0]
     # A seed just outside the support (e.g. an optimum with a slightly unstable root when the
-    # truth lies on the stability boundary) is moved onto the boundary, along the segment from
-    # the best admissible point, so its mode is not lost.
+    # truth lies on the stability boundary) is moved onto the boundary (see _into_support), so
+    # its mode is not lost.
     repaired = [_into_support(lik, tr, theta, anchor) for theta in seeds[~ok]]
     seeds = np.vstack([seeds[ok], *[r[None, :] for r in repaired if r is not None]])
     if not ok.any():
         seeds = np.vstack([seeds, best])
-    ok = np.ones(len(seeds), dtype=bool)
-    seeds = seeds[ok]
     ll = lik(seeds)
     keep = ll >= ll.max() - mode_window
     seeds = seeds[keep][np.argsort(-ll[keep])]
@@ -250,14 +248,9 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
         cand = tr.to_theta(base + scale * rng.normal(size=(n_try, base.size)))
         pools.append(cand[lik.in_support(cand)])
     pools = [p for p in pools if len(p)] or [tr.to_theta(u_seeds)]
-    out = np.empty((n_walkers, lik.ndim))
-    used = [0] * len(pools)
-    for i in range(n_walkers):
-        k = i % len(pools)
-        pool = pools[k]
-        out[i] = pool[used[k] % len(pool)]
-        used[k] += 1
-    return out
+    # Round-robin over the seeds; walker i takes copy i // len(pools) of its seed's pool.
+    return np.array([pools[i % len(pools)][(i // len(pools)) % len(pools[i % len(pools)])]
+                     for i in range(n_walkers)])
 
 
 def _into_support(lik: Likelihood, tr: _Transform, theta, anchor, *, steps: int = 40):

@@ -71,8 +71,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--workers", type=int, default=0, metavar="N",
-                   help="processes running structures side by side (default 0: one per CPU); "
-                        "the numbers do not depend on it")
+                   help="processes running structures side by side and then drawing the figures "
+                        "(default 0: one per CPU); the numbers do not depend on it")
     p.add_argument("--no-figures", action="store_true",
                    help="skip the figures and report.html (faster; summary, table and NetCDF only)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
@@ -229,7 +229,7 @@ def _parse_priors(specs) -> dict:
 
 
 def cmd_compare(args) -> int:
-    from .compare import compare, write_outputs
+    from .compare import available_cpus, compare, process_pool, write_outputs
     from .structures import resolve_structures
 
     data = _read(args)
@@ -241,11 +241,21 @@ def cmd_compare(args) -> int:
         raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
     out = Path(args.out) if args.out else Path(f"bayesfo-{Path(args.data).stem}")
     progress = not args.quiet and sys.stderr.isatty()
-    result = compare(data, structures, noise=args.noise, seed=args.seed, priors=priors,
-                     progress=progress, evidence_check=args.evidence_check,
-                     holdout=_parse_floats(args.holdout, "--holdout") if args.holdout else None,
-                     workers=args.workers)
-    write_outputs(result, out, figures=not args.no_figures)
+    holdout = _parse_floats(args.holdout, "--holdout") if args.holdout else None
+    options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
+                   evidence_check=args.evidence_check, holdout=holdout)
+    if args.workers < 0:
+        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
+    n_proc = min(args.workers or available_cpus(), len(structures))
+    if n_proc > 1:
+        # One pool for the structures and then the figures: its processes have the libraries
+        # loaded by the time they draw.
+        with process_pool(n_proc) as pool:
+            result = compare(data, structures, pool=pool, **options)
+            write_outputs(result, out, figures=not args.no_figures, pool=pool)
+    else:
+        result = compare(data, structures, workers=1, **options)
+        write_outputs(result, out, figures=not args.no_figures)
     if not args.quiet:
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"

@@ -72,6 +72,33 @@ def worker_environment():
                 os.environ[k] = v
 
 
+@contextmanager
+def process_pool(workers: int = 0):
+    """Worker processes (spawn, one BLAS thread each) that :func:`compare` and
+    :func:`write_outputs` can share through their ``pool`` argument: the figures are then drawn
+    by processes that have already loaded the libraries.
+
+    Parameters
+    ----------
+    workers : int
+        Number of processes (0: one per CPU).
+
+    Yields
+    ------
+    concurrent.futures.ProcessPoolExecutor
+    """
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    # spawn: no fork of a process that may hold threads (BLAS, tqdm).
+    ctx = multiprocessing.get_context("spawn")
+    with worker_environment(), ProcessPoolExecutor(workers or available_cpus(),
+                                                   mp_context=ctx) as pool:
+        yield pool
+
+
 class PredictiveWarning(UserWarning):
     """PSIS-LOO is unreliable for some frequency (Pareto k above 0.7)."""
 
@@ -341,7 +368,7 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
             priors=None, progress: bool | None = None, evidence_check: bool = False,
-            prior_odds: dict | None = None, holdout=None, workers: int = 1,
+            prior_odds: dict | None = None, holdout=None, workers: int = 1, pool=None,
             **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
@@ -367,6 +394,9 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     workers : int
         Processes running structures side by side (0: one per CPU). The numbers do not depend
         on it: every structure runs with ``seed``.
+    pool : concurrent.futures.Executor, optional
+        Run the structures in this pool instead (from :func:`process_pool`; ``workers`` is then
+        ignored).
     **sampler_kwargs
         Passed to :func:`~bayesfo.inference.posterior.sample_posterior` (e.g. ``max_steps``).
 
@@ -395,25 +425,18 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     options = {"noise": noise, "priors": priors, "seed": seed, "evidence_check": evidence_check,
                "test": test, "sampler_kwargs": sampler_kwargs}
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
-    if n_proc <= 1:
+    if pool is None and n_proc <= 1:
         outcomes = []
         for s in structures:
             outcomes.append(_run_structure(s, data, options))
             bar.update()
+    elif pool is not None:
+        outcomes = _run_in_pool(pool, structures, data, options, bar)
     else:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
-
-        # spawn: no fork of a process that may hold threads (BLAS, tqdm); each structure gets
-        # the same seed whatever the worker count, so the numbers do not depend on it.
-        ctx = multiprocessing.get_context("spawn")
-        with worker_environment(), ProcessPoolExecutor(n_proc, mp_context=ctx) as pool:
-            # Larger structures first (they take longest); results keep the order given.
-            order = sorted(range(len(structures)), key=lambda i: -structures[i].n_params)
-            futures = {i: pool.submit(_run_structure, structures[i], data, options) for i in order}
-            for f in futures.values():
-                f.add_done_callback(lambda _: bar.update())
-            outcomes = [futures[i].result() for i in range(len(structures))]
+        # Each structure gets the same seed whatever the worker count, so the numbers do not
+        # depend on it.
+        with process_pool(n_proc) as own:
+            outcomes = _run_in_pool(own, structures, data, options, bar)
     bar.close()
     results = []
     for result, caught in outcomes:
@@ -425,6 +448,15 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
     _model_probabilities(results, prior_odds or {})
     return Comparison(data, tuple(results), seed, holdout=test)
+
+
+def _run_in_pool(pool, structures, data, options, bar) -> list:
+    # Larger structures first (they take longest); results keep the order given.
+    order = sorted(range(len(structures)), key=lambda i: -structures[i].n_params)
+    futures = {i: pool.submit(_run_structure, structures[i], data, options) for i in order}
+    for f in futures.values():
+        f.add_done_callback(lambda _: bar.update())
+    return [futures[i].result() for i in range(len(structures))]
 
 
 def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
@@ -559,7 +591,7 @@ def _finite(obj):
 
 
 def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
-                  formats=("png", "pdf")) -> dict[str, Path]:
+                  formats=("png", "pdf"), pool=None) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
     One NetCDF per structure, the figures (``formats``; see
@@ -577,6 +609,8 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         Draw the figures and the report (matplotlib; a few seconds per structure).
     formats : sequence of str
         Figure file formats.
+    pool : concurrent.futures.Executor, optional
+        Draw the figures in these worker processes (from :func:`process_pool`).
 
     Returns
     -------
@@ -594,7 +628,7 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         from .report import write_report
 
         drawn = write_figures(comparison, out_dir / "figures", formats=formats,
-                              seed=comparison.seed)
+                              seed=comparison.seed, pool=pool)
         written.update(drawn)
         written["report.html"] = write_report(comparison, out_dir, drawn)
     written["ranking.csv"] = atomic_write_text(out_dir / "ranking.csv", ranking_csv(comparison))

@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from bayesfo.compare import compare, write_outputs
+from bayesfo.compare import compare, process_pool, write_outputs
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
 from bayesfo.inference._arviz import arviz
@@ -38,12 +38,14 @@ def main():
     data = FrequencyResponse(w, g + sd / np.sqrt(2) * (rng.normal(size=40) + 1j * rng.normal(size=40)),
                              sd, kind="modulus", units="Pa")
     # What `bayesfo compare --structures zener,voigt` does: both structures side by side on the
-    # two cores, then the NetCDF files, the figures (PNG and PDF), report.html and summary.json.
+    # two cores, then the NetCDF files, the figures (PNG and PDF, drawn by the same two processes),
+    # report.html and summary.json.
     t = time.perf_counter()
-    result = compare(data, resolve_structures("zener,voigt"), seed=0, progress=False, workers=2)
-    t_posteriors = time.perf_counter() - t
-    with tempfile.TemporaryDirectory() as out:
-        write_outputs(result, out)
+    with process_pool(2) as pool, tempfile.TemporaryDirectory() as out:
+        result = compare(data, resolve_structures("zener,voigt"), seed=0, progress=False,
+                         pool=pool)
+        t_posteriors = time.perf_counter() - t
+        write_outputs(result, out, pool=pool)
     t_compare = time.perf_counter() - t
     print(f"compare zener,voigt: {t_posteriors:.1f} s for optimisation, posteriors, evidence and "
           f"criteria (2 processes), {t_compare - t_posteriors:.1f} s for figures and report")

@@ -391,3 +391,15 @@ def test_write_figures_single_structure_and_formats(comparison, tmp_path):
     assert all([p.suffix for p in paths] == [".png", ".svg"] for paths in written.values())
     with pytest.raises(InputError, match="'formats'.*'xyz'"):
         write_figures(single, tmp_path, formats=("png", "xyz"))
+
+
+def test_write_figures_in_worker_processes_gives_the_same_files(comparison, tmp_path):
+    from bayesfo.compare import process_pool
+
+    serial = write_figures(comparison, tmp_path / "serial", formats=("png",))
+    with process_pool(2) as pool:
+        pooled = write_figures(comparison, tmp_path / "pooled", formats=("png",), pool=pool)
+    assert list(pooled) == list(serial)
+    for name, paths in serial.items():
+        # Agg renders the same pixels in any process: the figures are the same figures.
+        assert pooled[name][0].read_bytes() == paths[0].read_bytes(), name

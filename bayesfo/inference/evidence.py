@@ -174,11 +174,17 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
     )
 
 
-def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: float = 0.1) -> Evidence:
+def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: float = 0.1,
+                    sample: str = "rslice") -> Evidence:
     """ln Z by static nested sampling with dynesty on the same prior and likelihood.
 
     The prior transform maps the unit cube through each prior's quantile function; points
     outside the support get log-likelihood −inf.
+
+    ``sample`` is dynesty's way of drawing a new live point. The default, random-direction
+    slice sampling (``"rslice"``), follows the thin curved ridges of the over-parameterised
+    max-order members (near pole–zero cancellations), where dynesty's default for few
+    dimensions (uniform draws from bounding ellipsoids) accepts almost nothing.
     """
     import dynesty
 
@@ -196,7 +202,8 @@ def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: 
         return value if np.isfinite(value) else -np.inf
 
     rng = np.random.default_rng(seed)
-    sampler = dynesty.NestedSampler(loglike, prior_transform, lik.ndim, nlive=nlive, rstate=rng)
+    sampler = dynesty.NestedSampler(loglike, prior_transform, lik.ndim, nlive=nlive, sample=sample,
+                                    rstate=rng)
     sampler.run_nested(dlogz=dlogz, print_progress=False)
     res = sampler.results
     log_s, log_s_err = log_support_fraction(lik, np.random.default_rng(seed + 1))

@@ -53,28 +53,79 @@ def _check_formats(formats) -> tuple[str, ...]:
     return formats
 
 
+#: Figures drawn from the whole comparison, in the order they are written.
+COMBINED = ("ranking", "bode", "nyquist", "residuals", "q_posteriors")
+
+
+def _combined_makers(comparison, seed: int) -> dict:
+    makers = {
+        "ranking": lambda: plot_ranking(comparison),
+        "bode": lambda: plot_bode(comparison, seed=seed),
+        "nyquist": lambda: plot_nyquist(comparison, seed=seed),
+        "residuals": lambda: plot_residuals(comparison, seed=seed),
+    }
+    if any(order_parameter(r) is not None for r in ok_results(comparison)):
+        makers["q_posteriors"] = lambda: plot_q_posteriors(comparison)
+    return makers
+
+
+def _structure_makers(result, data, color) -> dict:
+    stem = _file_stem(result.name)
+    return {
+        f"corner_{stem}": lambda: plot_corner(result, color=color,
+                                              linear=linear_fits(result.structure, data)),
+        f"trace_{stem}": lambda: plot_trace(result, color=color),
+    }
+
+
 def figure_jobs(comparison, *, seed: int = 0) -> list[tuple[str, object]]:
     """``(name, make)`` for every figure of a comparison, ``make()`` returning a
     :class:`~bayesfo.plotting.Drawn`; structures that failed are left out."""
-    jobs = [
-        ("ranking", lambda: plot_ranking(comparison)),
-        ("bode", lambda: plot_bode(comparison, seed=seed)),
-        ("nyquist", lambda: plot_nyquist(comparison, seed=seed)),
-        ("residuals", lambda: plot_residuals(comparison, seed=seed)),
-    ]
-    ranked = ok_results(comparison)
-    if any(order_parameter(r) is not None for r in ranked):
-        jobs.append(("q_posteriors", lambda: plot_q_posteriors(comparison)))
+    jobs = list(_combined_makers(comparison, seed).items())
     colors = colors_for(comparison.ranking)
-    for r in ranked:
-        stem = _file_stem(r.name)
-        jobs.append((f"corner_{stem}", lambda r=r: plot_corner(
-            r, color=colors[r.name], linear=linear_fits(r.structure, comparison.data))))
-        jobs.append((f"trace_{stem}", lambda r=r: plot_trace(r, color=colors[r.name])))
+    for r in ok_results(comparison):
+        jobs.extend(_structure_makers(r, comparison.data, colors[r.name]).items())
     return jobs
 
 
-def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0
+def _save_all(makers: dict, out_dir: Path, formats) -> dict[str, list[Path]]:
+    """Draw each figure of ``makers`` and write it in every format."""
+    import matplotlib.pyplot as plt
+
+    written = {}
+    for name, make in makers.items():
+        drawn = make()
+        try:
+            paths = [out_dir / f"{name}.{fmt}" for fmt in formats]
+            with style():
+                for i, path in enumerate(paths):
+                    save_figure(drawn.figure, path)
+                    if i == 0 and drawn.figure.get_layout_engine() is not None:
+                        # The layout of the first format holds for the others: computing it
+                        # again is a third of the drawing time.
+                        drawn.figure.set_layout_engine("none")
+            written[name] = paths
+        finally:
+            plt.close(drawn.figure)
+    return written
+
+
+def _draw_in_worker(task: tuple, out_dir: Path, formats, seed: int) -> dict[str, list[Path]]:
+    """One task of a worker process: ``("combined", comparison, names)`` or
+    ``("structure", result, data, color)``."""
+    import matplotlib
+
+    matplotlib.use("agg")  # a worker never shows a window
+    if task[0] == "combined":
+        _, comparison, names = task
+        makers = {k: v for k, v in _combined_makers(comparison, seed).items() if k in names}
+    else:
+        _, result, data, color = task
+        makers = _structure_makers(result, data, color)
+    return _save_all(makers, out_dir, formats)
+
+
+def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0, pool=None
                   ) -> dict[str, list[Path]]:
     """Draw every figure of a comparison and write each in every format.
 
@@ -93,6 +144,10 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0
         File formats matplotlib can write (``png``, ``pdf``, ``svg``, …).
     seed : int
         Seed of the posterior draws behind the response figures.
+    pool : concurrent.futures.Executor, optional
+        Worker processes that draw the figures side by side (e.g.
+        :func:`bayesfo.compare.process_pool`): the combined figures in two tasks, the figures
+        of each structure in one. The files are the same as drawn here.
 
     Returns
     -------
@@ -104,23 +159,21 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0
     InputError
         If ``formats`` is empty or names a format matplotlib cannot write.
     """
-    import matplotlib.pyplot as plt
-
     formats = _check_formats(formats)
     out_dir = Path(out_dir)
-    written: dict[str, list[Path]] = {}
-    for name, make in figure_jobs(comparison, seed=seed):
-        drawn = make()
-        try:
-            paths = [out_dir / f"{name}.{fmt}" for fmt in formats]
-            with style():
-                for i, path in enumerate(paths):
-                    save_figure(drawn.figure, path)
-                    if i == 0 and drawn.figure.get_layout_engine() is not None:
-                        # The layout of the first format holds for the others: computing it
-                        # again is a third of the drawing time.
-                        drawn.figure.set_layout_engine("none")
-            written[name] = paths
-        finally:
-            plt.close(drawn.figure)
-    return written
+    if pool is None:
+        written: dict[str, list[Path]] = {}
+        for name, make in figure_jobs(comparison, seed=seed):
+            written.update(_save_all({name: make}, out_dir, formats))
+        return written
+    order = [name for name, _ in figure_jobs(comparison, seed=seed)]
+    combined = [name for name in order if name in COMBINED]
+    colors = colors_for(comparison.ranking)
+    # Per-structure tasks carry one result only; the combined figures need all of them.
+    tasks = [("structure", r, comparison.data, colors[r.name]) for r in ok_results(comparison)]
+    tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
+    futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed) for t in reversed(tasks)]
+    drawn = {}
+    for f in futures:
+        drawn.update(f.result())
+    return {name: drawn[name] for name in order}

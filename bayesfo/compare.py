@@ -522,7 +522,11 @@ def _evidence(lik, post, seed, check: bool) -> dict:
     if not post.converged:
         out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
     if check:
-        nested = nested_evidence(lik, seed=seed)
+        # Uniform draws from bounding ellipsoids where emcee found one compact mode; slice
+        # sampling where it did not converge (ridges, several modes), on which uniform draws
+        # stall (see nested_evidence).
+        how = {} if post.converged else {"sample": "rslice", "slices": max(25, 5 * lik.ndim)}
+        nested = nested_evidence(lik, seed=seed, **how)
         out["evidence_check"] = nested
         combined = math.hypot(out["evidence"].log_z_err, nested.log_z_err)
         agree = abs(out["evidence"].log_z - nested.log_z) <= 2 * combined

@@ -95,3 +95,25 @@ def test_routes_agree_on_the_thesis_set_up():
         bridge, nested = r.criteria["evidence"], r.criteria["evidence_check"]
         assert abs(bridge.log_z - nested.log_z) < 0.3, r.name
         assert r.criteria["evidence_agree"]
+
+
+def test_bridge_proposal_finds_the_components_of_a_mixture():
+    from bayesfo.inference.evidence import _GaussianMixture
+
+    rng = np.random.default_rng(5)
+    # Two well separated normal clusters, 70/30, in three dimensions.
+    a = rng.normal([0, 0, 0], [1.0, 0.5, 0.2], size=(1400, 3))
+    b = rng.normal([8, -4, 1], [0.3, 0.3, 0.3], size=(600, 3))
+    mix = _GaussianMixture.fit(np.vstack([a, b]), rng)
+    assert len(mix.weights) == 2
+    order = np.argsort(mix.means[:, 0])
+    assert mix.weights[order] == pytest.approx([0.7, 0.3], abs=0.01)
+    # Its density is the weighted sum of the fitted normals (independent computation).
+    x = rng.normal(size=(50, 3)) * 3
+    expected = sum(w * stats.multivariate_normal(m, c @ c.T).pdf(x)
+                   for w, m, c in zip(mix.weights, mix.means, mix.chols, strict=True))
+    assert np.allclose(np.exp(mix.log_pdf(x)), expected, rtol=1e-10, atol=1e-300)
+    draws = mix.sample(20_000, rng)
+    assert np.mean(draws[:, 0] > 4) == pytest.approx(0.3, abs=0.01)
+    # One compact cloud stays one normal.
+    assert len(_GaussianMixture.fit(a, rng).weights) == 1

@@ -2,8 +2,9 @@
 
 ``bridge_evidence``
     Bridge sampling (Meng and Wong 1996, in the iterative form of Gronau et al. 2017) from the
-    emcee posterior draws: a multivariate normal proposal fitted to half of the draws (in the
-    sampling coordinates, log for log-uniform priors), the other half and as many proposal
+    emcee posterior draws: a proposal fitted to half of the draws (in the sampling coordinates,
+    log for log-uniform priors; a mixture of multivariate normals on k-means clusters, k chosen
+    by BIC, one normal for a compact posterior), the other half and as many proposal
     draws in the bridge, and the relative mean-squared error of Frühwirth-Schnatter (2004)
     with the autocorrelation of the draws taken into account through their effective size.
 ``nested_evidence``
@@ -89,6 +90,64 @@ def _ess(x: np.ndarray) -> float:
     return float(arviz().ess(x))
 
 
+@dataclass(frozen=True)
+class _GaussianMixture:
+    """Proposal of bridge sampling: a mixture of multivariate normals fitted to posterior draws.
+
+    A single normal is a poor proposal for posteriors with several modes (the q ↔ q/2 modes
+    of max-order members) or a curved ridge; k-means clusters (k = 1 … 4, chosen by BIC on the
+    draws it is fitted to) each get their mean and covariance.
+    """
+
+    weights: np.ndarray
+    means: np.ndarray
+    chols: np.ndarray
+
+    @classmethod
+    def fit(cls, x: np.ndarray, rng: np.random.Generator, max_components: int = 4):
+        from scipy.cluster.vq import kmeans2
+
+        n, d = x.shape
+        scale = x.std(axis=0)
+        scale = np.where(scale > 0, scale, 1.0)
+        best, best_bic = None, np.inf
+        for k in range(1, max_components + 1):
+            if k == 1:
+                labels = np.zeros(n, dtype=int)
+            else:
+                _, labels = kmeans2(x / scale, k, seed=rng, minit="++")
+            counts = np.bincount(labels, minlength=k)
+            if np.any(counts < 5 * d):  # too few draws for a covariance
+                break
+            means = np.array([x[labels == j].mean(axis=0) for j in range(k)])
+            chols = []
+            for j in range(k):
+                cov = np.atleast_2d(np.cov(x[labels == j], rowvar=False))
+                cov = cov + 1e-12 * np.diag(np.diag(cov) + 1e-300)
+                chols.append(np.linalg.cholesky(cov))
+            mix = cls(counts / n, means, np.array(chols))
+            n_params = k * (d + d * (d + 1) / 2) + k - 1
+            bic = -2 * float(np.sum(mix.log_pdf(x))) + n_params * math.log(n)
+            if bic < best_bic:
+                best, best_bic = mix, bic
+        return best
+
+    def log_pdf(self, x: np.ndarray) -> np.ndarray:
+        d = x.shape[1]
+        terms = []
+        for w, mean, chol in zip(self.weights, self.means, self.chols, strict=True):
+            z = np.linalg.solve(chol, (x - mean).T)
+            log_det = 2 * np.sum(np.log(np.diag(chol)))
+            terms.append(math.log(w) - 0.5 * np.sum(z * z, axis=0) - 0.5 * log_det
+                         - 0.5 * d * math.log(2 * math.pi))
+        return logsumexp(np.array(terms), axis=0)
+
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        which = rng.choice(len(self.weights), size=n, p=self.weights)
+        z = rng.standard_normal((n, self.means.shape[1]))
+        return self.means[which] + np.einsum("nij,nj->ni", self.chols[which], z)
+
+
 def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 0,
                     max_iter: int = 1000, tol: float = 1e-10) -> Evidence:
     """ln Z by bridge sampling from the posterior draws of ``posterior``.
@@ -118,18 +177,11 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
     bridge_half = draws[:, 1::2].reshape(-1, u.shape[1])
     if bridge_half.shape[0] < 10 * u.shape[1]:
         raise InputError("too few posterior draws for bridge sampling")
-    mean = fit_half.mean(axis=0)
-    cov = np.atleast_2d(np.cov(fit_half, rowvar=False))
-    cov = cov + 1e-12 * np.diag(np.diag(cov) + 1e-300)
-    chol = np.linalg.cholesky(cov)
+    mixture = _GaussianMixture.fit(fit_half, rng)
     n1 = bridge_half.shape[0]
     n2 = n1
-    proposal = mean + rng.standard_normal((n2, u.shape[1])) @ chol.T
-    log_det = 2 * np.sum(np.log(np.diag(chol)))
-
-    def log_g(x):
-        z = np.linalg.solve(chol, (x - mean).T)
-        return -0.5 * np.sum(z * z, axis=0) - 0.5 * log_det - 0.5 * x.shape[1] * math.log(2 * math.pi)
+    proposal = mixture.sample(n2, rng)
+    log_g = mixture.log_pdf
 
     l1 = log_q(bridge_half) - log_g(bridge_half)
     l2 = log_q(proposal) - log_g(proposal)
@@ -175,16 +227,19 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
 
 
 def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: float = 0.1,
-                    sample: str = "rslice") -> Evidence:
+                    sample: str = "unif", slices: int | None = None) -> Evidence:
     """ln Z by static nested sampling with dynesty on the same prior and likelihood.
 
     The prior transform maps the unit cube through each prior's quantile function; points
     outside the support get log-likelihood −inf.
 
-    ``sample`` is dynesty's way of drawing a new live point. The default, random-direction
-    slice sampling (``"rslice"``), follows the thin curved ridges of the over-parameterised
-    max-order members (near pole–zero cancellations), where dynesty's default for few
-    dimensions (uniform draws from bounding ellipsoids) accepts almost nothing.
+    ``sample`` is dynesty's way of drawing a new live point: ``"unif"`` (the default) draws
+    uniformly from the bounding ellipsoids, exactly from the constrained prior while they enclose
+    it; on the thin curved ridges of over-parameterised structures (near pole–zero
+    cancellations) it accepts almost nothing and may take hours. ``"rslice"`` (random-direction
+    slice sampling) follows such ridges; it needs ``slices`` well above dynesty's default of
+    3 + ndim, which gives ln Z too low by 0.5–1.3 nats on the thesis' G_spec data (measured:
+    ``benchmarks/bench_evidence_routes.py``); 25 slices give the values of uniform draws.
     """
     import dynesty
 
@@ -202,8 +257,9 @@ def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: 
         return value if np.isfinite(value) else -np.inf
 
     rng = np.random.default_rng(seed)
+    kwargs = {} if slices is None else {"slices": int(slices)}
     sampler = dynesty.NestedSampler(loglike, prior_transform, lik.ndim, nlive=nlive, sample=sample,
-                                    rstate=rng)
+                                    rstate=rng, **kwargs)
     sampler.run_nested(dlogz=dlogz, print_progress=False)
     res = sampler.results
     log_s, log_s_err = log_support_fraction(lik, np.random.default_rng(seed + 1))

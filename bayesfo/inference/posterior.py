@@ -5,8 +5,8 @@ The sampler works in coordinates u where log-uniform parameters are replaced by 
 Jacobian, so samples are from the posterior of the declared priors. Walkers start around every
 distinct admissible optimum of the global optimisation and the linear methods that lies within
 ``mode_window`` log-likelihood units of the best one (jittered, kept inside the support), and move
-with a mixture of differential-evolution, DE-snooker and stretch moves, which can jump between the
-q modes of high-order structures (thesis Table A.9).
+with a mixture of differential-evolution (including the mode-hopping γ = 1 variant), DE-snooker
+and stretch moves, which can jump between the q modes of high-order structures (thesis Table A.9).
 
 The run length is set by the integrated autocorrelation time τ (emcee): it continues until it is
 at least ``tau_factor``·τ steps long and τ has settled, up to ``max_steps``. Burn-in is 2·τ_max,
@@ -332,8 +332,12 @@ def sample_posterior(
         progress = sys.stderr.isatty()
     tr = _Transform(lik)
     p0 = tr.to_u(initial_walkers(lik, seeds_scaled, n_walkers, rng))
-    moves = [(emcee.moves.DEMove(), 0.6), (emcee.moves.DESnookerMove(), 0.2),
-             (emcee.moves.StretchMove(), 0.2)]
+    # DE with γ = 1 carries a walker by the distance between two others: from one mode to
+    # another where walkers sit in both (ter Braak 2006). Max-order members have such modes
+    # (a degree-k polynomial in s^q is one of degree 2k in s^(q/2)); without this move the
+    # walkers keep the split between the modes they started with.
+    moves = [(emcee.moves.DEMove(), 0.5), (emcee.moves.DEMove(gamma0=1.0), 0.1),
+             (emcee.moves.DESnookerMove(), 0.2), (emcee.moves.StretchMove(), 0.2)]
     sampler = emcee.EnsembleSampler(n_walkers, ndim, _log_prob_fn(lik, tr), moves=moves,
                                     vectorize=True)
     sampler.random_state = np.random.RandomState(seed).get_state()
@@ -468,16 +472,27 @@ def _diagnostics(sampler, tau, tr, names):
 
 
 def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:
-    """Peaks of a kernel density of ``u`` with a prominence of at least 10 % of the highest."""
+    """Peaks of a kernel density of ``u`` with a prominence of at least 5 % of the highest and
+    half their own height.
+
+    The bandwidth is Silverman's robust rule, 0.9·min(sd, IQR/1.34)·n^(-1/5): the standard
+    deviation of draws from two separated modes is that of their distance, and a bandwidth set
+    by it smooths a minor mode away.
+    """
     from scipy import signal, stats
 
     if np.ptp(u) <= 0 or u.size < 20:
         return 1
-    grid = np.linspace(max(lo, u.min()), min(hi, u.max()), 256)
-    dens = stats.gaussian_kde(u)(grid)
+    sd = float(np.std(u))
+    spread = min(sd, float(np.subtract(*np.percentile(u, [75, 25]))) / 1.34) or sd
+    grid = np.linspace(max(lo, u.min()), min(hi, u.max()), 512)
+    dens = stats.gaussian_kde(u, bw_method=0.9 * spread * u.size ** -0.2 / sd)(grid)
     padded = np.r_[0.0, dens, 0.0]
-    peaks, _ = signal.find_peaks(padded, prominence=0.1 * dens.max())
-    return max(1, len(peaks))
+    peaks, props = signal.find_peaks(padded, prominence=0.05 * dens.max())
+    # A mode stands out: the valley to its higher neighbour is below half its own height (a
+    # flat or noisy density has bumps of small relative prominence).
+    real = props["prominences"] >= 0.5 * padded[peaks]
+    return max(1, int(np.sum(real)))
 
 
 def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:

@@ -128,13 +128,18 @@ def test_g_spec_posterior_sd_of_q_matches_spread_of_optimum():
     assert abs(result.summary["q"].mean - 0.5) < 4 * sd_q
 
 
+def _g_spec_noisy():
+    """G_spec with independent complex noise of sd 0.005 per frequency (σ known), seed 3."""
+    rng = np.random.default_rng(3)
+    noise = 5e-3 / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25))
+    return FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+
+
 def test_high_order_q_posterior_is_flagged_multimodal():
     # The thesis suspected that q is poorly determined for high orders (Table A.9); on G_spec
     # data the max-n2m2 posterior of q has a mode at 0.25 (1/(1 + λ²) with λ = s^0.25 is G_spec
     # exactly) besides the one at 0.5, and the summary says so. The Voigt's q has one tight mode.
-    rng = np.random.default_rng(3)
-    noise = 5e-3 / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25))
-    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+    data = _g_spec_noisy()
     with pytest.warns(ConvergenceWarning):
         high, _ = run_posterior(get_structure("max-n2m2"), data, seed=1, progress=False,
                                 predictive=False, max_steps=3000)
@@ -150,9 +155,7 @@ def test_walkers_move_between_the_q_modes_of_a_max_order_member():
     # 1/(1 + λ²) with λ = s^0.25 is G_spec). Walkers start in both; the mode-hopping DE move
     # carries them across (measured: 14 of 32 walkers within 3000 steps; without it none, and
     # the split between the modes stays the one the walkers started with).
-    rng = np.random.default_rng(3)
-    noise = 5e-3 / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25))
-    data = FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+    data = _g_spec_noisy()
     with pytest.warns(ConvergenceWarning):
         post, _ = run_posterior(get_structure("max-n2m0"), data, seed=1, progress=False,
                                 predictive=False, max_steps=3000)

@@ -53,11 +53,8 @@ def _check_formats(formats) -> tuple[str, ...]:
     return formats
 
 
-#: Figures drawn from the whole comparison, in the order they are written.
-COMBINED = ("ranking", "bode", "nyquist", "residuals", "q_posteriors")
-
-
 def _combined_makers(comparison, seed: int) -> dict:
+    """The figures drawn from the whole comparison, by name, in the order they are written."""
     makers = {
         "ranking": lambda: plot_ranking(comparison),
         "bode": lambda: plot_bode(comparison, seed=seed),
@@ -167,7 +164,7 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
             written.update(_save_all({name: make}, out_dir, formats))
         return written
     order = [name for name, _ in figure_jobs(comparison, seed=seed)]
-    combined = [name for name in order if name in COMBINED]
+    combined = list(_combined_makers(comparison, seed))
     colors = colors_for(comparison.ranking)
     # Per-structure tasks carry one result only; the combined figures need all of them.
     tasks = [("structure", r, comparison.data, colors[r.name]) for r in ok_results(comparison)]

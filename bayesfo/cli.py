@@ -68,6 +68,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] left out of the fit for validation")
+    p.add_argument("--evidence", default="auto", choices=("auto", "bridge", "ladder"),
+                   help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
+                        "ladder (ladder); auto: the ladder where the posterior did not converge")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--workers", type=int, default=0, metavar="N",
@@ -243,7 +246,7 @@ def cmd_compare(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     holdout = _parse_floats(args.holdout, "--holdout") if args.holdout else None
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
-                   evidence_check=args.evidence_check, holdout=holdout)
+                   evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout)
     if args.workers < 0:
         raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
     n_proc = min(args.workers or available_cpus(), len(structures))
@@ -260,8 +263,8 @@ def cmd_compare(args) -> int:
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
         print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "
-              "log-evidence ln Z (bridge sampling); P = posterior probability, equal prior odds")
-        print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>16} {'dlnZ':>8} {'P':>6} "
+              "log-evidence ln Z (bridge sampling; L: from a tempered ladder); P = posterior probability, equal prior odds")
+        print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
               f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3}")
         for row in result.table():
             if row.get("error"):
@@ -272,9 +275,10 @@ def cmd_compare(args) -> int:
                 z = dz = p = "-"
             else:
                 z = f"{row['log_evidence']:.2f} ± {row['log_evidence_err']:.2f}"
+                z += " L" if row["evidence_method"] == "ladder" else "  "
                 dz = f"{row['delta_log_evidence']:.2f}"
                 p = f"{row['posterior_probability']:.3f}"
-            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>16} {dz:>8} "
+            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} {dz:>8} "
                   f"{p:>6} {row['loo']:>10.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
                   f"{'yes' if row['converged'] else 'NO':>3}")
         pairs = result.baselines()

@@ -4,8 +4,9 @@ For every structure: the global least-squares optimisation (modes and a maximum-
 start), the emcee posterior, and the criteria that follow from them: maximum log-likelihood,
 AIC, AICc, BIC (from the higher of the optimiser's and the sampler's maximum), WAIC and PSIS-LOO
 (arviz, pointwise per frequency), RMSE at the posterior mode (thesis eq. (3.23)), and the
-log-evidence ln Z by bridge sampling from the posterior draws (optionally checked by dynesty
-nested sampling, with a flag when the two disagree by more than twice their combined error).
+log-evidence ln Z by bridge sampling from the posterior draws, or from the particles of a
+tempered ladder where the posterior did not converge (optionally checked by dynesty nested
+sampling, with a flag when the two disagree by more than twice their combined error).
 Structures are ranked by ln Z; posterior model probabilities assume equal prior odds unless
 given.
 
@@ -37,7 +38,7 @@ from .data import FrequencyResponse
 from .errors import InputError
 from .identify.optimize import FitResult, fit_structure
 from .inference import Likelihood, PosteriorResult, run_posterior, save_netcdf
-from .inference.evidence import bridge_evidence, nested_evidence
+from .inference.evidence import bridge_evidence, ladder_evidence, nested_evidence
 from .inference._arviz import arviz
 from .structures import Structure
 
@@ -219,6 +220,7 @@ class Comparison:
             rows.append({
                 "rank": order[r.name] + 1, "structure": r.name, "n_params": r.structure.n_params,
                 "parent": _parent(r.structure), "log_evidence": log_z, "log_evidence_err": None if ev is None else ev.log_z_err,
+                "evidence_method": None if ev is None else ev.method,
                 "delta_log_evidence": None if ev is None else log_z - best_z,
                 "bayes_factor": None if ev is None else math.exp(log_z - best_z),
                 "posterior_probability": c.get("posterior_probability"),
@@ -367,8 +369,8 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
 
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
-            priors=None, progress: bool | None = None, evidence_check: bool = False,
-            prior_odds: dict | None = None, holdout=None, workers: int = 1, pool=None,
+            priors=None, progress: bool | None = None, evidence: str = "auto",
+            evidence_check: bool = False, prior_odds: dict | None = None, holdout=None, workers: int = 1, pool=None,
             **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
@@ -383,8 +385,13 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         Prior overrides ``{name: Prior}`` applied to every structure that has the parameter.
     progress : bool, optional
         A progress bar over structures (default: when stderr is a terminal).
+    evidence : {"auto", "bridge", "ladder"}
+        How ln Z is computed: bridge sampling from the emcee draws (``"bridge"``), or from the
+        particles of a tempered ladder (``"ladder"``, sequential Monte Carlo from the prior,
+        seconds per structure); ``"auto"`` takes the draws where the posterior converged and
+        the ladder where it did not.
     evidence_check : bool
-        Also compute ln Z by dynesty nested sampling and flag disagreements with the bridge
+        Also compute ln Z by dynesty nested sampling and flag disagreements with the default
         estimate larger than twice the combined error (slower: seconds to minutes each).
     prior_odds : dict, optional
         Prior model probabilities ``{name: weight}`` (default equal).
@@ -414,6 +421,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     structures = list(structures)
     if not structures:
         raise InputError("no structure to compare")
+    if evidence not in ("auto", "bridge", "ladder"):
+        raise InputError(f"evidence must be 'auto', 'bridge' or 'ladder', got {evidence!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
         raise InputError(f"workers must be a non-negative integer, got {workers!r}")
     test = None
@@ -423,6 +432,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         progress = sys.stderr.isatty()
     n_proc = min(workers or available_cpus(), len(structures))
     options = {"noise": noise, "priors": priors, "seed": seed, "evidence_check": evidence_check,
+               "evidence": evidence,
                "test": test, "sampler_kwargs": sampler_kwargs}
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
     if pool is None and n_proc <= 1:
@@ -476,7 +486,7 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
             criteria = _criteria(lik, fit, post)
             if test is not None:
                 criteria.update(_holdout(lik, post, test))
-            extra = _evidence(lik, post, seed, options["evidence_check"])
+            extra = _evidence(lik, post, seed, options["evidence_check"], options["evidence"])
             criteria["warnings"].extend(extra.pop("warnings"))
             criteria.update(extra)
             result = StructureResult(s, fit, post, criteria)
@@ -512,14 +522,28 @@ class EvidenceWarning(UserWarning):
     """The two evidence estimates disagree, or the evidence could not be computed."""
 
 
-def _evidence(lik, post, seed, check: bool) -> dict:
+def _evidence(lik, post, seed, check: bool, route: str = "auto") -> dict:
     out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": []}
+    # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
+    # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
+    # from the prior instead (ladder_evidence).
+    ladder = route == "ladder" or (route == "auto" and not post.converged)
     try:
-        out["evidence"] = bridge_evidence(lik, post, seed=seed)
+        if ladder:
+            try:
+                out["evidence"] = ladder_evidence(lik, seed=seed)
+            except InputError as exc:
+                if route == "ladder":
+                    raise
+                warnings.warn(f"{post.structure}: tempered ladder failed ({exc}); ln Z from the "
+                              "emcee draws instead", EvidenceWarning, stacklevel=3)
+                out["evidence"] = bridge_evidence(lik, post, seed=seed)
+        else:
+            out["evidence"] = bridge_evidence(lik, post, seed=seed)
     except InputError as exc:
         warnings.warn(f"{post.structure}: no evidence: {exc}", EvidenceWarning, stacklevel=3)
         return out
-    if not post.converged:
+    if not post.converged and out["evidence"].method == "bridge":
         out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
     if check:
         # Uniform draws from bounding ellipsoids where emcee found one compact mode; slice
@@ -532,9 +556,10 @@ def _evidence(lik, post, seed, check: bool) -> dict:
         agree = abs(out["evidence"].log_z - nested.log_z) <= 2 * combined
         out["evidence_agree"] = bool(agree)
         if not agree:
-            out["warnings"].append(f"{post.structure}: bridge and nested ln Z disagree")
+            method = out["evidence"].method
+            out["warnings"].append(f"{post.structure}: {method} and nested ln Z disagree")
             warnings.warn(
-                f"{post.structure}: bridge ln Z = {out['evidence'].log_z:.2f} ± "
+                f"{post.structure}: {method} ln Z = {out['evidence'].log_z:.2f} ± "
                 f"{out['evidence'].log_z_err:.2f} and nested ln Z = {nested.log_z:.2f} ± "
                 f"{nested.log_z_err:.2f} disagree", EvidenceWarning, stacklevel=3)
     return out
@@ -557,7 +582,7 @@ def _model_probabilities(results, prior_odds: dict) -> None:
 
 
 RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "log_evidence_err",
-                  "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
+                  "evidence_method", "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
                   "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
                   "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",
                   "holdout_lpd", "holdout_rmse", "q_mean",

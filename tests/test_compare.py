@@ -199,3 +199,30 @@ def test_worker_processes_give_the_same_numbers(voigt_comparison):
         assert np.array_equal(a.posterior.samples, b.posterior.samples)
     with pytest.raises(ValueError, match="workers"):
         compare(data, resolve_structures("voigt"), workers=-1)
+
+
+def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
+    import math
+    import warnings
+
+    from bayesfo.errors import InputError
+
+    result, _ = voigt_comparison
+    data, voigt = result.data, resolve_structures("voigt")
+    bridge = result["voigt"].criteria["evidence"]
+    ladder = compare(data, voigt, seed=1, progress=False, evidence="ladder")["voigt"]
+    ev = ladder.criteria["evidence"]
+    assert ev.method == "ladder" and ladder.posterior.converged
+    # Two independent estimators of the same integral.
+    assert abs(ev.log_z - bridge.log_z) < 4 * math.hypot(ev.log_z_err, bridge.log_z_err) + 0.02
+    # 100 steps are too few for the convergence check: "auto" then takes the ladder's value.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        short = compare(data, voigt, seed=1, progress=False, max_steps=100)["voigt"]
+    assert not short.posterior.converged
+    assert short.criteria["evidence"].method == "ladder"
+    assert short.criteria["evidence"].log_z == pytest.approx(ev.log_z, abs=1e-9)
+    assert not any("unreliable" in w for w in short.criteria["warnings"])
+    assert result.table()[0]["evidence_method"] == "bridge"
+    with pytest.raises(InputError, match="evidence must be"):
+        compare(data, voigt, evidence="nested")

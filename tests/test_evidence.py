@@ -8,7 +8,12 @@ from scipy import stats
 
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood, run_posterior
-from bayesfo.inference.evidence import bridge_evidence, log_support_fraction, nested_evidence
+from bayesfo.inference.evidence import (
+    bridge_evidence,
+    ladder_evidence,
+    log_support_fraction,
+    nested_evidence,
+)
 from bayesfo.structures import Scaling, fix_parameters, get_structure, load_library
 
 LINEAR_CARD = """
@@ -57,6 +62,14 @@ def test_nested_sampling_matches_closed_form(linear_case):
     ev = nested_evidence(lik, seed=1, nlive=300)
     assert abs(ev.log_z - exact) < 4 * ev.log_z_err
     assert abs(ev.log_z - exact) < 0.5 and ev.log_z_err < 0.3
+
+
+def test_ladder_matches_closed_form(linear_case):
+    # Bridge sampling from the particles of two tempered ladders: errors of a few thousandths.
+    s, data, lik, exact = linear_case
+    ev = ladder_evidence(lik, seed=1)
+    assert ev.method == "ladder" and ev.log_z_err < 0.02
+    assert abs(ev.log_z - exact) < max(4 * ev.log_z_err, 0.01) and abs(ev.log_z - exact) < 0.05
 
 
 def test_support_fraction_of_the_zener_prior():

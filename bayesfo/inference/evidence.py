@@ -7,6 +7,12 @@
     by BIC, one normal for a compact posterior), the other half and as many proposal
     draws in the bridge, and the relative mean-squared error of Frühwirth-Schnatter (2004)
     with the autocorrelation of the draws taken into account through their effective size.
+``ladder_evidence``
+    Bridge sampling as above, from the particles of sequential Monte Carlo over a tempered
+    ladder (``bayesfo.inference.smc``) instead of the emcee draws: the particles start from the
+    prior and keep every mode with its weight, where emcee's walkers may not (ridges and
+    several modes of over-parameterised structures). The default route when the emcee
+    posterior did not converge.
 ``nested_evidence``
     Nested sampling with dynesty, on the same prior (its quantile function is the prior
     transform) and the same likelihood.
@@ -30,6 +36,7 @@ from scipy.special import logsumexp
 from ..errors import InputError
 from .likelihood import Likelihood
 from .posterior import PosteriorResult, _log_prob_fn, _Transform
+from .smc import ladder_run
 
 
 @dataclass(frozen=True)
@@ -42,7 +49,8 @@ class Evidence:
         Natural-log evidence (physical units of the data, like the log-likelihood) and its
         standard error.
     method : str
-        ``"bridge"`` or ``"nested"``.
+        ``"bridge"`` (from the emcee draws), ``"ladder"`` (bridge sampling from the particles of
+        a tempered ladder) or ``"nested"``.
     log_support : float
         ln P(S), the log prior mass of the support (0 when the whole prior range is admissible).
     n_likelihood : int
@@ -166,16 +174,25 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
     X.-L. Meng and W. H. Wong (1996), Statistica Sinica 6; Q. F. Gronau et al. (2017), J. Math.
     Psychol. 81; S. Frühwirth-Schnatter (2004), Econometrics Journal 7.
     """
+    tr = _Transform(lik)
+    u = tr.to_u(posterior.samples_scaled)
+    return _bridge(lik, u.reshape(posterior.n_walkers, -1, u.shape[1]), seed=seed,
+                   max_iter=max_iter, tol=tol)
+
+
+def _bridge(lik: Likelihood, draws: np.ndarray, *, seed: int, max_iter: int = 1000,
+            tol: float = 1e-10, method: str = "bridge") -> Evidence:
+    """Bridge sampling from posterior draws ``draws`` (chains × draws × parameters, in the
+    sampling coordinates): every other draw of each chain fits the proposal, the rest enter
+    the bridge with their effective size."""
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
     tr = _Transform(lik)
     log_q = _log_prob_fn(lik, tr)
-    u = tr.to_u(posterior.samples_scaled)
-    n_walkers = posterior.n_walkers
-    draws = u.reshape(n_walkers, -1, u.shape[1])
-    fit_half = draws[:, 0::2].reshape(-1, u.shape[1])
-    bridge_half = draws[:, 1::2].reshape(-1, u.shape[1])
-    if bridge_half.shape[0] < 10 * u.shape[1]:
+    n_walkers = draws.shape[0]
+    fit_half = draws[:, 0::2].reshape(-1, draws.shape[2])
+    bridge_half = draws[:, 1::2].reshape(-1, draws.shape[2])
+    if bridge_half.shape[0] < 10 * draws.shape[2]:
         raise InputError("too few posterior draws for bridge sampling")
     mixture = _GaussianMixture.fit(fit_half, rng)
     n1 = bridge_half.shape[0]
@@ -219,9 +236,45 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
     return Evidence(
         log_z=log_z_support - log_s,
         log_z_err=math.sqrt(re2 + log_s_err**2),
-        method="bridge",
+        method=method,
         log_support=log_s,
         n_likelihood=int(n1 + n2),
+        seconds=time.perf_counter() - t0,
+    )
+
+
+def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
+                    n_runs: int = 2, **ladder_kwargs) -> Evidence:
+    """ln Z by bridge sampling from the particles of ``n_runs`` independent tempered ladders.
+
+    Each run (:func:`bayesfo.inference.smc.ladder_run`) carries ``n_particles`` prior draws
+    to the posterior; bridge sampling on its final particles gives one ln Z with its error. The
+    result is their mean; its error combines the runs' stated errors with their spread, which
+    also holds what the stated errors miss (how well each run weighted the posterior's modes).
+
+    Unlike :func:`bridge_evidence` it needs no converged emcee run: the ladder reaches the
+    posterior from the prior, so it does not depend on where the walkers started.
+    """
+    t0 = time.perf_counter()
+    if n_runs < 2:
+        raise ValueError("n_runs must be at least 2 (their spread is part of the error)")
+    runs = np.random.SeedSequence(seed).spawn(n_runs)
+    values, errors, calls = [], [], 0
+    for i, child in enumerate(runs):
+        run = ladder_run(lik, np.random.default_rng(child), n_particles=n_particles,
+                         **ladder_kwargs)
+        ev = _bridge(lik, run.particles[None], seed=seed + i)
+        values.append(ev.log_z)
+        errors.append(ev.log_z_err)
+        calls += run.n_likelihood + ev.n_likelihood
+    values, errors = np.array(values), np.array(errors)
+    err = math.sqrt((np.mean(errors**2) + np.var(values, ddof=1)) / n_runs)
+    return Evidence(
+        log_z=float(values.mean()),
+        log_z_err=err,
+        method="ladder",
+        log_support=ev.log_support,
+        n_likelihood=int(calls),
         seconds=time.perf_counter() - t0,
     )
 

@@ -82,17 +82,19 @@ DEFAULT_OPTIONS = {
     "noise": "auto",
     "priors": (),            # NAME=TYPE:A:B specifications
     "holdout": None,         # angular frequencies [rad/s] left out of the fit
+    "evidence": "auto",      # ln Z from the emcee draws (bridge), a tempered ladder, or auto
     "evidence_check": False,
     "models": (),            # extra structure cards (paths)
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
 }
 
 KINDS = ("compliance", "modulus", "generic")
+EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
 NOISE_MODELS = ("auto", "known", "constant", "proportional")
 
 #: Manifest columns; ``invert`` is another name for ``reciprocal``.
 MANIFEST_COLUMNS = ("path", "id", "kind", "reciprocal", "invert", "structures", "noise", "prior",
-                    "seed", "holdout", "evidence_check", "temperature")
+                    "seed", "holdout", "evidence", "evidence_check", "temperature")
 
 #: Files written at the top of the output directory (no data-set id may take these names).
 COMBINED_FILES = ("batch_summary.csv", "batch_summary.png", "batch_summary.pdf",
@@ -246,7 +248,8 @@ def check_options(options: dict, where: str) -> dict:
                              f"got {holdout}")
     return {"kind": opts["kind"], "reciprocal": bool(opts["reciprocal"]),
             "structures": tuple(s.name for s in structures), "noise": opts["noise"],
-            "priors": priors, "holdout": holdout, "evidence_check": bool(opts["evidence_check"]),
+            "priors": priors, "holdout": holdout, "evidence": opts["evidence"],
+            "evidence_check": bool(opts["evidence_check"]),
             "models": models, "figures": bool(opts["figures"])}
 
 
@@ -398,7 +401,7 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
     ``id`` (the sub-directory name), ``kind``, ``reciprocal`` (or ``invert``: compare 1/G of the
     data; true/false), ``structures`` (a comma list, quoted), ``noise``, ``prior`` (specifications
     ``NAME=TYPE:A:B`` separated by ``;``), ``seed``, ``holdout`` (angular frequencies separated by
-    ``;``), ``evidence_check`` (true/false) and ``temperature`` (``20``, ``20 C``, ``293.15 K``).
+    ``;``), ``evidence`` (auto, bridge or ladder), ``evidence_check`` (true/false) and ``temperature`` (``20``, ``20 C``, ``293.15 K``).
     An empty cell takes the command line's value.
 
     Parameters
@@ -467,6 +470,11 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
                 opts["reciprocal"] = _bool_cell(cell, here)
             elif col == "evidence_check":
                 opts["evidence_check"] = _bool_cell(cell, here)
+            elif col == "evidence":
+                if cell not in EVIDENCE_ROUTES:
+                    raise InputError(f"{here}: evidence must be one of "
+                                     f"{', '.join(EVIDENCE_ROUTES)}, got {cell!r}")
+                opts["evidence"] = cell
             elif col == "structures":
                 opts["structures"] = cell
             elif col == "noise":
@@ -724,6 +732,7 @@ def run_task(task: dict) -> dict:
             # worker, a daemonic process, could not start compare's own process pool).
             comparison = compare(data, structures, noise=opts["noise"], seed=task["seed"],
                                  priors=priors, progress=False,
+                                 evidence=opts["evidence"],
                                  evidence_check=opts["evidence_check"],
                                  holdout=list(opts["holdout"]) if opts["holdout"] else None,
                                  workers=1)
@@ -1230,7 +1239,7 @@ def add_parser(subparsers):
                         "'path' column and per-file options)")
     p.add_argument("--manifest", action="append", default=[], metavar="FILE",
                    help="manifest CSV: path[,id,kind,reciprocal|invert,structures,noise,prior,"
-                        "seed,holdout,evidence_check,temperature]; repeatable")
+                        "seed,holdout,evidence,evidence_check,temperature]; repeatable")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--kind", choices=KINDS,
                    help="what the responses are (default: each file's '# kind:' line, "
@@ -1248,6 +1257,9 @@ def add_parser(subparsers):
                    help="seed of every data set (the same numbers whatever the workers)")
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] left out of every fit for validation")
+    p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
+                   help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
+                        "ladder (ladder); auto: the ladder where the posterior did not converge")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--no-figures", action="store_true",
@@ -1272,7 +1284,7 @@ def cmd_batch(args) -> int:
     options = {"kind": args.kind, "reciprocal": args.reciprocal, "structures": args.structures,
                "noise": args.noise, "priors": tuple(args.prior),
                "holdout": _parse_floats(args.holdout, "--holdout") if args.holdout else None,
-               "evidence_check": args.evidence_check,
+               "evidence": args.evidence, "evidence_check": args.evidence_check,
                "models": tuple(getattr(args, "models", None) or ()),
                "figures": not args.no_figures}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,

@@ -153,17 +153,18 @@ def test_manifest_with_per_file_options(tmp_path):
         shutil.copy(ADHESIVE / f"{name}.csv", data / f"{name}.csv")
     m = _manifest(tmp_path, (
         "# per-file options; empty cells take the command line's values\n"
-        "path,id,kind,invert,structures,seed,temperature,prior,holdout\n"
-        "data/Tp020C.csv,warm,,yes,\"voigt,zener-inv\",7,293.15 K,q=uniform:0.2:1,1.2;10\n"
-        "data/Tm010C.csv,,generic,,,,,,\n"
-        "data/Tm010C.csv,,,,,,,,\n"))
+        "path,id,kind,invert,structures,seed,temperature,prior,holdout,evidence\n"
+        "data/Tp020C.csv,warm,,yes,\"voigt,zener-inv\",7,293.15 K,q=uniform:0.2:1,1.2;10,ladder\n"
+        "data/Tm010C.csv,,generic,,,,,,,\n"
+        "data/Tm010C.csv,,,,,,,,,\n"))
     defaults = {"structures": "zener", "priors": ["sigma_rel=log-uniform:1e-4:0.1"]}
     datasets = expand_inputs([m], options=defaults, seed=1)
     a, b, c = datasets
     assert (a.id, a.seed, a.temperature) == ("warm", 7, 20.0)
     assert a.options["reciprocal"] is True and a.options["structures"] == ("voigt", "zener-inv")
     assert a.options["priors"] == ("q=uniform:0.2:1",) and a.options["holdout"] == (1.2, 10.0)
-    assert a.options["kind"] is None
+    assert a.options["kind"] is None and a.options["evidence"] == "ladder"
+    assert b.options["evidence"] == "auto"
     assert (b.options["kind"], b.seed, b.temperature) == ("generic", 1, -10.0)  # stem
     assert b.options["structures"] == ("zener",)
     assert b.options["priors"] == ("sigma_rel=log-uniform:1e-4:0.1",)
@@ -179,6 +180,7 @@ def test_manifest_with_per_file_options(tmp_path):
     ("kind\nmodulus\n", r"line 1: no 'path' column"),
     ("# c\npath,kind\na.csv,modulus,extra\n", r"line 3: expected 2 cells as in the header, got 3"),
     ("path,kind\na.csv,stress\n", r"line 2, column 'kind': kind must be one of"),
+    ("path,evidence\na.csv,nested\n", r"line 2, column 'evidence': evidence must be one of"),
     ("path,invert\na.csv,maybe\n", r"line 2, column 'invert': expected true or false"),
     ("path,seed\na.csv,1.5\n", r"line 2, column 'seed': the seed must be an integer"),
     ("path,temperature\na.csv,warm\n", r"line 2, column 'temperature': expected a temperature"),

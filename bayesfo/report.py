@@ -296,6 +296,8 @@ def _ranking_table(comparison) -> str:
             v = row.get(key)
             if key == "posterior_probability":
                 cells.append(_cell(v, text=_prob(v)))
+            elif key == "log_evidence" and _finite(v) and row.get("evidence_method") == "ladder":
+                cells.append(_cell(v, text=f"{_num(v, fmt)} L"))
             elif key == "rhat_max" and _finite(v) and not row["converged"]:
                 cells.append(_cell(v, fmt, cls="flag"))
             else:
@@ -305,7 +307,8 @@ def _ranking_table(comparison) -> str:
         ok = row["converged"]
         cells.append(f'<td class="text{"" if ok else " flag"}">{"yes" if ok else "NO"}</td>')
         body.append(f'<tr id="row-{_e(name)}">' + "".join(cells) + "</tr>")
-    note = ("<p class='small'>Ranked by ln Z (bridge sampling); Δln Z to the best; P: posterior "
+    note = ("<p class='small'>Ranked by ln Z (bridge sampling from the posterior draws; where "
+            "a posterior did not converge, from the particles of a tempered ladder, marked L); Δln Z to the best; P: posterior "
             "model probability; elpd: expected log pointwise predictive density (higher is "
             "better) with the standard error of each estimate; AIC and BIC: lower is better; "
             "RMSE at the posterior mode (thesis eq. (3.23)); q: posterior mean and sd of the "
@@ -397,7 +400,11 @@ def _diagnostics_section(comparison) -> str:
                 f"{post.n_walkers} walkers × {post.n_steps} steps, τ max {_num(tau, '.0f')}, "
                 f"acceptance {_num(post.acceptance, '.2f')}")
         if r.criteria.get("evidence_agree") is False:
-            line += "; <span class='flag'>bridge and nested ln Z disagree</span>"
+            line += "; <span class='flag'>the two ln Z estimates (default and nested) disagree</span>"
+        ev = r.criteria.get("evidence")
+        if ev is not None and ev.method == "ladder":
+            line += (f"; ln Z from a tempered ladder ({ev.n_likelihood:,} likelihood evaluations, "
+                     f"{ev.seconds:.1f} s)")
         notes = list(post.messages) + [w for w in r.criteria.get("warnings", [])
                                        if w not in post.messages]
         if notes:

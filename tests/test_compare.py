@@ -223,6 +223,11 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
     assert short.criteria["evidence"].method == "ladder"
     assert short.criteria["evidence"].log_z == pytest.approx(ev.log_z, abs=1e-9)
     assert not any("unreliable" in w for w in short.criteria["warnings"])
+    # The report marks the ladder's value and says how it was computed.
+    from bayesfo.report import render_report
+
+    html = render_report(compare(data, voigt, seed=1, progress=False, evidence="ladder"))
+    assert f"{ev.log_z:.2f} L</td>" in html and "ln Z from a tempered ladder" in html
     assert result.table()[0]["evidence_method"] == "bridge"
     with pytest.raises(InputError, match="evidence must be"):
         compare(data, voigt, evidence="nested")

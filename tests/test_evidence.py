@@ -115,7 +115,7 @@ def test_routes_agree_on_the_thesis_set_up():
 NESTED_REFERENCE = {
     "maxwell": (-1472.46, 0.22, 500),
     "max-n2m0": (None, None, 2000),
-    "max-n2m1": (None, None, 2000),
+    "max-n2m1": (196.85, 0.14, 2000),
     "max-n3m1": (None, None, 2000),
     "max-n3m3": (191.85, 0.29, 500),
 }

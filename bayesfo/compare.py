@@ -526,12 +526,13 @@ def _evidence(lik, post, seed, check: bool, route: str = "auto") -> dict:
     out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": []}
     # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
     # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
-    # from the prior instead (ladder_evidence).
+    # from the prior instead (ladder_evidence), proposing from the draws as well so that it
+    # keeps the narrow modes the walkers found.
     ladder = route == "ladder" or (route == "auto" and not post.converged)
     try:
         if ladder:
             try:
-                out["evidence"] = ladder_evidence(lik, seed=seed)
+                out["evidence"] = ladder_evidence(lik, seed=seed, guide=post)
             except InputError as exc:
                 if route == "ladder":
                     raise

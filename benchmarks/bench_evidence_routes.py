@@ -58,7 +58,7 @@ def main(argv=None):
         t_bridge = time.perf_counter() - t
         bridge = r.criteria["evidence"]
         lik = Likelihood(s, data)
-        ladder = ladder_evidence(lik, seed=args.seed)
+        ladder = ladder_evidence(lik, seed=args.seed, guide=r.posterior)
         default = bridge if r.posterior.converged else ladder
         line = (f"{s.name:<12} {bridge.log_z:9.2f} ± {bridge.log_z_err:4.2f} {t_bridge:6.1f} "
                 f"{ladder.log_z:9.2f} ± {ladder.log_z_err:4.2f} {ladder.seconds:6.1f} ")

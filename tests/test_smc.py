@@ -16,12 +16,12 @@ from bayesfo.priors import Uniform
 
 MEANS = np.array([[-6.0, -4.0], [5.0, 3.0]])
 WEIGHTS = np.array([0.3, 0.7])
-WIDTH = 0.05
+WIDTHS = np.array([0.05, 0.05])
 
 
 class _TwoModes:
-    """Duck-typed likelihood: L(θ) = C Σ_k w_k N(θ; μ_k, s² I) with uniform priors on
-    [−10, 10]², so Z = C / 400 (the modes lie 80 widths inside the box), and the posterior puts
+    """Duck-typed likelihood: L(θ) = C Σ_k w_k N(θ; μ_k, s_k² I) with uniform priors on
+    [−10, 10]², so Z = C / 400 (the modes lie far inside the box), and the posterior puts
     weight w_k on mode k. The modes are 200 widths apart: a random-walk sampler started in one
     never finds the other."""
 
@@ -33,14 +33,17 @@ class _TwoModes:
     data = SimpleNamespace(kind="generic")
     grid = None
 
+    def __init__(self, widths=WIDTHS):
+        self.widths = np.asarray(widths, dtype=float)
+
     def in_support(self, theta):
         theta = np.atleast_2d(theta)
         return np.all(np.abs(theta) <= 10.0, axis=1)
 
     def __call__(self, theta):
         theta = np.atleast_2d(theta)
-        d2 = np.sum((theta[:, None, :] - MEANS[None]) ** 2, axis=2) / WIDTH**2
-        log_n = -0.5 * d2 - math.log(2 * math.pi * WIDTH**2)
+        d2 = np.sum((theta[:, None, :] - MEANS[None]) ** 2, axis=2) / self.widths**2
+        log_n = -0.5 * d2 - np.log(2 * math.pi * self.widths**2)
         return self.log_c + logsumexp(log_n + np.log(WEIGHTS), axis=1)
 
 
@@ -54,12 +57,29 @@ def test_ladder_weights_separated_modes_and_finds_their_evidence():
     share = np.mean(run.particles[:, 0] > 0)
     assert abs(share - 0.7) < 0.06
     near = np.min(np.linalg.norm(run.particles[:, None, :] - MEANS[None], axis=2), axis=1)
-    assert np.all(near < 6 * WIDTH)
+    assert np.all(near < 6 * WIDTHS.max())
     ev = ladder_evidence(lik, seed=0)
     assert ev.method == "ladder" and ev.log_support == 0.0
     assert abs(ev.log_z - exact) < max(4 * ev.log_z_err, 0.02) and abs(ev.log_z - exact) < 0.1
     # The same seed gives the same numbers.
     assert ladder_evidence(lik, seed=0).log_z == ev.log_z
+
+
+def test_guide_finds_a_spike_with_almost_no_prior_mass():
+    # Mode 2 (weight 0.7) is a spike of width 1e-3 on a broad mode 1 of width 1: L^β stays a
+    # spike at every β, so no prior draw comes near it and the plain ladder loses 70 % of Z.
+    # Draws from the spike alone (an emcee run stuck in it) as the guide: the ladder finds it
+    # and still gives the broad mode its weight 0.3, because its moves are exact.
+    lik = _TwoModes(widths=[1.0, 1e-3])
+    exact = lik.log_c - math.log(400.0)
+    plain = ladder_evidence(lik, seed=0)
+    assert abs(plain.log_z - (exact + math.log(0.3))) < 0.1
+    guide = SimpleNamespace(samples_scaled=MEANS[1] + 1e-3 * np.random.default_rng(3).normal(
+        size=(2000, 2)))
+    guided = ladder_evidence(lik, seed=0, guide=guide)
+    assert abs(guided.log_z - exact) < max(4 * guided.log_z_err, 0.03)
+    run = ladder_run(lik, np.random.default_rng(4), guide=guide.samples_scaled)
+    assert abs(np.mean(np.linalg.norm(run.particles - MEANS[1], axis=1) < 0.01) - 0.7) < 0.06
 
 
 def test_next_rung_keeps_the_requested_effective_sample_size():

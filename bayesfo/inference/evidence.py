@@ -11,8 +11,9 @@
     Bridge sampling as above, from the particles of sequential Monte Carlo over a tempered
     ladder (``bayesfo.inference.smc``) instead of the emcee draws: the particles start from the
     prior and keep every mode with its weight, where emcee's walkers may not (ridges and
-    several modes of over-parameterised structures). The default route when the emcee
-    posterior did not converge.
+    several modes of over-parameterised structures); the walkers' draws guide its moves
+    towards the narrow modes they found. The default route when the emcee posterior did not
+    converge.
 ``nested_evidence``
     Nested sampling with dynesty, on the same prior (its quantile function is the prior
     transform) and the same likelihood.
@@ -34,6 +35,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
+from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .posterior import PosteriorResult, _log_prob_fn, _Transform
 from .smc import ladder_run
@@ -96,64 +98,6 @@ def _ess(x: np.ndarray) -> float:
     from ._arviz import arviz
 
     return float(arviz().ess(x))
-
-
-@dataclass(frozen=True)
-class _GaussianMixture:
-    """Proposal of bridge sampling: a mixture of multivariate normals fitted to posterior draws.
-
-    A single normal is a poor proposal for posteriors with several modes (the q ↔ q/2 modes
-    of max-order members) or a curved ridge; k-means clusters (k = 1 … 4, chosen by BIC on the
-    draws it is fitted to) each get their mean and covariance.
-    """
-
-    weights: np.ndarray
-    means: np.ndarray
-    chols: np.ndarray
-
-    @classmethod
-    def fit(cls, x: np.ndarray, rng: np.random.Generator, max_components: int = 4):
-        from scipy.cluster.vq import kmeans2
-
-        n, d = x.shape
-        scale = x.std(axis=0)
-        scale = np.where(scale > 0, scale, 1.0)
-        best, best_bic = None, np.inf
-        for k in range(1, max_components + 1):
-            if k == 1:
-                labels = np.zeros(n, dtype=int)
-            else:
-                _, labels = kmeans2(x / scale, k, seed=rng, minit="++")
-            counts = np.bincount(labels, minlength=k)
-            if np.any(counts < 5 * d):  # too few draws for a covariance
-                break
-            means = np.array([x[labels == j].mean(axis=0) for j in range(k)])
-            chols = []
-            for j in range(k):
-                cov = np.atleast_2d(np.cov(x[labels == j], rowvar=False))
-                cov = cov + 1e-12 * np.diag(np.diag(cov) + 1e-300)
-                chols.append(np.linalg.cholesky(cov))
-            mix = cls(counts / n, means, np.array(chols))
-            n_params = k * (d + d * (d + 1) / 2) + k - 1
-            bic = -2 * float(np.sum(mix.log_pdf(x))) + n_params * math.log(n)
-            if bic < best_bic:
-                best, best_bic = mix, bic
-        return best
-
-    def log_pdf(self, x: np.ndarray) -> np.ndarray:
-        d = x.shape[1]
-        terms = []
-        for w, mean, chol in zip(self.weights, self.means, self.chols, strict=True):
-            z = np.linalg.solve(chol, (x - mean).T)
-            log_det = 2 * np.sum(np.log(np.diag(chol)))
-            terms.append(math.log(w) - 0.5 * np.sum(z * z, axis=0) - 0.5 * log_det
-                         - 0.5 * d * math.log(2 * math.pi))
-        return logsumexp(np.array(terms), axis=0)
-
-    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        which = rng.choice(len(self.weights), size=n, p=self.weights)
-        z = rng.standard_normal((n, self.means.shape[1]))
-        return self.means[which] + np.einsum("nij,nj->ni", self.chols[which], z)
 
 
 def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 0,
@@ -244,7 +188,8 @@ def _bridge(lik: Likelihood, draws: np.ndarray, *, seed: int, max_iter: int = 10
 
 
 def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
-                    n_runs: int = 2, **ladder_kwargs) -> Evidence:
+                    n_runs: int = 2, guide: PosteriorResult | None = None,
+                    **ladder_kwargs) -> Evidence:
     """ln Z by bridge sampling from the particles of ``n_runs`` independent tempered ladders.
 
     Each run (:func:`bayesfo.inference.smc.ladder_run`) carries ``n_particles`` prior draws
@@ -253,16 +198,20 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
     also holds what the stated errors miss (how well each run weighted the posterior's modes).
 
     Unlike :func:`bridge_evidence` it needs no converged emcee run: the ladder reaches the
-    posterior from the prior, so it does not depend on where the walkers started.
+    posterior from the prior. ``guide`` (a posterior result, converged or not) lets the ladder
+    propose from its draws as well (independence moves, see ``ladder_run``), so that a narrow
+    mode found by the optimiser and the walkers is not lost on the way; the moves keep every
+    rung exact, so a poor guide costs efficiency, never correctness.
     """
     t0 = time.perf_counter()
     if n_runs < 2:
         raise ValueError("n_runs must be at least 2 (their spread is part of the error)")
     runs = np.random.SeedSequence(seed).spawn(n_runs)
     values, errors, calls = [], [], 0
+    guide_u = None if guide is None else _Transform(lik).to_u(guide.samples_scaled)
     for i, child in enumerate(runs):
         run = ladder_run(lik, np.random.default_rng(child), n_particles=n_particles,
-                         **ladder_kwargs)
+                         guide=guide_u, **ladder_kwargs)
         ev = _bridge(lik, run.particles[None], seed=seed + i)
         values.append(ev.log_z)
         errors.append(ev.log_z_err)

@@ -14,6 +14,14 @@ two particles is a symmetric random-walk step whose scale follows the tempered p
 keeps every mode of a multimodal posterior (the q ↔ q/2 aliases of the max-order members) with
 its proper weight: the modes are all present in the prior, and each rung only reweights them.
 
+A mode with almost no prior mass (a narrow peak of high likelihood beside a broad region of
+lower likelihood: L^β keeps it narrow at every β) is found by no prior draw and would be lost,
+and ln Z with it. Given draws of the posterior from elsewhere (``guide``: the emcee walkers,
+converged or not), each rung also takes independence Metropolis–Hastings steps proposing from a
+normal mixture fitted to the particles and one fitted to those draws; the steps are exact for
+the tempered posterior whatever the guide, so it can only help the particles find modes, not
+bias their weights.
+
 The error is the spread of independent runs, ``n_runs`` of them (the single-run variance
 estimators degenerate once the genealogy of the particles collapses).
 
@@ -27,13 +35,13 @@ Y. Zhou, A. M. Johansen and J. A. D. Aston (2016), J. Comput. Graph. Stat. 25.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
+from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .posterior import _Transform
 
@@ -126,16 +134,30 @@ def _next_beta(beta: float, log_lik: np.ndarray, ess_fraction: float) -> float:
 
 def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 1000,
                ess_fraction: float = 0.5, accepted_moves: float = 10.0, max_moves: int = 100,
-               jump_fraction: float = 0.1, max_rungs: int = 2000) -> LadderRun:
+               jump_fraction: float = 0.1, max_rungs: int = 2000, guide=None,
+               guided_moves: int = 2) -> LadderRun:
     """One sequential Monte Carlo run from the prior to the posterior of ``lik``.
 
     At each rung the particles take Metropolis steps until each has made ``accepted_moves``
     accepted moves on average (at most ``max_moves`` steps).
+
+    ``guide`` (draws in the sampling coordinates, e.g. emcee's) adds ``guided_moves``
+    independence Metropolis–Hastings steps per rung, proposing from an equal mixture of a
+    normal mixture fitted to the particles and one fitted to the guide. They leave each tempered
+    posterior invariant, whatever the guide, and let particles reach a narrow mode of high
+    likelihood that none of them found by chance at small β (a mode with little prior mass is
+    otherwise lost, and ln Z with it).
     """
     target = _Target(lik)
     u = _prior_particles(target, n_particles, rng)
     log_prior, log_lik = target(u)
     n, d = u.shape
+    guide_mix = None
+    if guide is not None:
+        guide = np.asarray(guide, dtype=float)
+        guide = guide[np.all(np.isfinite(guide), axis=1)]
+        if len(guide) >= 10 * d:
+            guide_mix = _GaussianMixture.fit(guide, rng)
     gamma = 2.38 / math.sqrt(2 * d)
     beta, log_z = 0.0, 0.0
     betas, acceptance = [0.0], []
@@ -149,6 +171,8 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
         u, log_prior, log_lik = u[idx], log_prior[idx], log_lik[idx]
         beta = new_beta
         betas.append(beta)
+        if guide_mix is not None:
+            _guided_moves(target, guide_mix, u, log_prior, log_lik, beta, rng, guided_moves)
         snapshot = u.copy()
         accepted = np.zeros(n)
         steps = 0
@@ -169,3 +193,27 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
                          f"the posterior in {max_rungs} rungs")
     return LadderRun(log_z=log_z, betas=np.array(betas), particles=u, log_likelihood=log_lik,
                      acceptance=np.array(acceptance), n_likelihood=target.calls)
+
+
+def _guided_moves(target: _Target, guide_mix: _GaussianMixture, u, log_prior, log_lik,
+                  beta: float, rng: np.random.Generator, steps: int) -> None:
+    """Independence Metropolis–Hastings steps (in place) targeting prior · L^β, proposing from
+    ½ (mixture fitted to the particles) + ½ (``guide_mix``)."""
+    n, d = u.shape
+    unique = np.unique(u, axis=0)
+    own = _GaussianMixture.fit(unique, rng) if len(unique) >= 10 * d else None
+    if own is None:
+        return
+
+    def log_q(x):
+        return np.logaddexp(own.log_pdf(x), guide_mix.log_pdf(x)) - math.log(2.0)
+
+    for _ in range(steps):
+        from_guide = rng.random(n) < 0.5
+        prop = np.where(from_guide[:, None], guide_mix.sample(n, rng), own.sample(n, rng))
+        lp_new, ll_new = target(prop)
+        with np.errstate(invalid="ignore"):
+            log_ratio = ((lp_new + beta * ll_new - log_q(prop))
+                         - (log_prior + beta * log_lik - log_q(u)))
+        ok = np.log(rng.random(n)) < np.where(np.isfinite(log_ratio), log_ratio, -np.inf)
+        u[ok], log_prior[ok], log_lik[ok] = prop[ok], lp_new[ok], ll_new[ok]

@@ -370,8 +370,8 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
             priors=None, progress: bool | None = None, evidence: str = "auto",
-            evidence_check: bool = False, prior_odds: dict | None = None, holdout=None, workers: int = 1, pool=None,
-            **sampler_kwargs) -> Comparison:
+            evidence_check: bool = False, prior_odds: dict | None = None, holdout=None,
+            workers: int = 1, pool=None, **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
     Parameters

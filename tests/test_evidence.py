@@ -114,9 +114,9 @@ def test_routes_agree_on_the_thesis_set_up():
 # 0; benchmarks/bench_evidence_routes.py): (value, stated error, live points).
 NESTED_REFERENCE = {
     "maxwell": (-1472.46, 0.22, 500),
-    "max-n2m0": (None, None, 2000),
+    "max-n2m0": (192.57, 0.15, 2000),
     "max-n2m1": (196.85, 0.14, 2000),
-    "max-n3m1": (None, None, 2000),
+    "max-n3m1": (196.53, 0.14, 2000),
     "max-n3m3": (191.85, 0.29, 500),
 }
 
@@ -138,7 +138,7 @@ def test_ladder_evidence_of_unconverged_posteriors_on_the_thesis_set_up():
                          progress=False, workers=2)
     for r in result.results:
         ev = r.criteria["evidence"]
-        ref, err, _ = NESTED_REFERENCE[r.name]
+        ref, _, _ = NESTED_REFERENCE[r.name]
         assert ev.method == ("bridge" if r.posterior.converged else "ladder"), r.name
         assert abs(ev.log_z - ref) < 0.3, (r.name, ev.log_z, ref)
 

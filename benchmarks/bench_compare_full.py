@@ -1,8 +1,10 @@
 """Full comparison: Voigt, Zener, Maxwell, every max-order member with n <= 3 and the integer
 baseline of each, on the thesis' G_spec set-up (25 points, complex noise σ = 0.005, known).
 
-Prints the wall time of the whole comparison (optimisation, posterior, bridge evidence, WAIC,
-PSIS-LOO, AIC/BIC for every structure) and each structure's sampler figures. Goal (issue 5): the whole comparison in ≤ 3 minutes on 2 cores.
+Prints the wall time of the whole comparison (optimisation, posterior, evidence, WAIC, PSIS-LOO,
+AIC/BIC for every structure) and each structure's sampler figures and evidence route (bridge
+sampling from the draws, or the tempered ladder where the posterior did not converge). Goal
+(issue 5): the whole comparison in ≤ 3 minutes on 2 cores.
 
 Usage: python benchmarks/bench_compare_full.py [--seed N] [--workers N]
 """
@@ -37,14 +39,15 @@ def main(argv=None):
     t0 = time.perf_counter()
     result = compare(data, structures, seed=args.seed, progress=False, workers=args.workers)
     total = time.perf_counter() - t0
-    print(f"{'structure':<14} {'steps':>6} {'ln Z':>16} {'R-hat':>6} converged")
+    print(f"{'structure':<14} {'steps':>6} {'ln Z':>16} {'route':>7} {'t [s]':>6} {'R-hat':>6} "
+          "converged")
     for r in result.results:
         if r.error:
             print(f"{r.name:<14}  not run: {r.error}")
             continue
         ev = r.criteria["evidence"]
         print(f"{r.name:<14} {r.posterior.n_steps:6d} {ev.log_z:9.2f} ± {ev.log_z_err:4.2f} "
-              f"{r.posterior.rhat_max:6.3f} {r.posterior.converged}")
+              f"{ev.method:>7} {ev.seconds:6.1f} {r.posterior.rhat_max:6.3f} {r.posterior.converged}")
     print(f"{len(structures)} structures on {data.n_frequencies} points, {args.workers or 'one per CPU'} "
           f"worker(s): {total:.1f} s (goal ≤ 180 s on 2 cores)")
 

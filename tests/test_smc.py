@@ -27,7 +27,7 @@ class _TwoModes:
 
     log_c = 50.0
     ndim = 2
-    prior_list = [Uniform(-10.0, 10.0), Uniform(-10.0, 10.0)]
+    prior_list = (Uniform(-10.0, 10.0), Uniform(-10.0, 10.0))
     structure = SimpleNamespace(name="two-modes", n_params=2,
                                 constraints_hold=lambda theta, kind, grid: np.ones(len(theta), bool))
     data = SimpleNamespace(kind="generic")

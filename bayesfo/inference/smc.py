@@ -2,10 +2,13 @@
 
 A population of particles drawn from the prior (restricted to its support) is carried through
 the tempered posteriors π_β ∝ prior · L^β, β = 0 → 1. Each rung reweights the particles by
-L^(β' − β), which gives the stepping-stone estimate of Z_β' / Z_β (Xie et al. 2011), resamples
-them and moves them with Metropolis steps that leave π_β' invariant. The rungs are chosen so
-that the reweighting keeps half the effective sample size (Jasra et al. 2011; Zhou, Johansen and
-Aston 2016); the product of the ratios is ln Z (Del Moral, Doucet and Jasra 2006).
+L^(β' − β), resamples them and moves them with Metropolis steps that leave π_β' invariant. The
+rungs are chosen so that the reweighting keeps half the effective sample size (Jasra et al.
+2011; Zhou, Johansen and Aston 2016). The product of the rungs' mean weights is the
+stepping-stone estimate of ln Z (Del Moral, Doucet and Jasra 2006; Xie et al. 2011), kept in
+``LadderRun.log_z``; it depends on every rung being in equilibrium and scatters by 0.3–1 nats
+between runs here, so :func:`bayesfo.inference.evidence.ladder_evidence` takes ln Z by bridge
+sampling from the final particles instead (a few hundredths of a nat).
 
 The moves are differential-evolution proposals (ter Braak 2006) drawn from the population at
 the start of the rung: u' = u + γ (u_a − u_b) for two other particles a, b. The difference of
@@ -22,14 +25,16 @@ normal mixture fitted to the particles and one fitted to those draws; the steps 
 the tempered posterior whatever the guide, so it can only help the particles find modes, not
 bias their weights.
 
-The error is the spread of independent runs, ``n_runs`` of them (the single-run variance
-estimators degenerate once the genealogy of the particles collapses).
+The error of ``ladder_evidence`` combines the bridge-sampling errors of independent runs with
+their spread (the single-run variance estimators of sequential Monte Carlo degenerate once the
+genealogy of the particles collapses).
 
 References
 ----------
 P. Del Moral, A. Doucet and A. Jasra (2006), J. R. Stat. Soc. B 68; W. Xie, P. O. Lewis, Y. Fan,
 L. Kuo and M.-H. Chen (2011), Syst. Biol. 60; C. J. F. ter Braak (2006), Stat. Comput. 16;
-Y. Zhou, A. M. Johansen and J. A. D. Aston (2016), J. Comput. Graph. Stat. 25.
+Y. Zhou, A. M. Johansen and J. A. D. Aston (2016), J. Comput. Graph. Stat. 25; A. Jasra,
+D. A. Stephens, A. Doucet and T. Tsagaris (2011), Scand. J. Stat. 38.
 """
 
 from __future__ import annotations
@@ -48,7 +53,8 @@ from .posterior import _Transform
 
 @dataclass(frozen=True)
 class LadderRun:
-    """One sequential Monte Carlo run: its ln Z, the rungs β and the final particles (u)."""
+    """One sequential Monte Carlo run: its stepping-stone ln Z, the rungs β, the final particles
+    (in the sampling coordinates u), their log-likelihoods and the acceptance rate per rung."""
 
     log_z: float
     betas: np.ndarray
@@ -64,7 +70,6 @@ class _Target:
     def __init__(self, lik: Likelihood):
         self.lik = lik
         self.tr = _Transform(lik)
-        self.k = lik.structure.n_params
         self.calls = 0
 
     def __call__(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -221,7 +221,9 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
         short = compare(data, voigt, seed=1, progress=False, max_steps=100)["voigt"]
     assert not short.posterior.converged
     assert short.criteria["evidence"].method == "ladder"
-    assert short.criteria["evidence"].log_z == pytest.approx(ev.log_z, abs=1e-9)
+    # The ladder's guide (the draws) differs, its integral does not.
+    other = short.criteria["evidence"]
+    assert abs(other.log_z - ev.log_z) < 4 * math.hypot(other.log_z_err, ev.log_z_err) + 0.02
     assert not any("unreliable" in w for w in short.criteria["warnings"])
     # The report marks the ladder's value and says how it was computed.
     from bayesfo.report import render_report

@@ -486,7 +486,8 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
             criteria = _criteria(lik, fit, post)
             if test is not None:
                 criteria.update(_holdout(lik, post, test))
-            extra = _evidence(lik, post, seed, options["evidence_check"], options["evidence"])
+            extra = _evidence(lik, post, seed, options["evidence_check"], options["evidence"],
+                              best_log_likelihood=criteria["max_log_likelihood"])
             criteria["warnings"].extend(extra.pop("warnings"))
             criteria.update(extra)
             result = StructureResult(s, fit, post, criteria)
@@ -522,7 +523,14 @@ class EvidenceWarning(UserWarning):
     """The two evidence estimates disagree, or the evidence could not be computed."""
 
 
-def _evidence(lik, post, seed, check: bool, route: str = "auto") -> dict:
+#: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by the
+#: optimiser and the sampler has missed part of the posterior (1 000 particles of a posterior
+#: reach within a few nats of its maximum).
+LADDER_SHORTFALL = 5.0
+
+
+def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
+              best_log_likelihood: float | None = None) -> dict:
     out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": []}
     # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
     # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
@@ -544,6 +552,14 @@ def _evidence(lik, post, seed, check: bool, route: str = "auto") -> dict:
     except InputError as exc:
         warnings.warn(f"{post.structure}: no evidence: {exc}", EvidenceWarning, stacklevel=3)
         return out
+    ev = out["evidence"]
+    if (ev.reached_log_likelihood is not None and best_log_likelihood is not None
+            and ev.reached_log_likelihood < best_log_likelihood - LADDER_SHORTFALL):
+        message = (f"{post.structure}: a tempered-ladder run ended "
+                   f"{best_log_likelihood - ev.reached_log_likelihood:.1f} nats below the best "
+                   "fit, so its ln Z may be too low")
+        out["warnings"].append(message)
+        warnings.warn(message, EvidenceWarning, stacklevel=3)
     if not post.converged and out["evidence"].method == "bridge":
         out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
     if check:

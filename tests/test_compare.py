@@ -230,6 +230,17 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
 
     html = render_report(compare(data, voigt, seed=1, progress=False, evidence="ladder"))
     assert f"{ev.log_z:.2f} L</td>" in html and "ln Z from a tempered ladder" in html
+    # A ladder run that ends well below the best fit is flagged (its ln Z may be too low).
+    from bayesfo.compare import EvidenceWarning, _evidence
+    from bayesfo.inference import Likelihood
+
+    lik, best = Likelihood(voigt[0], data), result["voigt"].criteria["max_log_likelihood"]
+    assert abs(best - ev.reached_log_likelihood) < 2
+    ok = _evidence(lik, result["voigt"].posterior, 1, False, "ladder", best_log_likelihood=best)
+    assert not ok["warnings"]
+    with pytest.warns(EvidenceWarning, match="ended 1[0-9].[0-9] nats below the best fit"):
+        _evidence(lik, result["voigt"].posterior, 1, False, "ladder",
+                  best_log_likelihood=ev.reached_log_likelihood + 12)
     assert result.table()[0]["evidence_method"] == "bridge"
     with pytest.raises(InputError, match="evidence must be"):
         compare(data, voigt, evidence="nested")

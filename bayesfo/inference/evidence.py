@@ -59,6 +59,9 @@ class Evidence:
         Likelihood evaluations spent by the estimator.
     seconds : float
         Wall time.
+    reached_log_likelihood : float or None
+        Tempered ladder only: the highest log-likelihood among the final particles of the run
+        that reached least high (a run that ends well below the best fit has missed mass).
     """
 
     log_z: float
@@ -67,6 +70,7 @@ class Evidence:
     log_support: float
     n_likelihood: int
     seconds: float
+    reached_log_likelihood: float | None = None
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
@@ -207,7 +211,7 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
     if n_runs < 2:
         raise ValueError("n_runs must be at least 2 (their spread is part of the error)")
     runs = np.random.SeedSequence(seed).spawn(n_runs)
-    values, errors, calls = [], [], 0
+    values, errors, calls, reached = [], [], 0, []
     guide_u = None if guide is None else _Transform(lik).to_u(guide.samples_scaled)
     for i, child in enumerate(runs):
         run = ladder_run(lik, np.random.default_rng(child), n_particles=n_particles,
@@ -216,6 +220,7 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
         values.append(ev.log_z)
         errors.append(ev.log_z_err)
         calls += run.n_likelihood + ev.n_likelihood
+        reached.append(float(np.max(run.log_likelihood)))
     values, errors = np.array(values), np.array(errors)
     err = math.sqrt((np.mean(errors**2) + np.var(values, ddof=1)) / n_runs)
     return Evidence(
@@ -225,6 +230,7 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
         log_support=ev.log_support,
         n_likelihood=int(calls),
         seconds=time.perf_counter() - t0,
+        reached_log_likelihood=min(reached),
     )
 
 

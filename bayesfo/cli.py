@@ -68,7 +68,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] left out of the fit for validation")
-    p.add_argument("--evidence", default="auto", choices=("auto", "bridge", "ladder"),
+    p.add_argument("--evidence", default="auto", choices=batch.EVIDENCE_ROUTES,
                    help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
                         "ladder (ladder); auto: the ladder where the posterior did not converge")
     p.add_argument("--evidence-check", action="store_true",

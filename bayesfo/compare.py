@@ -560,7 +560,7 @@ def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
                    "fit, so its ln Z may be too low")
         out["warnings"].append(message)
         warnings.warn(message, EvidenceWarning, stacklevel=3)
-    if not post.converged and out["evidence"].method == "bridge":
+    if not post.converged and ev.method == "bridge":
         out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
     if check:
         # Uniform draws from bounding ellipsoids where emcee found one compact mode; slice

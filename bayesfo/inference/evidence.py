@@ -129,7 +129,7 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
 
 
 def _bridge(lik: Likelihood, draws: np.ndarray, *, seed: int, max_iter: int = 1000,
-            tol: float = 1e-10, method: str = "bridge") -> Evidence:
+            tol: float = 1e-10) -> Evidence:
     """Bridge sampling from posterior draws ``draws`` (chains × draws × parameters, in the
     sampling coordinates): every other draw of each chain fits the proposal, the rest enter
     the bridge with their effective size."""
@@ -184,7 +184,7 @@ def _bridge(lik: Likelihood, draws: np.ndarray, *, seed: int, max_iter: int = 10
     return Evidence(
         log_z=log_z_support - log_s,
         log_z_err=math.sqrt(re2 + log_s_err**2),
-        method=method,
+        method="bridge",
         log_support=log_s,
         n_likelihood=int(n1 + n2),
         seconds=time.perf_counter() - t0,

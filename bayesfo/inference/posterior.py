@@ -171,26 +171,40 @@ class _Transform:
             return np.where(self.log, np.log(np.abs(theta)), theta)
 
 
-def _log_prob_fn(lik: Likelihood, tr: _Transform):
-    """Log posterior density in u (the hot path: one vectorised call per half-ensemble)."""
+def _log_parts_fn(lik: Likelihood, tr: _Transform):
+    """(log prior density in u, log-likelihood) of a batch of points in u, both −inf outside
+    the support; the tempered ladder weighs the two parts differently."""
     k = lik.structure.n_params
     kind, grid = lik.data.kind, lik.grid
 
-    def log_prob(u):
+    def log_parts(u):
         u = np.atleast_2d(u)
-        out = np.full(u.shape[0], -np.inf)
+        log_prior = np.full(u.shape[0], -np.inf)
+        log_lik = np.full(u.shape[0], -np.inf)
         rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
         if not rows.size:
-            return out
+            return log_prior, log_lik
         theta = tr.to_theta(u[rows])
         ok = lik.structure.constraints_hold(theta[:, :k], kind, grid)
         rows, theta = rows[ok], theta[ok]
         if rows.size:
-            lp = tr.flat_const + lik(theta)
+            lp = np.full(rows.size, tr.flat_const)
             for i, prior in tr.other:
                 lp = lp + prior.log_prob(theta[:, i])
-            out[rows] = lp
-        return out
+            log_prior[rows] = lp
+            log_lik[rows] = lik(theta)
+        return log_prior, log_lik
+
+    return log_parts
+
+
+def _log_prob_fn(lik: Likelihood, tr: _Transform):
+    """Log posterior density in u (the hot path: one vectorised call per half-ensemble)."""
+    log_parts = _log_parts_fn(lik, tr)
+
+    def log_prob(u):
+        log_prior, log_lik = log_parts(u)
+        return log_prior + log_lik
 
     return log_prob
 

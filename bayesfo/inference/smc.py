@@ -48,7 +48,7 @@ from scipy.special import logsumexp
 from ..errors import InputError
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
-from .posterior import _Transform
+from .posterior import _log_parts_fn, _Transform
 
 
 @dataclass(frozen=True)
@@ -65,31 +65,18 @@ class LadderRun:
 
 
 class _Target:
-    """Log prior (in the sampling coordinates u) and log-likelihood of a batch of particles."""
+    """Log prior (in the sampling coordinates u) and log-likelihood of a batch of particles,
+    counting the likelihood evaluations."""
 
     def __init__(self, lik: Likelihood):
         self.lik = lik
         self.tr = _Transform(lik)
+        self._parts = _log_parts_fn(lik, self.tr)
         self.calls = 0
 
     def __call__(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        tr, lik = self.tr, self.lik
-        log_prior = np.full(u.shape[0], -np.inf)
-        log_lik = np.full(u.shape[0], -np.inf)
-        rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
-        if rows.size:
-            theta = tr.to_theta(u[rows])
-            ok = lik.in_support(theta)
-            rows, theta = rows[ok], theta[ok]
-        if rows.size:
-            self.calls += rows.size
-            lp = np.full(rows.size, tr.flat_const)
-            for i, prior in tr.other:
-                lp = lp + prior.log_prob(theta[:, i])
-            ll = lik(theta)
-            good = np.isfinite(lp) & np.isfinite(ll)
-            log_prior[rows[good]] = lp[good]
-            log_lik[rows[good]] = ll[good]
+        log_prior, log_lik = self._parts(u)
+        self.calls += int(np.count_nonzero(np.isfinite(log_prior)))
         return log_prior, log_lik
 
 

@@ -71,8 +71,9 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from ._io import atomic_write_text, publish, read_text_file
+from ._io import atomic_write_text, read_text_file
 from .errors import InputError
+from .outdir import check_output_directory, is_output_path, recover, staged_run
 
 #: Options of one data set, with the defaults of ``bayesfo compare``.
 DEFAULT_OPTIONS = {
@@ -143,6 +144,9 @@ class DataSet:
         Temperature [°C] of an isotherm, if known.
     origin : str
         Where the data set was named (an argument, or a manifest line), for messages.
+    error : str or None
+        Bad input found while the inputs were read (a ``# temperature:`` line that is not a
+        temperature): the data set is recorded as an input error and not run; the others run.
     """
 
     id: str
@@ -151,6 +155,7 @@ class DataSet:
     seed: int
     temperature: float | None = None
     origin: str = ""
+    error: str | None = None
 
     def task(self) -> dict:
         """The picklable task of :func:`run_task`, carrying the data file's bytes (a few kB)
@@ -345,6 +350,15 @@ def temperature_of_file(path) -> float | None:
     return float(found[-1].replace("\u2212", "-")) if found else None
 
 
+def _temperature_or_error(path) -> tuple[float | None, str | None]:
+    """:func:`temperature_of_file`, with its input error as a message instead: one bad file
+    does not stop the batch."""
+    try:
+        return temperature_of_file(path), None
+    except InputError as exc:
+        return None, str(exc)
+
+
 # ---------------------------------------------------------------------- inputs and manifests
 def _looks_like_manifest(path: Path) -> bool:
     """A CSV whose header row has a ``path`` column (data files never have one)."""
@@ -391,6 +405,7 @@ class _Entry:
     temperature: float | None
     origin: str
     id: str | None = None  # given in a manifest
+    error: str | None = None  # see DataSet.error
 
 
 def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list[_Entry]:
@@ -509,9 +524,10 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
             problem = "is a directory" if file.is_dir() else "does not exist"
             raise InputError(f"{at}, column 'path': file '{file}' {problem}")
         opts = check_options(opts, at)
+        error = None
         if temperature is None:
-            temperature = temperature_of_file(file)
-        entries.append(_Entry(file, opts, row_seed, temperature, at, entry_id))
+            temperature, error = _temperature_or_error(file)
+        entries.append(_Entry(file, opts, row_seed, temperature, at, entry_id, error))
     if header is None:
         raise InputError(f"{where} is empty: expected a header row with a 'path' column")
     if not entries:
@@ -560,7 +576,8 @@ def expand_inputs(inputs=(), *, manifests=(), options: dict | None = None, seed:
     entries: list[_Entry] = []
 
     def data_file(file: Path, origin: str):
-        entries.append(_Entry(file, opts, seed, temperature_of_file(file), origin))
+        temperature, error = _temperature_or_error(file)
+        entries.append(_Entry(file, opts, seed, temperature, origin, error=error))
 
     def excluded(file: Path) -> bool:
         return exclude is not None and exclude in file.resolve().parents
@@ -662,7 +679,7 @@ def _assign_ids(entries: list[_Entry]) -> list[DataSet]:
     for e in auto:
         taken[ids[id(e)].lower()] = e.origin
     return [DataSet(e.id if e.id is not None else ids[id(e)], str(e.path), e.options, e.seed,
-                    e.temperature, e.origin) for e in entries]
+                    e.temperature, e.origin, e.error) for e in entries]
 
 
 # ====================================================================== the task
@@ -905,30 +922,20 @@ def temperature_rows(rows) -> list[dict]:
 
 
 # ====================================================================== output directory
-def _atomic_write_bytes(path: Path, data: bytes) -> Path:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        publish(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
 def _stored_rows(ds: DataSet, out_dir: Path, fingerprint: dict) -> tuple | None:
     """The rows of a data set whose stored result is complete for ``fingerprint``, else None."""
     sub = out_dir / ds.id
+    if sub.is_symlink():  # never followed: its files would lie outside the output directory
+        return None
     try:
+        recover(sub)  # a swap that an interrupted run left half done
         record = json.loads((sub / _BATCH_JSON).read_text(encoding="utf-8"))
         if (record.get("format") != _FORMAT or record.get("status") != OK
                 or record.get("task") != fingerprint):
             return None
-        if not all((sub / name).is_file() for name in record.get("files", [])):
+        files = record.get("files")
+        if not isinstance(files, list) or not all(
+                is_output_path(name) and (sub / name).is_file() for name in files):
             return None
         summary = json.loads((sub / "summary.json").read_text(encoding="utf-8"))
         return _dataset_rows(ds, OK, None, summary_rows(summary))
@@ -936,72 +943,49 @@ def _stored_rows(ds: DataSet, out_dir: Path, fingerprint: dict) -> tuple | None:
         return None
 
 
-def _known_files(sub: Path) -> set[str]:
-    """Output files of an earlier run in ``sub``: those its ``batch.json`` lists, and any of the
-    names ``write_outputs`` uses (in case ``batch.json`` was never written)."""
-    known = set()
-    try:
-        known.update(json.loads((sub / _BATCH_JSON).read_text(encoding="utf-8"))["files"])
-    except (OSError, ValueError, KeyError, TypeError):
-        pass
-    known.update(n for n in ("summary.json", "ranking.csv", "report.html") if (sub / n).is_file())
-    known.update(f.name for f in sub.glob("*.nc"))
-    if (sub / "figures").is_dir():
-        known.update(f.relative_to(sub).as_posix() for f in (sub / "figures").rglob("*")
-                     if f.is_file())
-    return known
-
-
 def _store(ds: DataSet, result: dict, out_dir: Path, fingerprint: dict) -> Outcome:
-    """Write a worker's result into ``out_dir/<id>/``, ``summary.json`` after the other outputs
-    and ``batch.json`` last; remove outputs of an earlier run that this one did not write."""
+    """Write a worker's result into ``out_dir/<id>/`` as one unit (:func:`bayesfo.outdir.staged_run`):
+    the outputs of an earlier run there are replaced by this one's, ``batch.json`` included."""
     sub = out_dir / ds.id
-    sub.mkdir(parents=True, exist_ok=True)
-    stale = _known_files(sub)
-    for name in (_BATCH_JSON, _ERROR_TXT):  # no longer valid, whatever happens next
-        (sub / name).unlink(missing_ok=True)
     files = (result.get("files") or {}) if result["status"] == OK else {}
     for name in files:
-        parts = Path(name).parts
-        if Path(name).is_absolute() or ".." in parts or not parts:
+        if not is_output_path(name):
             raise ValueError(f"output file name {name!r} leaves the data set's directory")
-    for name in sorted(files, key=lambda n: n == "summary.json"):  # summary.json last
-        target = sub / name
-        target.parent.mkdir(parents=True, exist_ok=True)
-        _atomic_write_bytes(target, files[name])
-    for name in stale - set(files):
-        (sub / name).unlink(missing_ok=True)
-    for d in sorted((p for p in sub.rglob("*") if p.is_dir()), key=lambda p: -len(p.parts)):
-        if not any(d.iterdir()):
-            d.rmdir()
-    if result["status"] == OK:
-        summary = json.loads(files["summary.json"].decode("utf-8"))
-        rows = _dataset_rows(ds, OK, None, summary_rows(summary))
-    else:
-        text = f"{result['error']}\n"
-        if result.get("traceback"):
-            text += "\n" + result["traceback"]
-        atomic_write_text(sub / _ERROR_TXT, text)
-        rows = _dataset_rows(ds, result["status"], result["error"])
-    record = {
-        "format": _FORMAT, "id": ds.id, "path": ds.path, "temperature_C": ds.temperature,
-        "task": fingerprint, "status": result["status"], "error": result["error"],
-        "warnings": result.get("warnings", []), "files": sorted(files),
-        "compare_seconds": result.get("compare_seconds"),
-        "compare_cpu_seconds": result.get("compare_cpu_seconds"),
-        "task_seconds": result.get("task_seconds"), "host": result.get("host"),
-        "pid": result.get("pid"), "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-    }
-    atomic_write_text(sub / _BATCH_JSON, json.dumps(record, indent=2) + "\n")
+    if sub.is_symlink():  # a link in the output directory is replaced, never followed
+        sub.unlink()
+    with staged_run(sub) as stage:
+        for name in files:
+            target = stage / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(files[name])
+        if result["status"] == OK:
+            summary = json.loads(files["summary.json"].decode("utf-8"))
+            rows = _dataset_rows(ds, OK, None, summary_rows(summary))
+        else:
+            text = f"{result['error']}\n"
+            if result.get("traceback"):
+                text += "\n" + result["traceback"]
+            (stage / _ERROR_TXT).write_text(text, encoding="utf-8")
+            rows = _dataset_rows(ds, result["status"], result["error"])
+        record = {
+            "format": _FORMAT, "id": ds.id, "path": ds.path, "temperature_C": ds.temperature,
+            "task": fingerprint, "status": result["status"], "error": result["error"],
+            "warnings": result.get("warnings", []), "files": sorted(files),
+            "compare_seconds": result.get("compare_seconds"),
+            "compare_cpu_seconds": result.get("compare_cpu_seconds"),
+            "task_seconds": result.get("task_seconds"), "host": result.get("host"),
+            "pid": result.get("pid"), "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        }
+        (stage / _BATCH_JSON).write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
     return Outcome(ds, result["status"], result["error"], False, rows,
                    tuple(result.get("warnings", [])), result.get("compare_seconds"),
                    result.get("compare_cpu_seconds"), result.get("task_seconds"))
 
 
-def _lost(ds: DataSet, exc: BaseException) -> dict:
+def _lost(ds: DataSet, exc: BaseException, why: str = "the worker failed") -> dict:
     """The result of a task whose worker failed (died, or lost its connection)."""
     return {"id": ds.id, "status": INTERNAL_ERROR, "files": {}, "warnings": [],
-            "error": f"the worker failed: {type(exc).__name__}: {exc}", "traceback": None}
+            "error": f"{why}: {type(exc).__name__}: {exc}", "traceback": None}
 
 
 def write_batch_outputs(result_rows, out_dir, structures=None) -> dict[str, Path]:
@@ -1042,32 +1026,56 @@ def _run_in_process(todo, on_result):
         on_result(ds, run_task(ds.task()))
 
 
-def _run_processes(todo, workers, on_result):
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+def _run_pool(todo, workers, on_result, task=run_task) -> list:
+    """Run ``task`` (:func:`run_task`) on ``todo`` in one pool of ``workers`` processes; return
+    the data sets whose pool broke (a worker died) before they finished, each with the
+    exception."""
+    from concurrent.futures.process import BrokenProcessPool
 
-    pool = ProcessPoolExecutor(max_workers=workers,
-                               mp_context=multiprocessing.get_context("spawn"))
-    try:
-        from .compare import worker_environment
+    from .parallel import new_pool, terminate, worker_environment
 
-        with worker_environment():  # processes are spawned while tasks are submitted
-            futures = {pool.submit(run_task, ds.task()): ds for ds in todo}
-        pending = set(futures)
-        while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in done:
-                ds = futures.pop(fut)  # drop the future and its output files once stored
-                try:
-                    result = fut.result()
-                except Exception as exc:  # the worker died (BrokenProcessPool) or similar
-                    result = _lost(ds, exc)
-                on_result(ds, result)
-            del done
-    except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
+    broken = []
+    with worker_environment():  # processes are spawned while tasks are submitted
+        pool = new_pool(workers)
+        try:
+            futures = {pool.submit(task, ds.task()): ds for ds in todo}
+            pending = set(futures)
+            while pending:
+                done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    ds = futures.pop(fut)  # drop the future and its output files once stored
+                    try:
+                        result = fut.result()
+                    except BrokenProcessPool as exc:
+                        broken.append((ds, exc))
+                        continue
+                    except Exception as exc:  # e.g. a result that cannot be unpickled
+                        result = _lost(ds, exc)
+                    on_result(ds, result)
+                del done
+        except BaseException:
+            terminate(pool)
+            raise
+        if broken:
+            terminate(pool)
+        else:
+            pool.shutdown(wait=True)
+    return broken
+
+
+def _run_processes(todo, workers, on_result, task=run_task):
+    """Run the data sets in worker processes. When a worker dies (killed, out of memory, a
+    crash in native code), the pool breaks and every unfinished data set is run again in a new
+    pool; if that breaks too, the rest run one by one, each in a pool of its own, so that only
+    the data set whose worker dies is recorded as failed."""
+    broken = _run_pool(todo, workers, on_result, task)
+    if broken:
+        broken = _run_pool([ds for ds, _ in broken], min(workers, len(broken)), on_result, task)
+    for ds, _ in broken:
+        again = _run_pool([ds], 1, on_result, task)
+        for ds_, exc in again:
+            on_result(ds_, _lost(ds_, exc, "its worker process died in each of three attempts "
+                                           "(killed, out of memory, or a crash in native code)"))
 
 
 def _dask_client(scheduler):
@@ -1157,16 +1165,17 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 0):
         raise InputError(f"--workers must be a non-negative integer, got {workers!r}")
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = check_output_directory(out_dir)
 
     outcomes: dict[str, Outcome] = {}
     fingerprints = {}
     todo = []
     for ds in datasets:
         fingerprints[ds.id] = fp = ds.fingerprint()
-        rows = _stored_rows(ds, out_dir, fp)
-        if rows is not None:
+        if ds.error is not None:
+            outcomes[ds.id] = _store(ds, {"id": ds.id, "status": INPUT_ERROR, "error": ds.error,
+                                          "files": {}, "warnings": []}, out_dir, fp)
+        elif (rows := _stored_rows(ds, out_dir, fp)) is not None:
             outcomes[ds.id] = Outcome(ds, OK, None, True, rows)
         else:
             todo.append(ds)
@@ -1192,7 +1201,7 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
                 if own:
                     client.close()
         else:
-            from .compare import available_cpus
+            from .parallel import available_cpus
 
             n = min(workers or available_cpus(), len(todo))
             if n == 1:

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, batch
-from .errors import InputError
+from .errors import InputError, OutputError
 
 
 class _Parser(argparse.ArgumentParser):
@@ -233,6 +233,7 @@ def _parse_priors(specs) -> dict:
 
 def cmd_compare(args) -> int:
     from .compare import available_cpus, compare, process_pool, write_outputs
+    from .outdir import check_output_directory
     from .structures import resolve_structures
 
     data = _read(args)
@@ -242,7 +243,7 @@ def cmd_compare(args) -> int:
     unknown = [k for k in priors if k not in known]
     if unknown:
         raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
-    out = Path(args.out) if args.out else Path(f"bayesfo-{Path(args.data).stem}")
+    out = check_output_directory(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
     progress = not args.quiet and sys.stderr.isatty()
     holdout = _parse_floats(args.holdout, "--holdout") if args.holdout else None
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
@@ -419,30 +420,55 @@ def _one_line_warning(message, category, filename, lineno, file=None, line=None)
     print(f"bayesfo: warning: {message}", file=sys.stderr)
 
 
+class Terminated(BaseException):
+    """SIGTERM arrived: unwinds like Ctrl-C, so that outputs are left as they were and worker
+    processes are ended."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated
+
+
 def main(argv=None) -> int:
     """Run the command line; returns the exit status."""
+    import signal
+    import threading
+
     parser = build_parser()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         args = parser.parse_args(argv)
         if args.command is None:
             parser.print_help()
             return 2
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.showwarning = _one_line_warning
-            np.seterr(all="ignore")
             return COMMANDS[args.command](args)
     except InputError as exc:
         print(f"bayesfo: error: {exc}", file=sys.stderr)
         return 2
+    except OutputError as exc:
+        print(f"bayesfo: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
-        print("bayesfo: interrupted", file=sys.stderr)
+        print("bayesfo: interrupted (no output is left half-written)",
+              file=sys.stderr)
         return 130
+    except Terminated:
+        print("bayesfo: terminated (no output is left half-written)",
+              file=sys.stderr)
+        return 143
     except Exception as exc:  # the contract: exit 1 on internal errors, no traceback by default
         if os.environ.get("BAYESFO_DEBUG"):
             raise
         print(f"bayesfo: internal error: {type(exc).__name__}: {exc} "
               "(set BAYESFO_DEBUG=1 for a traceback)", file=sys.stderr)
         return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -24,10 +24,8 @@ import csv
 import io
 import json
 import math
-import os
 import sys
 import warnings
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -38,66 +36,13 @@ from .data import FrequencyResponse
 from .errors import InputError
 from .identify.optimize import FitResult, fit_structure
 from .inference import Likelihood, PosteriorResult, run_posterior, save_netcdf
-from .inference.evidence import bridge_evidence, ladder_evidence, nested_evidence
 from .inference._arviz import arviz
+from .inference.evidence import bridge_evidence, ladder_evidence, nested_evidence
+from .outdir import final_path, staged_run
+from .parallel import WORKER_ENV, available_cpus, process_pool, worker_environment  # noqa: F401
 from .structures import Structure
 
 PARETO_K_WARN = 0.7
-
-#: Environment of worker processes: one BLAS thread each (the processes share the cores).
-WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-
-
-def available_cpus() -> int:
-    """CPUs this process may run on (its affinity where the system tells it)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
-@contextmanager
-def worker_environment():
-    """Single-threaded BLAS in the worker processes spawned inside this block (a variable the
-    user has set is kept)."""
-    saved = {k: os.environ.get(k) for k in WORKER_ENV}
-    for k, v in WORKER_ENV.items():
-        os.environ.setdefault(k, v)
-    try:
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
-@contextmanager
-def process_pool(workers: int = 0):
-    """Worker processes (spawn, one BLAS thread each) that :func:`compare` and
-    :func:`write_outputs` can share through their ``pool`` argument: the figures are then drawn
-    by processes that have already loaded the libraries.
-
-    Parameters
-    ----------
-    workers : int
-        Number of processes (0: one per CPU).
-
-    Yields
-    ------
-    concurrent.futures.ProcessPoolExecutor
-    """
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
-        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
-    # spawn: no fork of a process that may hold threads (BLAS, tqdm).
-    ctx = multiprocessing.get_context("spawn")
-    with worker_environment(), ProcessPoolExecutor(workers or available_cpus(),
-                                                   mp_context=ctx) as pool:
-        yield pool
 
 
 class PredictiveWarning(UserWarning):
@@ -642,15 +587,17 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
 
     One NetCDF per structure, the figures (``formats``; see
     :func:`bayesfo.plotting.write_figures`), ``report.html`` (self-contained, figures embedded),
-    ``ranking.csv`` and ``summary.json``, in that order, each through a temporary file and a
-    rename, so an interrupted run never leaves a half-written file and a ``summary.json`` means
-    the rest is complete.
+    ``ranking.csv`` and ``summary.json``. Everything is written into a staging directory inside
+    ``out_dir`` and swapped in at the end (:mod:`bayesfo.outdir`), so ``out_dir`` always holds the
+    complete output of one run: an interrupted run leaves the earlier output as it was, and the
+    outputs of an earlier run that this one does not write (a structure left out) are removed.
+    Files of the user's own in ``out_dir`` are never touched.
 
     Parameters
     ----------
     comparison : Comparison
     out_dir : path
-        Created if missing; existing files of the same names are replaced.
+        Created if missing.
     figures : bool
         Draw the figures and the report (matplotlib; a few seconds per structure).
     formats : sequence of str
@@ -664,21 +611,22 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         ``{name: path}`` of the files written (figures: ``{name: [paths]}``).
     """
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     written = {}
-    for r in comparison.results:
-        if r.posterior is not None:
-            written[r.name] = save_netcdf(r.posterior.idata, out_dir / f"{r.name}.nc")
-    if figures:
-        from .plotting import write_figures
-        from .report import write_report
+    with staged_run(out_dir) as stage:
+        for r in comparison.results:
+            if r.posterior is not None:
+                written[r.name] = save_netcdf(r.posterior.idata, stage / f"{r.name}.nc")
+        if figures:
+            from .plotting import write_figures
+            from .report import write_report
 
-        drawn = write_figures(comparison, out_dir / "figures", formats=formats,
-                              seed=comparison.seed, pool=pool)
-        written.update(drawn)
-        written["report.html"] = write_report(comparison, out_dir, drawn)
-    written["ranking.csv"] = atomic_write_text(out_dir / "ranking.csv", ranking_csv(comparison))
-    text = json.dumps(_finite(comparison.to_summary()), indent=2, default=_json_default,
-                      allow_nan=False)
-    written["summary.json"] = atomic_write_text(out_dir / "summary.json", text + "\n")
-    return written
+            drawn = write_figures(comparison, stage / "figures", formats=formats,
+                                  seed=comparison.seed, pool=pool)
+            written.update(drawn)
+            written["report.html"] = write_report(comparison, stage, drawn)
+        written["ranking.csv"] = atomic_write_text(stage / "ranking.csv", ranking_csv(comparison))
+        text = json.dumps(_finite(comparison.to_summary()), indent=2, default=_json_default,
+                          allow_nan=False)
+        written["summary.json"] = atomic_write_text(stage / "summary.json", text + "\n")
+    return {name: [final_path(p, stage, out_dir) for p in paths] if isinstance(paths, list)
+            else final_path(paths, stage, out_dir) for name, paths in written.items()}

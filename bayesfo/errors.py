@@ -23,5 +23,10 @@ class StructureError(InputError):
     """A structure card or structure name that cannot be used."""
 
 
+class OutputError(BayesfoError, OSError):
+    """The outputs cannot be written (no space left, no permission); the earlier outputs in the
+    output directory are kept. The command line maps it to exit status 1 with one line."""
+
+
 class NonlinearityWarning(UserWarning):
     """A sine record whose harmonics show that the system is not linear at that amplitude."""

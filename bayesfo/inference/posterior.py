@@ -17,8 +17,10 @@ and has ``converged = False``.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
+import shutil
 import sys
 import tempfile
 import warnings
@@ -562,10 +564,33 @@ def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kep
     return idata
 
 
+def _netcdf_bytes_needed(idata) -> int:
+    """An upper bound of the size of ``idata`` as NetCDF: its arrays uncompressed, plus the
+    HDF5 headers of every variable and group."""
+    total = 0
+    for group in idata.groups():
+        ds = idata[group]
+        total += ds.nbytes + 16_384 * (len(ds.variables) + 1)
+    return total + 65_536
+
+
 def save_netcdf(idata, path) -> Path:
-    """Write InferenceData to NetCDF through a temporary file and an atomic rename."""
+    """Write InferenceData to NetCDF through a temporary file and an atomic rename.
+
+    Raises
+    ------
+    OSError
+        ``ENOSPC`` before anything is written when the file system has less free space than the
+        file may need: HDF5 fails on a full disk with errors it cannot recover from (the
+        process crashes at exit), so the space is checked first.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    needed = _netcdf_bytes_needed(idata)
+    free = shutil.disk_usage(path.parent).free
+    if free < needed:
+        raise OSError(errno.ENOSPC, f"{needed} bytes may be needed for {path.name}, "
+                                    f"{free} are free", str(path.parent))
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".nc", dir=path.parent)
     os.close(fd)
     try:

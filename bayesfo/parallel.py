@@ -1,0 +1,127 @@
+"""Worker processes for the structures of a comparison and the data sets of a batch.
+
+Workers are spawned (no fork of a process that may hold threads), run one BLAS thread each,
+ignore Ctrl-C (the parent answers it, once) and end when their parent dies, so an interrupted or
+killed run never leaves orphans behind. :func:`process_pool` ends its workers at once when the
+block that uses it raises.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+from contextlib import contextmanager
+
+from .errors import InputError
+
+#: Environment of worker processes: one BLAS thread each (the processes share the cores).
+WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+_PR_SET_PDEATHSIG = 1  # prctl(2) option: a signal for this process when its parent dies
+
+
+def available_cpus() -> int:
+    """CPUs this process may run on (its affinity where the system tells it)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+@contextmanager
+def worker_environment():
+    """Single-threaded BLAS in the worker processes spawned inside this block (a variable the
+    user has set is kept)."""
+    saved = {k: os.environ.get(k) for k in WORKER_ENV}
+    for k, v in WORKER_ENV.items():
+        os.environ.setdefault(k, v)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def init_worker() -> None:
+    """Initializer of every worker process: Ctrl-C goes to the parent alone (which ends the
+    workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL."""
+    import threading
+
+    from tqdm import tqdm
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # tqdm's default lock is a multiprocessing semaphore; a worker ended by terminate() never
+    # releases it and the resource tracker prints a warning at exit. A worker draws no bar
+    # of its own, so a thread lock does.
+    tqdm.set_lock(threading.RLock())
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the parent's own cleanup must do
+        pass
+
+
+def new_pool(workers: int):
+    """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` spawned processes with
+    :func:`init_worker`; create it inside :func:`worker_environment`."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=init_worker)
+
+
+def terminate(pool) -> None:
+    """End a pool's worker processes now, without waiting for their tasks."""
+    # ProcessPoolExecutor.shutdown waits for running tasks (minutes for a posterior);
+    # Python 3.14 has terminate_workers(), 3.11 only the executor's own process table.
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in processes:
+        try:
+            p.terminate()
+        except (OSError, ValueError, AttributeError):
+            pass
+    for p in processes:
+        try:
+            p.join(timeout=2)
+        except (OSError, ValueError, AssertionError):
+            pass
+    # The executor's manager thread sees the dead workers and releases the queues' semaphores;
+    # without waiting for it, the resource tracker reports them as leaked at exit.
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None:
+        manager.join(timeout=2)
+
+
+@contextmanager
+def process_pool(workers: int = 0):
+    """Worker processes (spawn, one BLAS thread each) that :func:`~bayesfo.compare.compare` and
+    :func:`~bayesfo.compare.write_outputs` can share through their ``pool`` argument: the
+    figures are then drawn by processes that have already loaded the libraries.
+
+    Parameters
+    ----------
+    workers : int
+        Number of processes (0: one per CPU).
+
+    Yields
+    ------
+    concurrent.futures.ProcessPoolExecutor
+        Its workers are ended at once if the block raises (Ctrl-C included).
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    with worker_environment():  # processes are spawned as tasks are submitted
+        pool = new_pool(workers or available_cpus())
+        try:
+            yield pool
+        except BaseException:
+            terminate(pool)
+            raise
+        pool.shutdown(wait=True)

@@ -1,0 +1,341 @@
+"""Reliability and security of the outputs: nothing outside the output directory is touched,
+each output directory holds the complete output of one run, faults end with one line.
+
+The comparisons are small (the simulated Voigt compliance of tests/test_compare.py, two
+structures, no figures) so the fault tests stay fast; the signal tests run the command line in a
+child process on a bundled isotherm and signal it while it samples and while it writes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import errno
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import psutil
+import pytest
+
+import bayesfo.outdir as outdir
+from bayesfo.batch import _run_processes, expand_inputs, run_batch
+from bayesfo.compare import compare, write_outputs
+from bayesfo.data import FrequencyResponse
+from bayesfo.errors import OutputError
+from bayesfo.structures import get_structure, resolve_structures
+
+ROOT = Path(__file__).parents[1]
+ADHESIVE = ROOT / "examples" / "data" / "adhesive_468mp"
+W = np.logspace(np.log10(0.6), np.log10(300), 25)
+
+
+def _tree(d: Path) -> dict:
+    """Every file below ``d`` (links not followed) with its bytes."""
+    return {p.relative_to(d).as_posix(): (os.readlink(p) if p.is_symlink() else p.read_bytes())
+            for p in sorted(d.rglob("*")) if p.is_symlink() or p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    rng = np.random.default_rng(0)
+    g = get_structure("voigt").response([1.0, 1e-3, 0.5], W, "compliance")
+    sd = 0.02 * np.abs(g)
+    data = FrequencyResponse(W, g + sd / np.sqrt(2) * (rng.normal(size=25)
+                                                        + 1j * rng.normal(size=25)),
+                             sd, kind="compliance", name="simulated voigt")
+    return compare(data, resolve_structures("voigt,zener"), seed=1, progress=False, workers=1)
+
+
+@pytest.fixture
+def earlier(comparison, tmp_path):
+    """An output directory holding a complete earlier run and a file of the user's own."""
+    out = tmp_path / "out"
+    write_outputs(comparison, out, figures=False)
+    (out / "notes.txt").write_text("mine")
+    return out, _tree(out)
+
+
+# ---------------------------------------------------------------------- one run per directory
+def test_an_interrupted_run_leaves_the_earlier_output(comparison, earlier, monkeypatch):
+    import bayesfo.compare
+
+    out, before = earlier
+    assert set(before) == {"voigt.nc", "zener.nc", "ranking.csv", "summary.json", "notes.txt"}
+
+    def interrupted(*args, **kwargs):  # after both NetCDF files were written
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(bayesfo.compare, "ranking_csv", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_outputs(comparison, out, figures=False)
+    assert _tree(out) == before
+    assert not list(out.glob(".bayesfo-*"))
+
+
+def test_a_later_run_leaves_nothing_of_the_earlier_one(comparison, earlier):
+    out, before = earlier
+    fewer = dataclasses.replace(comparison, results=comparison.results[:1])
+    written = write_outputs(fewer, out, figures=False)
+    assert sorted(_tree(out)) == ["notes.txt", "ranking.csv", "summary.json", "voigt.nc"]
+    assert written["summary.json"] == out / "summary.json"
+    assert json.loads((out / "summary.json").read_text())["ranking"] == ["voigt"]
+    assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_full_disk_keeps_the_earlier_output(comparison, earlier, monkeypatch):
+    import bayesfo.inference.posterior as posterior
+
+    out, before = earlier
+    monkeypatch.setattr(posterior.shutil, "disk_usage", lambda p: shutil._ntuple_diskusage(
+        10**9, 10**9 - 1000, 1000))
+    with pytest.raises(OutputError, match=r"no space left on the device of '.*out'; the "
+                                          "earlier outputs there are kept"):
+        write_outputs(comparison, out, figures=False)
+    assert _tree(out) == before and not list(out.glob(".bayesfo-*"))
+
+
+def test_write_error_in_a_figure_keeps_the_earlier_output(comparison, earlier, monkeypatch):
+    import bayesfo.plotting
+
+    out, before = earlier
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(bayesfo.plotting, "write_figures", full)
+    with pytest.raises(OutputError, match="no space left"):
+        write_outputs(comparison, out, figures=True)
+    assert _tree(out) == before and not list(out.glob(".bayesfo-*"))
+
+
+def test_a_swap_cut_short_is_completed_by_the_next_run(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text(json.dumps({"structures": [{"name": "a"}, {"name": "b"}]}))
+    (out / "a.nc").write_text("old a")
+    (out / "b.nc").write_text("old b")
+    (out / "figures").mkdir()
+    (out / "figures" / "old.png").write_text("old")
+    calls = []
+    real_replace = os.replace
+
+    def dies_after_two(src, dst):  # the process is killed during the renames
+        calls.append(dst)
+        if len(calls) > 2:
+            raise SystemExit("killed")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(outdir.os, "replace", dies_after_two)
+    with pytest.raises(SystemExit):
+        with outdir.staged_run(out) as stage:
+            (stage / "a.nc").write_text("new a")
+            (stage / "figures").mkdir()
+            (stage / "figures" / "new.png").write_text("new")
+            (stage / "ranking.csv").write_text("new")
+            (stage / "summary.json").write_text(json.dumps({"structures": [{"name": "a"}]}))
+    monkeypatch.setattr(outdir.os, "replace", real_replace)
+    assert (out / outdir.JOURNAL).exists() and not (out / "summary.json").exists()
+    outdir.recover(out)
+    assert _tree(out) == {"a.nc": b"new a", "figures/new.png": b"new", "ranking.csv": b"new",
+                          "summary.json": b'{"structures": [{"name": "a"}]}'}
+
+
+def test_abandoned_staging_directories_are_removed(tmp_path):
+    out = tmp_path / "out"
+    (out / ".bayesfo-staging-dead" / "new").mkdir(parents=True)
+    (out / ".bayesfo-staging-dead" / "new" / ".voigt.x.nc").write_text("half")
+    (out / "summary.json").write_text("{}")
+    outdir.recover(out)
+    assert _tree(out) == {"summary.json": b"{}"}
+
+
+# ---------------------------------------------------------------------- nothing outside --out
+SUMMARY = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"],
+           "structures": [{"name": "voigt", "n_params": 3, "log_evidence": -1.5,
+                           "posterior_probability": 1.0,
+                           "parameters": {"q": {"mean": 0.5, "sd": 0.1, "hdi_low": 0.3,
+                                                "hdi_high": 0.7, "map": 0.5}}}]}
+
+
+@pytest.fixture
+def fake_compare(monkeypatch):
+    """compare and write_outputs replaced by instant fakes (batch runs in this process)."""
+    import bayesfo.compare
+
+    def fake_outputs(comparison, out, figures=True):
+        out = Path(out)
+        (out / "voigt.nc").write_bytes(b"nc")
+        (out / "figures").mkdir()
+        (out / "figures" / "bode.png").write_bytes(b"png")
+        (out / "summary.json").write_text(json.dumps(SUMMARY))
+
+    monkeypatch.setattr(bayesfo.compare, "compare", lambda *args, **kwargs: None)
+    monkeypatch.setattr(bayesfo.compare, "write_outputs", fake_outputs)
+
+
+def _victims(tmp_path) -> dict:
+    """Files outside the output directory that a hostile output directory names."""
+    v = tmp_path / "victims"
+    v.mkdir()
+    for name in ("victim.txt", "victim.nc", "absolute.txt", "in-linked-dir.png", "x.png"):
+        (v / name).write_text("precious")
+    return {p: p.read_bytes() for p in v.iterdir()}
+
+
+@pytest.mark.parametrize("attack", ["batch.json", "summary.json", "figures-link", "subdir-link",
+                                    "journal"])
+def test_a_hostile_output_directory_cannot_touch_files_outside(tmp_path, fake_compare, attack):
+    victims = _victims(tmp_path)
+    vdir = tmp_path / "victims"
+    shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
+    out = tmp_path / "out"
+    sub = out / "a"
+    sub.mkdir(parents=True)
+    if attack == "batch.json":
+        (sub / "batch.json").write_text(json.dumps(
+            {"format": 1, "status": "ok", "task": {},
+             "files": ["../../victims/victim.txt", str(vdir / "absolute.txt")]}))
+    elif attack == "summary.json":
+        (sub / "summary.json").write_text(json.dumps(
+            {"structures": [{"name": "../../victims/victim"}, {"name": str(vdir / "victim")}]}))
+    elif attack == "figures-link":
+        (sub / "figures").symlink_to(vdir)
+    elif attack == "subdir-link":
+        sub.rmdir()
+        sub.symlink_to(vdir)
+    else:
+        (sub / ".bayesfo-staging-x" / "new").mkdir(parents=True)
+        (sub / outdir.JOURNAL).write_text(json.dumps(
+            {"staging": "../../victims", "old": ["../victims/victim.txt"], "new": []}))
+    res = run_batch(expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"}),
+                    out, workers=1, progress=False, write_combined=False)
+    assert res.outcomes[0].status == "ok"
+    assert {p: p.read_bytes() for p in vdir.iterdir()} == victims
+    assert not sub.is_symlink() and (sub / "figures" / "bode.png").read_bytes() == b"png"
+    assert json.loads((sub / "batch.json").read_text())["files"] == [
+        "figures/bode.png", "summary.json", "voigt.nc"]
+
+
+def test_a_bad_temperature_line_fails_only_its_data_set(tmp_path, fake_compare):
+    shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
+    text = (ADHESIVE / "Tp150C.csv").read_text()
+    (tmp_path / "b.csv").write_text("# temperature: warm\n" + text)
+    res = run_batch(expand_inputs([tmp_path]), tmp_path / "out", workers=1, progress=False,
+                    write_combined=False)
+    assert [(o.dataset.id, o.status) for o in res.outcomes] == [("a", "ok"),
+                                                               ("b", "input_error")]
+    assert res.outcomes[1].error.startswith(f"file '{tmp_path / 'b.csv'}', line 1: '# temperat")
+    assert res.exit_status == 2
+    assert (tmp_path / "out" / "b" / "error.txt").read_text().startswith("file ")
+
+
+# ---------------------------------------------------------------------- dead batch workers
+def crashing_task(task):
+    """A task whose worker dies (as if killed) for the data set 'crash'."""
+    if task["id"] == "crash":
+        os.kill(os.getpid(), signal.SIGKILL)
+    return {"id": task["id"], "status": "ok"}
+
+
+def test_one_dead_worker_fails_only_its_data_set(tmp_path):
+    from bayesfo.batch import DataSet
+
+    todo = [DataSet(name, "x.csv", {}, 0) for name in ("a", "crash", "b", "c")]
+    results = {}
+    _run_processes(todo, 2, lambda ds, r: results.setdefault(ds.id, r), task=crashing_task)
+    assert {k: r["status"] for k, r in results.items()} == {
+        "a": "ok", "b": "ok", "c": "ok", "crash": "internal_error"}
+    assert "its worker process died in each of three attempts" in results["crash"]["error"]
+
+
+# ---------------------------------------------------------------------- signals
+def _cli(*args, cwd):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    return subprocess.Popen([sys.executable, "-m", "bayesfo.cli", *map(str, args)], cwd=cwd,
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for(condition, timeout=120.0):
+    t0 = time.monotonic()
+    while not condition():
+        if time.monotonic() - t0 > timeout:
+            raise AssertionError("the awaited moment never came")
+        time.sleep(0.05)
+
+
+def _workers(proc) -> list:
+    try:
+        return [c for c in psutil.Process(proc.pid).children(recursive=True)
+                if "spawn_main" in " ".join(c.cmdline())]
+    except psutil.Error:
+        return []
+
+
+@pytest.mark.parametrize("sig, moment, status", [
+    (signal.SIGINT, "sampling", 130), (signal.SIGTERM, "sampling", 143),
+    (signal.SIGTERM, "writing", 143), (signal.SIGKILL, "writing", -9)])
+def test_a_signal_ends_compare_and_its_workers_leaving_the_earlier_output(
+        tmp_path, sig, moment, status):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text('{"structures": [{"name": "voigt"}]}')
+    (out / "voigt.nc").write_text("earlier")
+    before = _tree(out)
+    proc = _cli("compare", ADHESIVE / "Tp020C.csv", "--structures", "voigt,zener",
+                "--workers", "2", "--out", out, "--quiet", cwd=tmp_path)
+    if moment == "sampling":
+        _wait_for(lambda: len(_workers(proc)) == 2)
+        time.sleep(0.5)
+    else:
+        _wait_for(lambda: any(out.glob(".bayesfo-staging-*/new/*")))
+    workers = _workers(proc)
+    proc.send_signal(sig)
+    stdout, stderr = proc.communicate(timeout=10)
+    assert proc.returncode == status
+    gone, alive = psutil.wait_procs(workers, timeout=5)
+    assert not alive
+    if sig != signal.SIGKILL:
+        # Warnings of the run may come first; the end is one line, and no worker speaks.
+        lines = stderr.strip().splitlines()
+        assert all(line.startswith("bayesfo: ") for line in lines), stderr
+        assert lines[-1].endswith("(no output is left half-written)")
+    outdir.recover(out)  # what the next run into the directory does first
+    assert _tree(out) == before
+
+
+def test_output_directory_that_is_a_file_is_refused_before_work(tmp_path, run_cli):
+    (tmp_path / "taken").write_text("x")
+    t0 = time.perf_counter()
+    status, _, err = run_cli("compare", ADHESIVE / "Tp020C.csv", "--out", tmp_path / "taken")
+    assert status == 2 and time.perf_counter() - t0 < 5
+    assert err == f"bayesfo: error: --out '{tmp_path / 'taken'}' is a file, not a directory; " \
+                  "give a directory\n"
+    status, _, err = run_cli("batch", ADHESIVE / "Tp020C.csv", "--out", tmp_path / "taken" / "x")
+    assert status == 2 and "--out" in err and "a part of the path is a file" in err
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_ends_batch_and_its_workers(tmp_path, sig, status):
+    for name in ("Tp020C", "Tp150C"):
+        shutil.copy(ADHESIVE / f"{name}.csv", tmp_path / f"{name}.csv")
+    out = tmp_path / "out"
+    proc = _cli("batch", tmp_path / "Tp020C.csv", tmp_path / "Tp150C.csv", "--structures",
+                "voigt,zener", "--workers", "2", "--out", out, "--quiet", "--no-figures",
+                cwd=tmp_path)
+    _wait_for(lambda: len(_workers(proc)) == 2)
+    time.sleep(0.5)
+    workers = _workers(proc)
+    t0 = time.monotonic()
+    proc.send_signal(sig)
+    _, stderr = proc.communicate(timeout=10)
+    assert proc.returncode == status and time.monotonic() - t0 < 5
+    assert not psutil.wait_procs(workers, timeout=5)[1]
+    assert stderr.strip().splitlines()[-1].endswith("(no output is left half-written)")
+    assert "Traceback" not in stderr
+    assert not list(out.rglob(".bayesfo-staging-*"))

@@ -258,10 +258,29 @@ def check_options(options: dict, where: str) -> dict:
             "models": models, "figures": bool(opts["figures"])}
 
 
+#: Seeds are 32-bit: every random generator in the chain (numpy, scipy, emcee) accepts them.
+MAX_SEED = 2**32 - 1
+
+
 def _check_seed(seed, where: str) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InputError(f"{where}: the seed must be a non-negative integer, got {seed!r}")
+    if (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))
+            or not 0 <= seed <= MAX_SEED):
+        raise InputError(f"{where}: the seed must be an integer from 0 to {MAX_SEED}, "
+                         f"got {seed!r}")
     return int(seed)
+
+
+def seed_argument(text: str) -> int:
+    """argparse type of ``--seed``."""
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"expected an integer from 0 to {MAX_SEED}, got {text!r}")
+    return value
 
 
 # ---------------------------------------------------------------------- temperatures
@@ -521,7 +540,8 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
         file = Path(row["path"]).expanduser()
         file = file if file.is_absolute() else path.parent / file
         if not file.is_file():
-            problem = "is a directory" if file.is_dir() else "does not exist"
+            problem = ("is a directory" if file.is_dir() else "is not a regular file (a pipe, "
+                       "device or socket)" if file.exists() else "does not exist")
             raise InputError(f"{at}, column 'path': file '{file}' {problem}")
         opts = check_options(opts, at)
         error = None
@@ -612,6 +632,9 @@ def expand_inputs(inputs=(), *, manifests=(), options: dict | None = None, seed:
                 raise InputError(f"{origin}: the pattern matches no file")
             for f in files:
                 data_file(f, origin)
+        elif p.exists():
+            raise InputError(f"{origin}: not a regular file (a pipe, device or socket); "
+                             "give a CSV file, a directory or a pattern")
         else:
             raise InputError(f"{origin}: no such file or directory")
     for m in manifests:
@@ -1262,7 +1285,7 @@ def add_parser(subparsers):
                         "or constant)")
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1; repeatable")
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=seed_argument, default=0,
                    help="seed of every data set (the same numbers whatever the workers)")
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] left out of every fit for validation")

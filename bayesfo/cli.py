@@ -65,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="noise model (default: known if the data give sigma, else relative or constant)")
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=batch.seed_argument, default=0)
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] left out of the fit for validation")
     p.add_argument("--evidence", default="auto", choices=batch.EVIDENCE_ROUTES,
@@ -89,13 +89,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="linear method of thesis Table 3.1, or global optimisation (default)")
     p.add_argument("--q", type=float, default=None,
                    help="fix the commensurate order (default: q-grid scan / optimised)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the optimiser's random starts")
+    p.add_argument("--seed", type=batch.seed_argument, default=0, help="seed of the optimiser's random starts")
     p.add_argument("--json", action="store_true", help="print JSON")
 
     p = sub.add_parser("simulate", help="thesis Monte Carlo studies beside the printed tables")
     p.add_argument("study", metavar="STUDY", help="table-3.2, table-a.1, table-a.3, table-3.4, table-a.5, table-a.7, figure-3.2")
     p.add_argument("--runs", type=int, default=None, help="noisy realisations (default: as in the thesis)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=batch.seed_argument, default=0)
     p.add_argument("--figure", metavar="FILE", help="figure-3.2: write the RMSE surface (.png, .pdf)")
     p.add_argument("--json", action="store_true", help="print JSON")
 
@@ -227,8 +227,17 @@ def _parse_priors(specs) -> dict:
             values = {keys[0]: float(a), keys[1]: float(b)}
         except ValueError:
             raise InputError(f"--prior {spec!r}: the bounds must be numbers") from None
+        if name.strip() in out:
+            raise InputError(f"--prior {spec!r}: a prior for '{name.strip()}' is already given; "
+                             "give one --prior per parameter")
         out[name.strip()] = prior_from_dict({"prior": kind, **values}, f"--prior {spec!r}")
     return out
+
+
+def _num(x, fmt: str = ".2f") -> str:
+    """A number for the terminal table; '-' for one that is undefined (its reason is among
+    the warnings)."""
+    return format(x, fmt) if x is not None and np.isfinite(x) else "-"
 
 
 def cmd_compare(args) -> int:
@@ -280,8 +289,8 @@ def cmd_compare(args) -> int:
                 dz = f"{row['delta_log_evidence']:.2f}"
                 p = f"{row['posterior_probability']:.3f}"
             print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} {dz:>8} "
-                  f"{p:>6} {row['loo']:>10.2f} {row['bic']:>10.2f} {q:>16} {row['rhat_max']:>6.3f} "
-                  f"{'yes' if row['converged'] else 'NO':>3}")
+                  f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>16} "
+                  f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3}")
         pairs = result.baselines()
         if pairs:
             print("integer baselines (q = 1) against their fractional parents:")

@@ -131,7 +131,8 @@ class Comparison:
 
         def key(r):
             ev = r.criteria.get("evidence")
-            return (ev is None, -(ev.log_z if ev is not None else r.criteria["loo"]))
+            value = ev.log_z if ev is not None else r.criteria["loo"]
+            return (ev is None, not math.isfinite(value), -value if math.isfinite(value) else 0)
 
         return [r.name for r in sorted(ok, key=key)]
 
@@ -146,12 +147,16 @@ class Comparison:
         order = {n: i for i, n in enumerate(self.ranking)}
         rows = []
         ok = [r for r in self.results if r.error is None]
-        best_loo = max((r.criteria["loo"] for r in ok), default=math.nan)
+        best_loo = max((r.criteria["loo"] for r in ok if math.isfinite(r.criteria["loo"])),
+                       default=math.nan)
         evs = [r.criteria["evidence"].log_z for r in ok if r.criteria.get("evidence") is not None]
         best_z = max(evs, default=math.nan)
         ranks = {}
         for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
-            ordered = sorted(ok, key=lambda r, c=crit, g=sign: g * r.criteria[c])
+            # An undefined criterion (NaN, with its reason among the warnings) ranks last.
+            ordered = sorted(ok, key=lambda r, c=crit, g=sign: (
+                not math.isfinite(r.criteria[c]),
+                g * r.criteria[c] if math.isfinite(r.criteria[c]) else 0))
             ranks[crit] = {r.name: i + 1 for i, r in enumerate(ordered)}
         for r in sorted(self.results, key=lambda r: order.get(r.name, len(order))):
             if r.error is not None:
@@ -269,6 +274,14 @@ class Comparison:
         return sorted(out, key=lambda f: -f["log_evidence"])
 
 
+def _frequencies(omega, shown: int = 6) -> str:
+    """``omega = 1, 2, 3 rad/s``, or the first few and how many more, for a warning line."""
+    text = ", ".join(f"{w:.4g}" for w in omega[:shown])
+    if len(omega) > shown:
+        text += f" and {len(omega) - shown} more"
+    return f"omega = {text} rad/s"
+
+
 def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
     az = arviz()
     n_real = 2 * lik.data.n_frequencies
@@ -295,18 +308,32 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
     k_max = float(np.max(pareto_k))
     if k_max > PARETO_K_WARN:
         bad = lik.data.omega[pareto_k > PARETO_K_WARN]
-        msg = (f"{post.structure}: Pareto k up to {k_max:.2f} at omega = "
-               + ", ".join(f"{w:.4g}" for w in bad) + " rad/s; PSIS-LOO is unreliable there")
+        msg = (f"{post.structure}: Pareto k up to {k_max:.2f} at {_frequencies(bad)}; "
+               "PSIS-LOO is unreliable there")
         warn.append(msg)
         warnings.warn(msg, PredictiveWarning, stacklevel=3)
+    elpd = {"waic": (float(waic.elpd_waic), float(waic.se)),
+            "loo": (float(loo.elpd_loo), float(loo.se))}
+    for name, (value, se) in elpd.items():
+        if not (math.isfinite(value) and math.isfinite(se)):
+            # Pointwise log-likelihoods that differ by more than ~700 nats between draws
+            # overflow the importance ratios: the criterion is undefined, not a number.
+            pointwise = post.idata.log_likelihood["G"].values.reshape(-1, lik.data.n_frequencies)
+            spread = float(np.ptp(pointwise, axis=0).max())
+            msg = (f"{post.structure}: {name.upper()} cannot be computed: the pointwise "
+                   f"log-likelihood varies by up to {spread:.3g} nats between posterior draws "
+                   "(the structure misfits these data far beyond its noise scale)")
+            warn.append(msg)
+            warnings.warn(msg, PredictiveWarning, stacklevel=3)
+            elpd[name] = (math.nan, math.nan)  # null in summary.json, empty in ranking.csv
     model = lik.structure.response(
         post.map_theta[: lik.structure.n_params], lik.data.omega, lik.data.kind
     )
     rmse = float(np.sqrt(np.sum(np.abs(lik.data.response - model) ** 2)) / lik.data.n_frequencies)
     return {
         "max_log_likelihood": max_ll, "aic": aic, "aicc": aicc, "bic": bic,
-        "waic": float(waic.elpd_waic), "waic_se": float(waic.se),
-        "loo": float(loo.elpd_loo), "loo_se": float(loo.se), "pareto_k_max": k_max,
+        "waic": elpd["waic"][0], "waic_se": elpd["waic"][1],
+        "loo": elpd["loo"][0], "loo_se": elpd["loo"][1], "pareto_k_max": k_max,
         "pareto_k": pareto_k.tolist(), "loo_pointwise": np.asarray(loo.loo_i).tolist(),
         "rmse": rmse, "warnings": warn,
         "priors": lik.describe_priors(),
@@ -441,7 +468,10 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
     seen = set()
     kept = []
     for w in caught:
-        key = (w.category, str(w.message))
+        text = str(w.message)
+        if not text.startswith(f"{s.name}:"):  # a library's warning: say which structure
+            text = f"{s.name}: {text}"
+        key = (w.category, text)
         if key not in seen and not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
             seen.add(key)
             kept.append(key)
@@ -556,7 +586,9 @@ def ranking_csv(comparison: Comparison) -> str:
     writer = csv.DictWriter(buf, fieldnames=RANKING_FIELDS, extrasaction="ignore", lineterminator="\n")
     writer.writeheader()
     for row in comparison.table():
-        writer.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in RANKING_FIELDS})
+        # No literal nan or inf: an undefined number is an empty cell, as null in summary.json.
+        writer.writerow({k: ("" if v is None else v)
+                         for k, v in _finite({k: row.get(k) for k in RANKING_FIELDS}).items()})
     return buf.getvalue()
 
 

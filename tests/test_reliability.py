@@ -339,3 +339,63 @@ def test_a_signal_ends_batch_and_its_workers(tmp_path, sig, status):
     assert stderr.strip().splitlines()[-1].endswith("(no output is left half-written)")
     assert "Traceback" not in stderr
     assert not list(out.rglob(".bayesfo-staging-*"))
+
+
+# ---------------------------------------------------------------------- arguments and numbers
+@pytest.mark.parametrize("argv, message", [
+    (["compare", "x.csv", "--seed", "-1"],
+     "argument --seed: expected an integer from 0 to 4294967295, got '-1'"),
+    (["batch", "x.csv", "--out", "o", "--seed", str(2**32)],
+     "argument --seed: expected an integer from 0 to 4294967295, got '4294967296'"),
+    (["compare", str(ADHESIVE / "Tp020C.csv"), "--prior", "q=uniform:0:1", "--prior",
+      "q=uniform:0.2:1"],
+     "--prior 'q=uniform:0.2:1': a prior for 'q' is already given; give one --prior per "
+     "parameter"),
+])
+def test_bad_arguments_are_one_line_errors(run_cli, argv, message):
+    status, out, err = run_cli(*argv)
+    assert status == 2 and out == ""
+    assert err.startswith(f"bayesfo: error: {message}") and err.count("\n") == 1
+
+
+def test_a_pipe_is_not_a_data_file(tmp_path, run_cli):
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    status, _, err = run_cli("batch", fifo, "--out", tmp_path / "out")
+    assert status == 2
+    assert err == (f"bayesfo: error: INPUT '{fifo}': not a regular file (a pipe, device or "
+                   "socket); give a CSV file, a directory or a pattern\n")
+
+
+def test_undefined_criteria_are_empty_cells_and_rank_last(comparison):
+    from bayesfo.cli import _num
+    from bayesfo.compare import _frequencies, ranking_csv
+
+    voigt, zener = comparison.results
+    broken = dataclasses.replace(zener, criteria=dict(zener.criteria, loo=np.nan,
+                                                      loo_se=np.nan, pareto_k_max=np.inf))
+    fake = dataclasses.replace(comparison, results=(voigt, broken))
+    rows = {r["structure"]: r for r in fake.table()}
+    assert rows["zener"]["rank_loo"] == 2 and rows["voigt"]["rank_loo"] == 1
+    assert rows["voigt"]["delta_loo"] == 0.0
+    text = ranking_csv(fake)
+    assert "nan" not in text.lower() and "inf" not in text.lower()
+    header, *lines = [line.split(",") for line in text.splitlines()]
+    zrow = dict(zip(header, next(li for li in lines if li[1] == "zener"), strict=True))
+    assert zrow["loo"] == zrow["loo_se"] == zrow["pareto_k_max"] == ""
+    assert _num(np.nan) == "-" and _num(None) == "-" and _num(1.234) == "1.23"
+    assert _frequencies(np.arange(1.0, 201.0)) == "omega = 1, 2, 3, 4, 5, 6 and 194 more rad/s"
+    assert _frequencies(np.array([0.5, 2.0])) == "omega = 0.5, 2 rad/s"
+
+
+@pytest.mark.slow
+def test_a_hopeless_misfit_gives_reasons_not_nan(tmp_path, run_cli):
+    """The integer Voigt on the NREL master curve (26 decades): its PSIS-LOO is undefined."""
+    status, out, err = run_cli("compare", ROOT / "examples" / "data" / "nrel_dma_master.csv",
+                               "--structures", "voigt-int", "--no-figures", "--workers", "1",
+                               "--out", tmp_path / "out")
+    assert status == 0
+    assert "voigt-int: LOO cannot be computed: the pointwise log-likelihood varies by" in err
+    assert " and 19" in err and "more rad/s; PSIS-LOO is unreliable there" in err
+    assert "nan" not in (tmp_path / "out" / "ranking.csv").read_text().lower()
+    assert "nan" not in out.lower()

@@ -4,6 +4,7 @@ tempered ladder's independence moves."""
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +36,10 @@ class _GaussianMixture:
             if k == 1:
                 labels = np.zeros(n, dtype=int)
             else:
-                _, labels = kmeans2(x / scale, k, seed=rng, minit="++")
+                with warnings.catch_warnings():
+                    # An empty cluster means k is too many: the count check below stops there.
+                    warnings.filterwarnings("ignore", "One of the clusters is empty")
+                    _, labels = kmeans2(x / scale, k, seed=rng, minit="++")
             counts = np.bincount(labels, minlength=k)
             if np.any(counts < 5 * d):  # too few draws for a covariance
                 break

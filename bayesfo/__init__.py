@@ -5,29 +5,59 @@ data support, and how sure can I be?". The data flow, module by module:
 
 ``data`` (FrequencyResponse, CSV reader) → ``structures`` (model cards in ``models/*.toml``,
 evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optimisation: the seeds)
-→ ``inference`` (likelihood, emcee posterior, diagnostics) → ``compare`` (criteria, ranking,
-output files). ``timeseries`` turns raw sine records into frequency responses; ``timedomain``
-simulates fitted models in the time domain for validation; ``studies`` reruns the thesis'
-Monte Carlo studies.
+→ ``inference`` (likelihood, emcee posterior, diagnostics, evidence) → ``comparison`` (run,
+criteria, results, output files) → ``report`` and ``plotting``. ``options`` checks the options
+of a comparison before any work; ``outdir`` keeps each output directory the output of one run;
+``parallel`` runs worker processes; ``batch`` runs comparisons over many data sets; ``cli`` is
+the command line, one module per command. ``timeseries`` turns raw sine records into frequency
+responses; ``timedomain`` simulates fitted models in the time domain for validation;
+``studies`` reruns the thesis' Monte Carlo studies.
 
 Example
 -------
->>> from bayesfo import read_csv, get_structure                   # doctest: +SKIP
->>> from bayesfo.compare import compare                           # doctest: +SKIP
->>> data = read_csv("examples/data/adhesive_468mp/Tp020C.csv")       # doctest: +SKIP
->>> result = compare(data, [get_structure("voigt"), get_structure("zener")])  # doctest: +SKIP
->>> result.ranking                                                   # doctest: +SKIP
+>>> import bayesfo as bf                                               # doctest: +SKIP
+>>> data = bf.read("examples/data/adhesive_468mp/Tp020C.csv")          # doctest: +SKIP
+>>> result = bf.compare(data, "voigt,zener", workers=1)                # doctest: +SKIP
+>>> result.ranking                                                     # doctest: +SKIP
 ['voigt', 'zener']
 """
 
-from .data import FrequencyResponse, read_csv
-from .errors import BayesfoError, InputError, NonlinearityWarning, StructureError
-from .structures import get_structure, resolve_structures
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
-__version__ = "0.1.0"
+try:
+    __version__ = _version("bayesfo")
+except PackageNotFoundError:  # run from a source tree that is not installed
+    __version__ = "0+unknown"
+
+from .data import FrequencyResponse, read_csv  # noqa: E402
+from .errors import BayesfoError, InputError, NonlinearityWarning, OutputError, StructureError  # noqa: E402
+from .structures import get_structure, resolve_structures  # noqa: E402
+
+#: Read a data file (see :func:`bayesfo.data.read_csv`).
+read = read_csv
+
+#: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
+#: ``import bayesfo`` and ``bayesfo --help`` stay fast.
+_LAZY = {"compare": "comparison", "write_outputs": "comparison", "Comparison": "comparison",
+         "StructureResult": "comparison"}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module 'bayesfo' has no attribute {name!r}")
 
 __all__ = [
     "BayesfoError",
+    "Comparison",
+    "OutputError",
+    "StructureResult",
+    "compare",
+    "read",
+    "write_outputs",
     "FrequencyResponse",
     "InputError",
     "NonlinearityWarning",

@@ -1,4 +1,4 @@
-"""Exceptions and warnings raised by bayesfo.
+"""Exceptions and warnings raised by bayesfo: all of them, in this one module.
 
 Every exception subclasses a built-in one, so ``except ValueError`` keeps working for callers
 that do not know about bayesfo. The command line maps :class:`InputError` to exit status 2 with a
@@ -30,3 +30,16 @@ class OutputError(BayesfoError, OSError):
 
 class NonlinearityWarning(UserWarning):
     """A sine record whose harmonics show that the system is not linear at that amplitude."""
+
+
+class ConvergenceWarning(UserWarning):
+    """The sampler stopped before its diagnostics reached the targets."""
+
+
+class PredictiveWarning(UserWarning):
+    """PSIS-LOO is unreliable for some frequency (Pareto k above 0.7)."""
+
+
+class EvidenceWarning(UserWarning):
+    """The two evidence estimates disagree, or the evidence could not be computed."""
+

@@ -127,7 +127,7 @@ def verdict(comparison) -> list[tuple[str, bool]]:
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
 
     Returns
     -------
@@ -459,7 +459,7 @@ def render_report(comparison, figures: dict | None = None) -> str:
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     figures : dict, optional
         ``{figure name: path or list of paths}``, e.g. the result of
         :func:`bayesfo.plotting.write_figures`; the PNG of each is embedded (figures without
@@ -512,7 +512,7 @@ def write_report(comparison, out_dir, figures: dict | None = None) -> Path:
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     out_dir : str or path-like
         Directory, created when missing.
     figures : dict, optional

@@ -12,7 +12,7 @@ import warnings
 
 import numpy as np
 
-from .compare import compare
+from .comparison import compare
 from .data import FrequencyResponse
 from .structures import get_structure, resolve_structures
 
@@ -55,7 +55,7 @@ def hit(scenario: str, result) -> bool:
 
 def hit_rate(scenario: str, seeds, *, workers: int = 1) -> tuple[float, list[str]]:
     """Share of seeds for which the comparison picks the truth, and the winner of each seed
-    (``workers``: processes per comparison, see :func:`~bayesfo.compare.compare`)."""
+    (``workers``: processes per comparison, see :func:`~bayesfo.comparison.compare`)."""
     winners = []
     hits = 0
     candidates = resolve_structures(SCENARIOS[scenario][4])

@@ -18,7 +18,7 @@ import warnings
 
 import numpy as np
 
-from bayesfo.compare import compare
+from bayesfo.comparison import compare
 from bayesfo.inference._arviz import arviz
 from bayesfo.structures import resolve_structures
 from bayesfo.studies import g_spec_data

@@ -14,11 +14,12 @@ import warnings
 
 import numpy as np
 
-from bayesfo.compare import compare, process_pool, write_outputs
+from bayesfo.comparison import compare, write_outputs
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
 from bayesfo.inference._arviz import arviz
 from bayesfo.inference.evidence import nested_evidence
+from bayesfo.parallel import process_pool
 from bayesfo.structures import get_structure, resolve_structures
 
 

@@ -24,7 +24,7 @@ import warnings
 
 import numpy as np
 
-from bayesfo.compare import compare
+from bayesfo.comparison import compare
 from bayesfo.errors import InputError
 from bayesfo.inference import Likelihood
 from bayesfo.inference._arviz import arviz

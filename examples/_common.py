@@ -11,7 +11,7 @@ import time
 import warnings
 from pathlib import Path
 
-from bayesfo.compare import compare, write_outputs
+from bayesfo.comparison import compare, write_outputs
 
 #: Sampler cap of the quick forms: structures that converge do so in 750–2500 steps here;
 #: those that do not (multimodal q, vanishing terms) stop at the cap and are flagged.
@@ -38,7 +38,7 @@ def make_parser(name: str, doc: str) -> argparse.ArgumentParser:
 
 
 def run_compare(data, structures, *, seed: int, quick: bool, **kwargs):
-    """:func:`bayesfo.compare.compare` with the quick cap, timed, with warnings collected.
+    """:func:`bayesfo.comparison.compare` with the quick cap, timed, with warnings collected.
 
     Sampler and predictive warnings are expected for structures that the data do not support
     (they are flags in the results as well); they are printed once, one line each, after the
@@ -147,7 +147,7 @@ def print_holdout(comp) -> None:
 
 
 def save(comp, out_dir, *, figures: bool = True, quick: bool = False) -> Path:
-    """Write the outputs with :func:`bayesfo.compare.write_outputs` and say where they are.
+    """Write the outputs with :func:`bayesfo.comparison.write_outputs` and say where they are.
 
     The quick forms draw PNG figures only.
     """

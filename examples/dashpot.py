@@ -41,6 +41,8 @@ from pathlib import Path
 import numpy as np
 from _common import (
     check_or_write_csv as _check_or_write_csv,
+)
+from _common import (
     comment_lines,
     make_parser,
     print_orders,

@@ -17,9 +17,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bayesfo import batch
-from bayesfo.batch import (DataSet, add_parser, cmd_batch, expand_inputs, parse_temperature,
-                           run_batch, temperature_from_stem, temperature_of_file)
+from bayesfo.batch import (
+    DataSet,
+    executors,
+    expand_inputs,
+    parse_temperature,
+    run_batch,
+    temperature_from_stem,
+    temperature_of_file,
+)
+from bayesfo.cli.batch import add_parser
+from bayesfo.cli.batch import run as cmd_batch
 from bayesfo.errors import InputError
 
 ADHESIVE = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp"
@@ -132,7 +140,7 @@ def test_bad_options_are_errors_before_any_work(tmp_path):
         expand_inputs([tmp_path], options={"structures": "voigtt"})
     with pytest.raises(InputError, match="prior 'alpha' names a parameter no selected structure"):
         expand_inputs([tmp_path], options={"structures": "voigt", "priors": ["alpha=uniform:0:1"]})
-    with pytest.raises(InputError, match="--seed: the seed must be a non-negative integer"):
+    with pytest.raises(InputError, match="--seed: the seed must be an integer from 0 to 4294967295, got -1"):
         expand_inputs([tmp_path], seed=-1)
     ds = expand_inputs([tmp_path])
     with pytest.raises(InputError, match="--workers applies to local processes"):
@@ -308,8 +316,8 @@ def test_resume_skips_complete_and_redoes_incomplete(reference, tmp_path, monkey
     (out2 / "Tp150C" / "batch.json").unlink()
     kept = {f: f.stat().st_mtime_ns for f in (out2 / "Tm010C").iterdir()}
     calls = []
-    real = batch.run_task
-    monkeypatch.setattr(batch, "run_task", lambda task: calls.append(task["id"]) or real(task))
+    real = executors.run_task
+    monkeypatch.setattr(executors, "run_task", lambda task: calls.append(task["id"]) or real(task))
     again = run_batch(datasets, out2, workers=1, progress=False)
     assert sorted(calls) == ["Tp150C", "broken"]  # failed data sets are retried too
     assert [o.reused for o in again.outcomes] == [True, False, False]
@@ -320,7 +328,7 @@ def test_resume_skips_complete_and_redoes_incomplete(reference, tmp_path, monkey
 
     # Another seed, or changed data, invalidate a complete result; nothing else does.
     calls.clear()
-    monkeypatch.setattr(batch, "run_task", lambda task: calls.append(task["id"]) or {
+    monkeypatch.setattr(executors, "run_task", lambda task: calls.append(task["id"]) or {
         "id": task["id"], "status": "input_error", "error": "not run", "files": {}})
     changed = [DataSet(d.id, d.path, d.options, 4 if d.id == "Tm010C" else d.seed,
                        d.temperature) for d in datasets]
@@ -356,7 +364,7 @@ def test_dask_local_cluster_gives_the_same_numbers(reference, tmp_path):
 
 def test_dask_errors_are_input_errors(reference, tmp_path, monkeypatch):
     datasets = [d for d in reference[0] if d.id == "broken"]
-    monkeypatch.setattr(batch, "SCHEDULER_TIMEOUT", 0.5)
+    monkeypatch.setattr(executors, "SCHEDULER_TIMEOUT", 0.5)
     with pytest.raises(InputError, match="cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'"):
         run_batch(datasets, tmp_path / "x", scheduler="tcp://127.0.0.1:9")
     monkeypatch.setitem(sys.modules, "distributed", None)
@@ -365,7 +373,7 @@ def test_dask_errors_are_input_errors(reference, tmp_path, monkeypatch):
 
 
 def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch):
-    import bayesfo.compare
+    import bayesfo.comparison
 
     shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
     summary = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"],
@@ -383,8 +391,8 @@ def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch)
             (out / "report.html").write_text("<html>")
         (out / "summary.json").write_text(json.dumps(summary))
 
-    monkeypatch.setattr(bayesfo.compare, "compare", lambda *args, **kwargs: None)
-    monkeypatch.setattr(bayesfo.compare, "write_outputs", fake_outputs)
+    monkeypatch.setattr(bayesfo.comparison, "compare", lambda *args, **kwargs: None)
+    monkeypatch.setattr(bayesfo.comparison, "write_outputs", fake_outputs)
     sub = tmp_path / "out" / "a"
     res = run_batch(expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"}),
                     tmp_path / "out", workers=1, progress=False, write_combined=False)
@@ -400,7 +408,7 @@ def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch)
 
 
 def test_tasks_carry_the_data_so_workers_need_no_shared_files(tmp_path):
-    from bayesfo.batch import _read_task_data
+    from bayesfo.batch.task import _read_task_data
     from bayesfo.data import read_csv
 
     shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "Tp150C.csv")
@@ -417,12 +425,12 @@ def test_tasks_carry_the_data_so_workers_need_no_shared_files(tmp_path):
 
 
 def test_internal_error_is_recorded_with_traceback(inputs, tmp_path, monkeypatch):
-    import bayesfo.compare
+    import bayesfo.comparison
 
     def boom(*args, **kwargs):
         raise RuntimeError("solver exploded")
 
-    monkeypatch.setattr(bayesfo.compare, "compare", boom)
+    monkeypatch.setattr(bayesfo.comparison, "compare", boom)
     datasets = expand_inputs([inputs / "Tm010C.csv"], options={"structures": STRUCTURES})
     res = run_batch(datasets, tmp_path, workers=1, progress=False)
     assert res.outcomes[0].status == "internal_error" and res.exit_status == 1

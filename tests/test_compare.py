@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bayesfo.compare import PredictiveWarning, compare, write_outputs
+from bayesfo.comparison import compare, write_outputs
 from bayesfo.data import FrequencyResponse
+from bayesfo.errors import PredictiveWarning
 from bayesfo.inference._arviz import arviz
 from bayesfo.structures import get_structure, resolve_structures
 
@@ -91,7 +92,7 @@ def test_criteria_are_consistent(voigt_comparison):
 
 def test_interrupted_write_leaves_no_summary(voigt_comparison, tmp_path, monkeypatch):
     result, _ = voigt_comparison
-    import bayesfo.compare as cmp
+    import bayesfo.comparison.output as cmp
 
     def boom(*a, **k):
         raise KeyboardInterrupt
@@ -105,7 +106,7 @@ def test_interrupted_write_leaves_no_summary(voigt_comparison, tmp_path, monkeyp
 
 # Whether PSIS-LOO flags the lowest frequency of these 17 points (Pareto k near 0.7) depends on
 # the draws; this test is about the command's outputs, so that warning is not an error here.
-@pytest.mark.filterwarnings("ignore::bayesfo.compare.PredictiveWarning")
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
 def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
     out = tmp_path / "adhesive"
     status, stdout, err = run_cli("compare", ADHESIVE, "--structures", "voigt,zener-int",
@@ -231,7 +232,8 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
     html = render_report(compare(data, voigt, seed=1, progress=False, evidence="ladder"))
     assert f"{ev.log_z:.2f} L</td>" in html and "ln Z from a tempered ladder" in html
     # A ladder run that ends well below the best fit is flagged (its ln Z may be too low).
-    from bayesfo.compare import EvidenceWarning, _evidence
+    from bayesfo.comparison.criteria import _evidence
+    from bayesfo.errors import EvidenceWarning
     from bayesfo.inference import Likelihood
 
     lik, best = Likelihood(voigt[0], data), result["voigt"].criteria["max_log_likelihood"]

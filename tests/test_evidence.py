@@ -94,7 +94,7 @@ def test_routes_agree_on_the_thesis_set_up():
     # G_spec = 1/(1 + s^0.5), 25 points, thesis noise (σ = 0.001 per time sample, 0.005 complex).
     import warnings
 
-    from bayesfo.compare import compare
+    from bayesfo.comparison import compare
     from bayesfo.structures import resolve_structures
     from bayesfo.studies import g_spec_data
 
@@ -128,7 +128,7 @@ def test_ladder_evidence_of_unconverged_posteriors_on_the_thesis_set_up():
     # reaches the posterior from the prior, matches dynesty within 0.3 nats.
     import warnings
 
-    from bayesfo.compare import compare
+    from bayesfo.comparison import compare
     from bayesfo.structures import resolve_structures
     from bayesfo.studies import g_spec_data
 

@@ -16,9 +16,12 @@ import pytest  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
 from scipy.integrate import trapezoid  # noqa: E402
 
-from bayesfo.compare import PredictiveWarning, StructureResult, compare  # noqa: E402
+from bayesfo.comparison import StructureResult, compare  # noqa: E402
 from bayesfo.data import FrequencyResponse  # noqa: E402
-from bayesfo.errors import InputError  # noqa: E402
+from bayesfo.errors import (
+    InputError,  # noqa: E402
+    PredictiveWarning,
+)
 from bayesfo.inference._arviz import arviz  # noqa: E402
 from bayesfo.plotting import (  # noqa: E402
     plot_bode,
@@ -394,7 +397,7 @@ def test_write_figures_single_structure_and_formats(comparison, tmp_path):
 
 
 def test_write_figures_in_worker_processes_gives_the_same_files(comparison, tmp_path):
-    from bayesfo.compare import process_pool
+    from bayesfo.parallel import process_pool
 
     serial = write_figures(comparison, tmp_path / "serial", formats=("png",))
     with process_pool(2) as pool:

@@ -24,8 +24,9 @@ import psutil
 import pytest
 
 import bayesfo.outdir as outdir
-from bayesfo.batch import _run_processes, expand_inputs, run_batch
-from bayesfo.compare import compare, write_outputs
+from bayesfo.batch import expand_inputs, run_batch
+from bayesfo.batch.executors import _run_processes
+from bayesfo.comparison import compare, write_outputs
 from bayesfo.data import FrequencyResponse
 from bayesfo.errors import OutputError
 from bayesfo.structures import get_structure, resolve_structures
@@ -63,7 +64,7 @@ def earlier(comparison, tmp_path):
 
 # ---------------------------------------------------------------------- one run per directory
 def test_an_interrupted_run_leaves_the_earlier_output(comparison, earlier, monkeypatch):
-    import bayesfo.compare
+    import bayesfo.comparison.output
 
     out, before = earlier
     assert set(before) == {"voigt.nc", "zener.nc", "ranking.csv", "summary.json", "notes.txt"}
@@ -71,7 +72,7 @@ def test_an_interrupted_run_leaves_the_earlier_output(comparison, earlier, monke
     def interrupted(*args, **kwargs):  # after both NetCDF files were written
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(bayesfo.compare, "ranking_csv", interrupted)
+    monkeypatch.setattr(bayesfo.comparison.output, "ranking_csv", interrupted)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(comparison, out, figures=False)
     assert _tree(out) == before
@@ -166,7 +167,7 @@ SUMMARY = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"
 @pytest.fixture
 def fake_compare(monkeypatch):
     """compare and write_outputs replaced by instant fakes (batch runs in this process)."""
-    import bayesfo.compare
+    import bayesfo.comparison
 
     def fake_outputs(comparison, out, figures=True):
         out = Path(out)
@@ -175,8 +176,8 @@ def fake_compare(monkeypatch):
         (out / "figures" / "bode.png").write_bytes(b"png")
         (out / "summary.json").write_text(json.dumps(SUMMARY))
 
-    monkeypatch.setattr(bayesfo.compare, "compare", lambda *args, **kwargs: None)
-    monkeypatch.setattr(bayesfo.compare, "write_outputs", fake_outputs)
+    monkeypatch.setattr(bayesfo.comparison, "compare", lambda *args, **kwargs: None)
+    monkeypatch.setattr(bayesfo.comparison, "write_outputs", fake_outputs)
 
 
 def _victims(tmp_path) -> dict:
@@ -368,8 +369,9 @@ def test_a_pipe_is_not_a_data_file(tmp_path, run_cli):
 
 
 def test_undefined_criteria_are_empty_cells_and_rank_last(comparison):
-    from bayesfo.cli import _num
-    from bayesfo.compare import _frequencies, ranking_csv
+    from bayesfo.cli.compare import _num
+    from bayesfo.comparison import ranking_csv
+    from bayesfo.comparison.criteria import _frequencies
 
     voigt, zener = comparison.results
     broken = dataclasses.replace(zener, criteria=dict(zener.criteria, loo=np.nan,

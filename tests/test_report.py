@@ -19,8 +19,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from bayesfo.compare import PredictiveWarning, StructureResult, compare  # noqa: E402
+from bayesfo.comparison import StructureResult, compare  # noqa: E402
 from bayesfo.data import FrequencyResponse  # noqa: E402
+from bayesfo.errors import PredictiveWarning
 from bayesfo.plotting import plot_bode, plot_ranking, save_figure  # noqa: E402
 from bayesfo.report import render_report, verdict, write_report  # noqa: E402
 from bayesfo.structures import get_structure  # noqa: E402

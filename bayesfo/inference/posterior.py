@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import publish
-from ..errors import InputError
+from ..errors import ConvergenceWarning, InputError
 from ..priors import LogUniform, Uniform
 from ._arviz import arviz
 from .likelihood import Likelihood
@@ -38,10 +38,6 @@ from .likelihood import Likelihood
 HDI_PROB = 0.94
 RHAT_MAX = 1.01
 ESS_MIN = 400
-
-
-class ConvergenceWarning(UserWarning):
-    """The sampler stopped before its diagnostics reached the targets."""
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """Figures. The only part of bayesfo that imports matplotlib (and only when a figure is drawn).
 
-Plot functions take results (a :class:`~bayesfo.compare.Comparison`, a
-:class:`~bayesfo.compare.StructureResult` or plain dicts), accept ``fig=`` or ``ax=``, and
+Plot functions take results (a :class:`~bayesfo.comparison.Comparison`, a
+:class:`~bayesfo.comparison.StructureResult` or plain dicts), accept ``fig=`` or ``ax=``, and
 return what they drew: a :class:`Drawn` with the figure, its axes, the plotted numbers and the
 artists, so that what a figure shows can be checked against an independent computation.
 

@@ -245,7 +245,7 @@ def loo_differences(results) -> dict[str, tuple[float, float]]:
     elpd, the standard error from the pointwise differences (as ``arviz.compare``'s ``dse``).
 
     The draws are those of each result's InferenceData; all results must be on the same data.
-    Pareto-k warnings of arviz are not repeated here: :func:`bayesfo.compare.compare` has
+    Pareto-k warnings of arviz are not repeated here: :func:`bayesfo.comparison.compare` has
     already reported them and flagged the structures.
     """
     import warnings

@@ -134,7 +134,7 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     out_dir : str or path-like
         Directory (created when missing); files are ``<name>.<format>``.
     formats : sequence of str
@@ -143,7 +143,7 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
         Seed of the posterior draws behind the response figures.
     pool : concurrent.futures.Executor, optional
         Worker processes that draw the figures side by side (e.g.
-        :func:`bayesfo.compare.process_pool`): the combined figures in two tasks, the figures
+        :func:`bayesfo.parallel.process_pool`): the combined figures in two tasks, the figures
         of each structure in one. The files are the same as drawn here.
 
     Returns

@@ -48,7 +48,7 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
 
     Parameters
     ----------
-    result : bayesfo.compare.StructureResult
+    result : bayesfo.comparison.StructureResult
     fig : matplotlib.figure.Figure, optional
         Empty figure without a layout engine (corner places the axes); default a new figure,
         one column wide up to two parameters, a page wide from five.
@@ -166,7 +166,7 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
 
     Parameters
     ----------
-    result : bayesfo.compare.StructureResult
+    result : bayesfo.comparison.StructureResult
     fig : matplotlib.figure.Figure, optional
         Empty figure to draw in; default a new single-column figure.
     color : str, optional
@@ -240,7 +240,7 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     ax : matplotlib.axes.Axes, optional
     ridge_height : float
         Height of the highest point of each ridge, in units of the ridge spacing.

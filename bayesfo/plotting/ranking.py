@@ -67,7 +67,7 @@ def plot_ranking(comparison, fig=None) -> Drawn:
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     fig : matplotlib.figure.Figure, optional
         Empty figure to draw in; default a new single-column figure.
 

@@ -83,7 +83,7 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     structures : sequence of str or StructureResult, optional
         Structures to draw (default: the best three by the ranking).
     fig : matplotlib.figure.Figure, optional
@@ -184,7 +184,7 @@ def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     structures : sequence of str or StructureResult, optional
         Default: the best three by the ranking.
     ax : matplotlib.axes.Axes, optional
@@ -278,7 +278,7 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
 
     Parameters
     ----------
-    comparison : bayesfo.compare.Comparison
+    comparison : bayesfo.comparison.Comparison
     structures : sequence of str or StructureResult, optional
         Default: the best three by the ranking.
     ax : matplotlib.axes.Axes or pair of Axes, optional

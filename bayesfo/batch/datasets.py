@@ -1,0 +1,432 @@
+"""The data sets of a batch: command-line inputs (files, directories, patterns) and manifests,
+expanded into :class:`DataSet` objects with unique ids and checked options."""
+
+from __future__ import annotations
+
+import csv
+import glob
+import hashlib
+import json
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from .. import __version__
+from .._io import read_text_file
+from ..errors import InputError
+from ..options import DEFAULT_OPTIONS, EVIDENCE_ROUTES, KINDS, check_options, check_seed
+from .temperature import parse_temperature, temperature_of_file
+
+#: Manifest columns; ``invert`` is another name for ``reciprocal``.
+MANIFEST_COLUMNS = ("path", "id", "kind", "reciprocal", "invert", "structures", "noise", "prior",
+                    "seed", "holdout", "evidence", "evidence_check", "temperature")
+
+
+#: Files written at the top of the output directory (no data-set id may take these names).
+COMBINED_FILES = ("batch_summary.csv", "batch_summary.png", "batch_summary.pdf",
+                  "temperature_summary.csv", "temperature_q.png", "temperature_q.pdf")
+
+
+@dataclass(frozen=True, eq=False)
+class DataSet:
+    """One data set of a batch: a CSV file with the options of its comparison.
+
+    Attributes
+    ----------
+    id : str
+        Name of its sub-directory of the output directory (unique, case-insensitively).
+    path : str
+        The CSV file, as given (relative to the working directory, or absolute).
+    options : dict
+        Keys of :data:`DEFAULT_OPTIONS`; ``structures`` is a tuple of resolved names.
+    seed : int
+    temperature : float or None
+        Temperature [°C] of an isotherm, if known.
+    origin : str
+        Where the data set was named (an argument, or a manifest line), for messages.
+    error : str or None
+        Bad input found while the inputs were read (a ``# temperature:`` line that is not a
+        temperature): the data set is recorded as an input error and not run; the others run.
+    """
+
+    id: str
+    path: str
+    options: dict
+    seed: int
+    temperature: float | None = None
+    origin: str = ""
+    error: str | None = None
+
+    def task(self) -> dict:
+        """The picklable task of :func:`run_task`, carrying the data file's bytes (a few kB)
+        so that a worker on another machine needs no access to the file."""
+        try:
+            content = Path(self.path).read_bytes()
+        except OSError:
+            content = None  # the worker reports the problem
+        return {"id": self.id, "path": str(Path(self.path).resolve()), "content": content,
+                "options": dict(self.options), "seed": self.seed}
+
+    def fingerprint(self) -> dict:
+        """What makes a stored result valid for this data set: the data file's content, the
+        options, the seed and the bayesfo version."""
+        return {"sha256": _sha256(self.path), "options": _jsonable(self.options),
+                "seed": self.seed, "bayesfo": __version__}
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    return obj
+
+
+def _sha256(path) -> str | None:
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for chunk in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(chunk)
+    except OSError:
+        return None
+    return digest.hexdigest()
+
+
+def _temperature_or_error(path) -> tuple[float | None, str | None]:
+    """:func:`temperature_of_file`, with its input error as a message instead: one bad file
+    does not stop the batch."""
+    try:
+        return temperature_of_file(path), None
+    except InputError as exc:
+        return None, str(exc)
+
+
+def _looks_like_manifest(path: Path) -> bool:
+    """A CSV whose header row has a ``path`` column (data files never have one)."""
+    try:
+        text = read_text_file(path)
+    except InputError:
+        return False
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped and not stripped.startswith("#"):
+            cells = next(csv.reader([line]))
+            return "path" in {c.strip().lower() for c in cells}
+    return False
+
+
+_TRUE = {"1", "true", "yes", "y"}
+
+
+_FALSE = {"0", "false", "no", "n"}
+
+
+def _bool_cell(cell: str, where: str) -> bool:
+    value = cell.strip().lower()
+    if value in _TRUE:
+        return True
+    if value in _FALSE:
+        return False
+    raise InputError(f"{where}: expected true or false, got {cell!r}")
+
+
+def _float_list(text: str, where: str) -> tuple[float, ...]:
+    try:
+        return tuple(float(v) for v in re.split(r"[,;\s]+", text.strip()) if v)
+    except ValueError:
+        raise InputError(f"{where}: expected numbers separated by ',' or ';', "
+                         f"got {text!r}") from None
+
+
+@dataclass(frozen=True, eq=False)
+class _Entry:
+    """A data set before its id is assigned."""
+
+    path: Path
+    options: dict
+    seed: int
+    temperature: float | None
+    origin: str
+    id: str | None = None  # given in a manifest
+    error: str | None = None  # see DataSet.error
+
+
+def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list[_Entry]:
+    """Read a manifest: a CSV naming data files, one per row, with per-file options.
+
+    Columns (header row required, case-insensitive, ``#`` comment lines allowed):
+    ``path`` (required; relative paths are relative to the manifest's directory), and optionally
+    ``id`` (the sub-directory name), ``kind``, ``reciprocal`` (or ``invert``: compare 1/G of the
+    data; true/false), ``structures`` (a comma list, quoted), ``noise``, ``prior`` (specifications
+    ``NAME=TYPE:A:B`` separated by ``;``), ``seed``, ``holdout`` (angular frequencies separated by
+    ``;``), ``evidence`` (auto, bridge or ladder), ``evidence_check`` (true/false) and ``temperature`` (``20``, ``20 C``, ``293.15 K``).
+    An empty cell takes the command line's value.
+
+    Parameters
+    ----------
+    path : path-like
+    defaults : dict, optional
+        Options of the command line (keys of :data:`DEFAULT_OPTIONS`).
+    seed : int
+        The command line's seed.
+
+    Returns
+    -------
+    list
+        One entry per row, options checked (see :func:`check_options`).
+
+    Raises
+    ------
+    InputError
+        Naming the manifest, the line and the column: an unreadable file, no ``path`` column, an
+        unknown or repeated column, a row with the wrong number of cells, an empty path, a file
+        that does not exist, or a value that cannot be used.
+    """
+    path = Path(path)
+    where = f"manifest '{path}'"
+    text = read_text_file(path, "manifest")
+    base = dict(DEFAULT_OPTIONS, **(defaults or {}))
+    header, header_line = None, 0
+    entries = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        cells = [c.strip() for c in next(csv.reader([line]))]
+        if header is None:
+            header, header_line = [c.lower() for c in cells], lineno
+            for col in header:
+                if col not in MANIFEST_COLUMNS:
+                    raise InputError(f"{where}, line {lineno}: unknown column '{col}' "
+                                     f"(known: {', '.join(MANIFEST_COLUMNS)})")
+                if header.count(col) > 1:
+                    raise InputError(f"{where}, line {lineno}: column '{col}' appears twice")
+            if "path" not in header:
+                raise InputError(f"{where}, line {lineno}: no 'path' column")
+            if "reciprocal" in header and "invert" in header:
+                raise InputError(f"{where}, line {lineno}: give 'reciprocal' or 'invert', not both")
+            continue
+        if len(cells) != len(header):
+            raise InputError(f"{where}, line {lineno}: expected {len(header)} cells as in the "
+                             f"header, got {len(cells)}")
+        row = dict(zip(header, cells))
+        at = f"{where}, line {lineno}"
+        opts = dict(base)
+        row_seed = seed
+        temperature = None
+        entry_id = None
+        for col, cell in row.items():
+            if not cell:
+                continue
+            here = f"{at}, column '{col}'"
+            if col == "kind":
+                if cell not in KINDS:
+                    raise InputError(f"{here}: kind must be one of {', '.join(KINDS)}, "
+                                     f"got {cell!r}")
+                opts["kind"] = cell
+            elif col in ("reciprocal", "invert"):
+                opts["reciprocal"] = _bool_cell(cell, here)
+            elif col == "evidence_check":
+                opts["evidence_check"] = _bool_cell(cell, here)
+            elif col == "evidence":
+                if cell not in EVIDENCE_ROUTES:
+                    raise InputError(f"{here}: evidence must be one of "
+                                     f"{', '.join(EVIDENCE_ROUTES)}, got {cell!r}")
+                opts["evidence"] = cell
+            elif col == "structures":
+                opts["structures"] = cell
+            elif col == "noise":
+                opts["noise"] = cell
+            elif col == "prior":
+                opts["priors"] = tuple(p.strip() for p in cell.split(";") if p.strip())
+            elif col == "holdout":
+                opts["holdout"] = _float_list(cell, here)
+            elif col == "seed":
+                try:
+                    row_seed = int(cell)
+                except ValueError:
+                    raise InputError(f"{here}: the seed must be an integer, got {cell!r}") from None
+                check_seed(row_seed, here)
+            elif col == "temperature":
+                temperature = parse_temperature(cell)
+                if temperature is None:
+                    raise InputError(f"{here}: expected a temperature such as 20, 20 C or "
+                                     f"293.15 K, got {cell!r}")
+            elif col == "id":
+                if not re.fullmatch(r"[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*", cell):
+                    raise InputError(f"{here}: an id may hold only letters, digits, '.', '_', "
+                                     f"'+' and '-' (and not start with '.'), got {cell!r}")
+                if cell.lower() in COMBINED_FILES:
+                    raise InputError(f"{here}: the id {cell!r} is the name of a combined output")
+                entry_id = cell
+        if not row["path"]:
+            raise InputError(f"{at}, column 'path': the path is empty")
+        file = Path(row["path"]).expanduser()
+        file = file if file.is_absolute() else path.parent / file
+        if not file.is_file():
+            problem = ("is a directory" if file.is_dir() else "is not a regular file (a pipe, "
+                       "device or socket)" if file.exists() else "does not exist")
+            raise InputError(f"{at}, column 'path': file '{file}' {problem}")
+        opts = check_options(opts, at)
+        error = None
+        if temperature is None:
+            temperature, error = _temperature_or_error(file)
+        entries.append(_Entry(file, opts, row_seed, temperature, at, entry_id, error))
+    if header is None:
+        raise InputError(f"{where} is empty: expected a header row with a 'path' column")
+    if not entries:
+        raise InputError(f"{where}, line {header_line}: a header but no data sets")
+    return entries
+
+
+def expand_inputs(inputs=(), *, manifests=(), options: dict | None = None, seed: int = 0,
+                  exclude=None) -> list[DataSet]:
+    """The data sets named by command-line inputs and manifests, with unique ids.
+
+    Parameters
+    ----------
+    inputs : sequence of str
+        Each a CSV file, a manifest (a CSV whose header has a ``path`` column, see
+        :func:`_read_manifest`), a directory (its ``*.csv`` files, not recursive, manifests
+        excepted) or a glob pattern (``*``, ``?``, ``[...]``; ``**`` recurses).
+    manifests : sequence of path-like
+        Manifests named explicitly (``--manifest``).
+    options : dict, optional
+        Options of every data set (keys of :data:`DEFAULT_OPTIONS`); a manifest row may override
+        them.
+    seed : int
+        Seed of every data set (a manifest row may override it).
+    exclude : path-like, optional
+        A directory whose files are never inputs (the output directory).
+
+    Returns
+    -------
+    list of DataSet
+        In the order given; a file named twice with the same options counts once. The id is the
+        file stem, or, when stems clash (case-insensitively), the stem prefixed by as many parent
+        directory names as make the clashing ids distinct (``run1-T020C``), else numbered
+        (``T020C-1``, ``T020C-2``); a manifest's ``id`` column wins.
+
+    Raises
+    ------
+    InputError
+        If nothing is given, an input does not exist or matches no file, a manifest is bad, an
+        option is bad, or two manifest rows give the same id.
+    """
+    seed = check_seed(seed, "--seed")
+    where = "the command line"
+    opts = check_options(dict(options or {}), where)
+    exclude = Path(exclude).resolve() if exclude is not None else None
+    entries: list[_Entry] = []
+
+    def data_file(file: Path, origin: str):
+        temperature, error = _temperature_or_error(file)
+        entries.append(_Entry(file, opts, seed, temperature, origin, error=error))
+
+    def excluded(file: Path) -> bool:
+        return exclude is not None and exclude in file.resolve().parents
+
+    for raw in inputs:
+        text = str(raw)
+        p = Path(text).expanduser()
+        origin = f"INPUT '{text}'"
+        if p.is_file():
+            if _looks_like_manifest(p):
+                entries.extend(_read_manifest(p, defaults=opts, seed=seed))
+            else:
+                data_file(p, origin)
+        elif p.is_dir():
+            files = [f for f in sorted(p.glob("*.csv"))
+                     if f.is_file() and not f.name.startswith(".") and not excluded(f)
+                     and not _looks_like_manifest(f)]
+            if not files:
+                raise InputError(f"{origin}: directory holds no .csv data file")
+            for f in files:
+                data_file(f, origin)
+        elif glob.has_magic(text):
+            matches = [Path(m) for m in sorted(glob.glob(os.path.expanduser(text), recursive=True))]
+            files = []
+            for m in matches:
+                if m.is_dir():
+                    files.extend(f for f in sorted(m.glob("*.csv")) if f.is_file())
+                elif m.is_file():
+                    files.append(m)
+            files = [f for f in files if not excluded(f) and not f.name.startswith(".")]
+            if not files:
+                raise InputError(f"{origin}: the pattern matches no file")
+            for f in files:
+                data_file(f, origin)
+        elif p.exists():
+            raise InputError(f"{origin}: not a regular file (a pipe, device or socket); "
+                             "give a CSV file, a directory or a pattern")
+        else:
+            raise InputError(f"{origin}: no such file or directory")
+    for m in manifests:
+        entries.extend(_read_manifest(m, defaults=opts, seed=seed))
+    if not entries:
+        raise InputError("no data set: give INPUT files, directories, patterns or --manifest")
+    return _assign_ids(_unique(entries))
+
+
+def _unique(entries: list[_Entry]) -> list[_Entry]:
+    seen, out = set(), []
+    for e in entries:
+        key = (str(e.path.resolve()), json.dumps(_jsonable(e.options), sort_keys=True), e.seed,
+               e.temperature, e.id)
+        if key not in seen:
+            seen.add(key)
+            out.append(e)
+    return out
+
+
+def _safe_id(stem: str) -> str:
+    out = re.sub(r"[^A-Za-z0-9._+\-]", "_", stem)
+    if out.startswith("."):
+        out = "_" + out[1:]
+    return out or "data"
+
+
+def _assign_ids(entries: list[_Entry]) -> list[DataSet]:
+    taken: dict[str, str] = {name: "combined output" for name in COMBINED_FILES}
+    for e in entries:
+        if e.id is not None:
+            key = e.id.lower()
+            if key in taken:
+                raise InputError(f"{e.origin}, column 'id': the id '{e.id}' is already used "
+                                 f"({taken[key]})")
+            taken[key] = e.origin
+    auto = [e for e in entries if e.id is None]
+    groups: dict[str, list[_Entry]] = {}
+    for e in auto:
+        groups.setdefault(_safe_id(e.path.stem).lower(), []).append(e)
+    ids: dict[int, str] = {}
+    for key, group in groups.items():
+        base = _safe_id(group[0].path.stem)
+        if len(group) == 1 and key not in taken:
+            ids[id(group[0])] = base
+            continue
+        parents = [list(reversed(e.path.resolve().parent.parts)) for e in group]
+        chosen = None
+        for depth in range(1, max(len(p) for p in parents) + 1):
+            names = ["-".join([_safe_id(x) for x in reversed(p[:depth])] + [_safe_id(e.path.stem)])
+                     for p, e in zip(parents, group)]
+            lowered = [n.lower() for n in names]
+            if len(set(lowered)) == len(names) and not set(lowered) & set(taken):
+                chosen = names
+                break
+        if chosen is None:
+            chosen, k = [], 1
+            for _ in group:
+                while f"{base}-{k}".lower() in taken or f"{base}-{k}" in chosen:
+                    k += 1
+                chosen.append(f"{base}-{k}")
+                k += 1
+        for e, name in zip(group, chosen):
+            ids[id(e)] = name
+    for e in auto:
+        taken[ids[id(e)].lower()] = e.origin
+    return [DataSet(e.id if e.id is not None else ids[id(e)], str(e.path), e.options, e.seed,
+                    e.temperature, e.origin, e.error) for e in entries]
+

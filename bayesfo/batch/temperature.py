@@ -1,0 +1,101 @@
+"""Temperatures of isotherms: from a ``# temperature:`` line, the file stem (``Tm010C``) or
+a ``# name:`` line."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from .._io import read_text_file
+from ..errors import InputError
+
+_NUMBER = r"[+\-\u2212]?\d+(?:\.\d*)?(?:[eE][+\-]?\d+)?"
+
+
+_TEMPERATURE_VALUE = re.compile(rf"^\s*({_NUMBER})\s*(°\s*C|deg\s*C|C|K)?\s*$", re.IGNORECASE)
+
+
+_TEMPERATURE_IN_NAME = re.compile(rf"({_NUMBER})\s*°\s*C")
+
+
+_TEMPERATURE_IN_STEM = re.compile(r"(?:^|[_\-\s.])T([mp+\-])?(\d+)(?:[.p](\d+))?C(?=$|[_\-\s.])",
+                                  re.IGNORECASE)
+
+
+def parse_temperature(text: str) -> float | None:
+    """A temperature in °C from text such as ``"20"``, ``"-10 °C"``, ``"20 C"`` or ``"293.15 K"``.
+
+    Returns None when the text is not a temperature.
+
+    Examples
+    --------
+    >>> parse_temperature("293.15 K")
+    20.0
+    >>> parse_temperature("-10 °C")
+    -10.0
+    """
+    m = _TEMPERATURE_VALUE.match(text)
+    if not m:
+        return None
+    value = float(m.group(1).replace("\u2212", "-"))
+    if (m.group(2) or "").upper() == "K":
+        value = round(value - 273.15, 10)
+    return value
+
+
+def temperature_from_stem(stem: str) -> float | None:
+    """A temperature in °C from a file stem such as ``T020C``, ``Tp020C``, ``Tm010C`` (−10 °C).
+
+    ``m`` or ``-`` before the digits is a minus sign, ``p`` or ``+`` a plus sign; ``T20p5C`` is
+    20.5 °C. The pattern must stand alone in the stem (at its start or end, or between ``_``,
+    ``-``, ``.`` or spaces).
+
+    Examples
+    --------
+    >>> temperature_from_stem("Tm010C"), temperature_from_stem("run3_T20p5C")
+    (-10.0, 20.5)
+    """
+    m = _TEMPERATURE_IN_STEM.search(stem)
+    if not m:
+        return None
+    value = float(m.group(2) + ("." + m.group(3) if m.group(3) else ""))
+    return -value if (m.group(1) or "").lower() in ("m", "-") else value
+
+
+def temperature_of_file(path) -> float | None:
+    """The temperature [°C] of a data file: a ``# temperature:`` comment (``20``, ``20 C``,
+    ``293.15 K``), else the file stem (:func:`temperature_from_stem`), else a ``# name:`` comment
+    holding ``<number> °C``; None if none of these gives one or the file cannot be read (the
+    comparison reports that).
+
+    Raises
+    ------
+    InputError
+        If a ``# temperature:`` comment is not a temperature (naming the file and line).
+    """
+    try:
+        text = read_text_file(path)
+    except InputError:
+        return None
+    meta = {}
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped.startswith("#"):
+            continue
+        key, sep, value = stripped.lstrip("#").partition(":")
+        key = key.strip().lower()
+        if sep and key == "temperature" and key not in meta:
+            meta[key] = parse_temperature(value)
+            if meta[key] is None:
+                raise InputError(f"file '{path}', line {lineno}: '# temperature:' expects a "
+                                 f"temperature such as 20, 20 C or 293.15 K, got {value.strip()!r}")
+        elif sep and key == "name":
+            meta.setdefault(key, value.strip())
+    if meta.get("temperature") is not None:
+        return meta["temperature"]
+    value = temperature_from_stem(Path(path).stem)
+    if value is not None:
+        return value
+    found = _TEMPERATURE_IN_NAME.findall(meta.get("name", ""))
+    return float(found[-1].replace("\u2212", "-")) if found else None
+

@@ -1,0 +1,104 @@
+"""The ``bayesfo`` command line.
+
+Exit status 0 on success, 2 on bad input (one line on stderr naming the file, column, row or
+argument), 1 on an internal error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from .. import __version__
+from ..errors import InputError, OutputError
+
+#: The commands, in the order of ``bayesfo --help``; each is the module ``bayesfo.cli.<name>``
+#: with ``add_parser(subparsers)`` and ``run(args) -> int``, imported when the parser is built
+#: (they import the computing modules only when they run).
+COMMANDS = ("inspect", "compare", "identify", "simulate", "structures", "extract", "batch")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message):
+        raise InputError(f"{message} (see '{self.prog} --help')")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="bayesfo",
+        description="Uncertainty-aware model choice for fractional-order transfer functions.",
+    )
+    parser.add_argument("--version", action="version", version=f"bayesfo {__version__}")
+    parser.add_argument("--models", action="append", default=[], metavar="PATH",
+                        help="extra structure card (.toml) or directory of cards; repeatable")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    for name in COMMANDS:
+        importlib.import_module(f"{__name__}.{name}").add_parser(sub)
+    return parser
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None):
+    print(f"bayesfo: warning: {message}", file=sys.stderr)
+
+
+class Terminated(BaseException):
+    """SIGTERM arrived: unwinds like Ctrl-C, so that outputs are left as they were and worker
+    processes are ended."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated
+
+
+def main(argv=None) -> int:
+    """Run the command line; returns the exit status."""
+    import signal
+    import threading
+
+    parser = build_parser()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return 2
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.showwarning = _one_line_warning
+            return importlib.import_module(f"{__name__}.{args.command}").run(args)
+    except InputError as exc:
+        print(f"bayesfo: error: {exc}", file=sys.stderr)
+        return 2
+    except OutputError as exc:
+        print(f"bayesfo: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("bayesfo: interrupted (no output is left half-written)",
+              file=sys.stderr)
+        return 130
+    except Terminated:
+        print("bayesfo: terminated (no output is left half-written)",
+              file=sys.stderr)
+        return 143
+    except Exception as exc:  # the contract: exit 1 on internal errors, no traceback by default
+        if os.environ.get("BAYESFO_DEBUG"):
+            raise
+        print(f"bayesfo: internal error: {type(exc).__name__}: {exc} "
+              "(set BAYESFO_DEBUG=1 for a traceback)", file=sys.stderr)
+        return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,128 @@
+"""``bayesfo batch``: compare structures on many data sets (local processes or a Dask cluster)."""
+
+from __future__ import annotations
+
+import sys
+
+from ..batch import OK, BatchResult, expand_inputs, run_batch
+from ..options import (
+    DEFAULT_STRUCTURES,
+    EVIDENCE_ROUTES,
+    KINDS,
+    NOISE_MODELS,
+    parse_floats,
+    seed_argument,
+)
+
+
+def add_parser(subparsers):
+    """Register the ``batch`` sub-command on the ``bayesfo`` command line.
+
+    Parameters
+    ----------
+    subparsers
+        The object returned by ``ArgumentParser.add_subparsers``.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``batch`` parser (its command is :func:`cmd_batch`).
+    """
+    p = subparsers.add_parser(
+        "batch", help="compare structures on many data sets (local processes or a Dask cluster)",
+        description="Run 'compare' on every data set; write DIR/<id>/ per data set, "
+                    "DIR/batch_summary.csv and its figure, and, for isotherms, "
+                    "DIR/temperature_summary.csv and the figure of q against temperature. "
+                    "A re-run skips the data sets whose results are complete.")
+    p.add_argument("inputs", nargs="*", metavar="INPUT",
+                   help="CSV file, directory of *.csv, glob pattern, or manifest (a CSV with a "
+                        "'path' column and per-file options)")
+    p.add_argument("--manifest", action="append", default=[], metavar="FILE",
+                   help="manifest CSV: path[,id,kind,reciprocal|invert,structures,noise,prior,"
+                        "seed,holdout,evidence,evidence_check,temperature]; repeatable")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--kind", choices=KINDS,
+                   help="what the responses are (default: each file's '# kind:' line, "
+                        "else generic)")
+    p.add_argument("--reciprocal", action="store_true",
+                   help="use 1/G of the data (sigma propagated)")
+    p.add_argument("--structures", default=DEFAULT_STRUCTURES,
+                   help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
+    p.add_argument("--noise", default="auto", choices=NOISE_MODELS,
+                   help="noise model (default: known if the data give sigma, else relative "
+                        "or constant)")
+    p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
+                   help="override a prior, e.g. q=uniform:0.2:1; repeatable")
+    p.add_argument("--seed", type=seed_argument, default=0,
+                   help="seed of every data set (the same numbers whatever the workers)")
+    p.add_argument("--holdout", default=None, metavar="W1,W2",
+                   help="angular frequencies [rad/s] left out of every fit for validation")
+    p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
+                   help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
+                        "ladder (ladder); auto: the ladder where the posterior did not converge")
+    p.add_argument("--evidence-check", action="store_true",
+                   help="also compute ln Z by dynesty nested sampling and flag disagreements")
+    p.add_argument("--no-figures", action="store_true",
+                   help="skip each data set's figures and report.html (the combined figures "
+                        "are still drawn)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="processes running data sets side by side (default 0: one per CPU; "
+                        "1: in this process); the numbers do not depend on it")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a Dask cluster (e.g. tcp://10.0.0.5:8786); needs bayesfo[cluster]")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar or table; only the one-line summary and errors")
+    return p
+
+
+def run(args) -> int:
+    """Run ``bayesfo batch``; returns the exit status (0 all compared, 2 bad input in some data
+    set, 1 an internal error in some data set). Problems with the command itself (arguments,
+    manifests, scheduler) raise :class:`~bayesfo.errors.InputError`."""
+    options = {"kind": args.kind, "reciprocal": args.reciprocal, "structures": args.structures,
+               "noise": args.noise, "priors": tuple(args.prior),
+               "holdout": parse_floats(args.holdout, "--holdout") if args.holdout else None,
+               "evidence": args.evidence, "evidence_check": args.evidence_check,
+               "models": tuple(getattr(args, "models", None) or ()),
+               "figures": not args.no_figures}
+    datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,
+                             seed=args.seed, exclude=args.out)
+    progress = not args.quiet and sys.stderr.isatty()
+    result = run_batch(datasets, args.out, workers=args.workers, scheduler=args.scheduler,
+                       progress=progress)
+    for o in result.failed:
+        print(f"bayesfo: error: {o.dataset.id}: {o.error}", file=sys.stderr)
+    if not args.quiet:
+        _print_table(result)
+    n_ok = sum(o.status == OK for o in result.outcomes)
+    reused = sum(o.reused for o in result.outcomes)
+    names = ", ".join(n for n in result.written)
+    print(f"batch: {len(result.outcomes)} data sets, {n_ok} compared ({reused} complete from an "
+          f"earlier run), {len(result.failed)} failed; {result.executor}, "
+          f"{result.wall_seconds:.1f} s; wrote {result.out_dir}/{{<id>/, {names}}}")
+    return result.exit_status
+
+
+def _print_table(result: BatchResult) -> None:
+    width = max([7] + [len(o.dataset.id) for o in result.outcomes])
+    print(f"{'dataset':<{width}} {'T [°C]':>7}  {'best':<14} {'P':>6}  {'q (94% HDI)':<26} status")
+    for o in result.outcomes:
+        t = "" if o.dataset.temperature is None else f"{o.dataset.temperature:g}"
+        if o.status != OK:
+            print(f"{o.dataset.id:<{width}} {t:>7}  {'-':<14} {'-':>6}  {'-':<26} "
+                  f"{o.status.replace('_', ' ')}")
+            continue
+        best = next((r for r in o.rows if r.get("best")), None)
+        if best is None:
+            print(f"{o.dataset.id:<{width}} {t:>7}  no ranked structure")
+            continue
+        p = best.get("posterior_probability")
+        q = "" if best.get("q_mean") is None else (
+            f"{best['q_mean']:.3f} [{best['q_hdi_low']:.3f}, {best['q_hdi_high']:.3f}]")
+        flags = "reused" if o.reused else "ok"
+        if not best.get("converged"):
+            flags += ", not converged"
+        print(f"{o.dataset.id:<{width}} {t:>7}  {best['structure']:<14} "
+              f"{'-' if p is None else f'{p:.3f}':>6}  {q:<26} {flags}")
+
+

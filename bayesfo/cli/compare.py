@@ -1,0 +1,134 @@
+"""``bayesfo compare``: posteriors, criteria and ranking of several structures on one data set."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..options import (
+    DEFAULT_STRUCTURES,
+    EVIDENCE_ROUTES,
+    parse_floats,
+    parse_priors,
+    seed_argument,
+)
+from ._common import add_data_options, library, read_data
+
+
+def add_parser(subparsers):
+    """Register ``bayesfo compare``: compare structures on one data set."""
+    p = subparsers.add_parser("compare", help="posteriors and criteria of several structures on one data set")
+    add_data_options(p)
+    p.add_argument("--structures", default=DEFAULT_STRUCTURES,
+                   help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory (default: bayesfo-<data name>)")
+    p.add_argument("--noise", default="auto", choices=("auto", "known", "constant", "proportional"),
+                   help="noise model (default: known if the data give sigma, else relative or constant)")
+    p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
+                   help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1")
+    p.add_argument("--seed", type=seed_argument, default=0)
+    p.add_argument("--holdout", default=None, metavar="W1,W2",
+                   help="angular frequencies [rad/s] left out of the fit for validation")
+    p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
+                   help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
+                        "ladder (ladder); auto: the ladder where the posterior did not converge")
+    p.add_argument("--evidence-check", action="store_true",
+                   help="also compute ln Z by dynesty nested sampling and flag disagreements")
+    p.add_argument("--workers", type=int, default=0, metavar="N",
+                   help="processes running structures side by side and then drawing the figures "
+                        "(default 0: one per CPU); the numbers do not depend on it")
+    p.add_argument("--no-figures", action="store_true",
+                   help="skip the figures and report.html (faster; summary, table and NetCDF only)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or table")
+    return p
+
+
+def _num(x, fmt: str = ".2f") -> str:
+    """A number for the terminal table; '-' for one that is undefined (its reason is among
+    the warnings)."""
+    return format(x, fmt) if x is not None and np.isfinite(x) else "-"
+
+
+def run(args) -> int:
+    from ..comparison import compare, write_outputs
+    from ..outdir import check_output_directory
+    from ..parallel import available_cpus, process_pool
+    from ..structures import resolve_structures
+
+    data = read_data(args)
+    structures = resolve_structures(args.structures, library(args))
+    priors = parse_priors(args.prior)
+    known = {p for s in structures for p in s.param_names} | {"sigma", "sigma_rel"}
+    unknown = [k for k in priors if k not in known]
+    if unknown:
+        raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
+    out = check_output_directory(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
+    progress = not args.quiet and sys.stderr.isatty()
+    holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
+    options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
+                   evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout)
+    if args.workers < 0:
+        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
+    n_proc = min(args.workers or available_cpus(), len(structures))
+    if n_proc > 1:
+        # One pool for the structures and then the figures: its processes have the libraries
+        # loaded by the time they draw.
+        with process_pool(n_proc) as pool:
+            result = compare(data, structures, pool=pool, **options)
+            write_outputs(result, out, figures=not args.no_figures, pool=pool)
+    else:
+        result = compare(data, structures, workers=1, **options)
+        write_outputs(result, out, figures=not args.no_figures)
+    if not args.quiet:
+        n_fit = result.data.n_frequencies
+        held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
+        print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "
+              "log-evidence ln Z (bridge sampling; L: from a tempered ladder); P = posterior probability, equal prior odds")
+        print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
+              f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3}")
+        for row in result.table():
+            if row.get("error"):
+                print(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  skipped: {row['error']}")
+                continue
+            q = "" if row["q_mean"] is None else f"{row['q_mean']:.3f} ({row['q_sd']:.3f})"
+            if row["log_evidence"] is None:
+                z = dz = p = "-"
+            else:
+                z = f"{row['log_evidence']:.2f} ± {row['log_evidence_err']:.2f}"
+                z += " L" if row["evidence_method"] == "ladder" else "  "
+                dz = f"{row['delta_log_evidence']:.2f}"
+                p = f"{row['posterior_probability']:.3f}"
+            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} {dz:>8} "
+                  f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>16} "
+                  f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3}")
+        pairs = result.baselines()
+        if pairs:
+            print("integer baselines (q = 1) against their fractional parents:")
+            for b in pairs:
+                if b["delta_log_evidence"] is None:
+                    continue
+                d = b["delta_log_evidence"]
+                verdict = "fractional order favoured" if d > 0 else "integer order favoured"
+                hdi = ""
+                if b["order"] is not None:
+                    lo, hi = b["order_hdi"]
+                    hdi = (f"; {b['order']} of {b['parent']} in [{lo:.3f}, {hi:.3f}] (94 % HDI"
+                           f"{', includes 1' if b['order_hdi_includes_1'] else ''})")
+                print(f"   {b['parent']:<14} vs {b['baseline']:<16} ln Z difference "
+                      f"{d:+9.2f} ± {b['delta_log_evidence_err']:.2f}: {verdict}{hdi}")
+        if result.holdout is not None:
+            print("held out " + ", ".join(f"{w:.4g}" for w in result.holdout.omega) + " rad/s:")
+            for row in result.table():
+                if not row.get("error"):
+                    print(f"   {row['structure']:<16} log predictive density {row['holdout_lpd']:10.2f}, "
+                          f"RMSE {row['holdout_rmse']:.4g} (in-sample RMSE {row['rmse']:.4g})")
+        if args.no_figures:
+            print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
+        else:
+            print(f"report: {out / 'report.html'} (figures in {out / 'figures'}; summary.json, "
+                  "ranking.csv and one NetCDF per structure beside it)")
+    return 0

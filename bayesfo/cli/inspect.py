@@ -1,0 +1,65 @@
+"""``bayesfo inspect``: read and check a data file; show what it holds."""
+
+from __future__ import annotations
+
+import json
+
+from ..options import (
+    parse_floats,
+)
+from ._common import add_data_options, library, read_data
+
+
+def add_parser(subparsers):
+    """Register ``bayesfo inspect``: read and check a data file."""
+    p = subparsers.add_parser("inspect", help="read and check a data file; show what it holds")
+    add_data_options(p)
+    p.add_argument("--structures", default=None,
+                   help="comma list of structures to check the data against (e.g. voigt,zener,max3)")
+    p.add_argument("--holdout", default=None, metavar="W1,W2",
+                   help="angular frequencies [rad/s] to hold out for validation")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    return p
+
+
+def run(args) -> int:
+    from ..structures import resolve_structures
+
+    data = read_data(args)
+    info = data.to_dict()
+    info.update(
+        omega_ref=data.omega_ref,
+        g_ref=data.g_ref,
+        magnitude_min=float(data.magnitude.min()),
+        magnitude_max=float(data.magnitude.max()),
+    )
+    if args.holdout:
+        train, test = data.split(parse_floats(args.holdout, "--holdout"))
+        info["holdout"] = test.omega.tolist()
+        data = train
+    if args.structures:
+        structures = resolve_structures(args.structures, library(args))
+        for s in structures:
+            s.check_data(data)
+        info["structures"] = {s.name: s.n_params for s in structures}
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return 0
+    print(f"{info['name']}: {info['n_frequencies']} frequencies, "
+          f"{info['omega_min']:.4g} to {info['omega_max']:.4g} rad/s, kind {info['kind']}"
+          + (f", units {info['units']}" if info["units"] else ""))
+    print(f"|G| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}; "
+          f"scaling omega_ref = {info['omega_ref']:.4g} rad/s, g_ref = {info['g_ref']:.4g}")
+    print("sigma: " + ("given per point" if info["has_sigma"] else "not given (estimated when fitting)"))
+    bad = info["dissipation_violations"]
+    if bad:
+        print(f"warning: {len(bad)} point(s) with negative loss, impossible for a passive "
+              f"{info['kind']}: omega = " + ", ".join(f"{w:.4g}" for w in bad) + " rad/s")
+    for note in info["notes"]:
+        print(f"note: {note}")
+    if "holdout" in info:
+        print("held out: " + ", ".join(f"{w:.4g}" for w in info["holdout"]) + " rad/s")
+    if "structures" in info:
+        print("structures (parameters): "
+              + ", ".join(f"{k} ({v})" for k, v in info["structures"].items()))
+    return 0

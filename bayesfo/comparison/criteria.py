@@ -1,0 +1,177 @@
+"""Criteria of one structure from its fit and posterior: maximum log-likelihood, AIC, AICc, BIC,
+WAIC and PSIS-LOO, RMSE, held-out predictive density, the evidence ln Z by the chosen route,
+and the posterior model probabilities across structures."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..errors import EvidenceWarning, InputError, PredictiveWarning
+from ..identify.optimize import FitResult
+from ..inference import Likelihood, PosteriorResult
+from ..inference._arviz import arviz
+from ..inference.evidence import bridge_evidence, ladder_evidence, nested_evidence
+
+PARETO_K_WARN = 0.7
+
+
+def _frequencies(omega, shown: int = 6) -> str:
+    """``omega = 1, 2, 3 rad/s``, or the first few and how many more, for a warning line."""
+    text = ", ".join(f"{w:.4g}" for w in omega[:shown])
+    if len(omega) > shown:
+        text += f" and {len(omega) - shown} more"
+    return f"omega = {text} rad/s"
+
+
+def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
+    az = arviz()
+    n_real = 2 * lik.data.n_frequencies
+    k = lik.ndim
+    # Maximum log-likelihood: the sampler's best draw or the optimiser's optimum (with the
+    # maximum-likelihood noise for that optimum), whichever is higher.
+    theta_fit = np.atleast_2d(fit.theta_scaled)
+    if lik.noise_param:
+        theta_fit = np.column_stack([theta_fit, lik.noise_estimate(theta_fit)])
+    ll_fit = float(lik(theta_fit)[0]) if fit.admissible and lik.in_support(theta_fit)[0] else -np.inf
+    max_ll = max(post.max_log_likelihood, ll_fit)
+    aic = 2 * k - 2 * max_ll
+    aicc = aic + (2 * k * (k + 1) / (n_real - k - 1) if n_real - k - 1 > 0 else math.inf)
+    bic = k * math.log(n_real) - 2 * max_ll
+    warn = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        waic = az.waic(post.idata, pointwise=True)
+        loo = az.loo(post.idata, pointwise=True)
+    for w in caught:
+        if "posterior variance of the log predictive" in str(w.message):
+            warn.append(f"{post.structure}: WAIC is unreliable (large pointwise variances)")
+    pareto_k = np.asarray(loo.pareto_k)
+    k_max = float(np.max(pareto_k))
+    if k_max > PARETO_K_WARN:
+        bad = lik.data.omega[pareto_k > PARETO_K_WARN]
+        msg = (f"{post.structure}: Pareto k up to {k_max:.2f} at {_frequencies(bad)}; "
+               "PSIS-LOO is unreliable there")
+        warn.append(msg)
+        warnings.warn(msg, PredictiveWarning, stacklevel=3)
+    elpd = {"waic": (float(waic.elpd_waic), float(waic.se)),
+            "loo": (float(loo.elpd_loo), float(loo.se))}
+    for name, (value, se) in elpd.items():
+        if not (math.isfinite(value) and math.isfinite(se)):
+            # Pointwise log-likelihoods that differ by more than ~700 nats between draws
+            # overflow the importance ratios: the criterion is undefined, not a number.
+            pointwise = post.idata.log_likelihood["G"].values.reshape(-1, lik.data.n_frequencies)
+            spread = float(np.ptp(pointwise, axis=0).max())
+            msg = (f"{post.structure}: {name.upper()} cannot be computed: the pointwise "
+                   f"log-likelihood varies by up to {spread:.3g} nats between posterior draws "
+                   "(the structure misfits these data far beyond its noise scale)")
+            warn.append(msg)
+            warnings.warn(msg, PredictiveWarning, stacklevel=3)
+            elpd[name] = (math.nan, math.nan)  # null in summary.json, empty in ranking.csv
+    model = lik.structure.response(
+        post.map_theta[: lik.structure.n_params], lik.data.omega, lik.data.kind
+    )
+    rmse = float(np.sqrt(np.sum(np.abs(lik.data.response - model) ** 2)) / lik.data.n_frequencies)
+    return {
+        "max_log_likelihood": max_ll, "aic": aic, "aicc": aicc, "bic": bic,
+        "waic": elpd["waic"][0], "waic_se": elpd["waic"][1],
+        "loo": elpd["loo"][0], "loo_se": elpd["loo"][1], "pareto_k_max": k_max,
+        "pareto_k": pareto_k.tolist(), "loo_pointwise": np.asarray(loo.loo_i).tolist(),
+        "rmse": rmse, "warnings": warn,
+        "priors": lik.describe_priors(),
+    }
+
+
+def _holdout(lik, post, test: FrequencyResponse) -> dict:
+    """Log pointwise predictive density and RMSE on held-out frequencies."""
+    from scipy.special import logsumexp
+
+    # Same structure, noise model, priors and units as the fit: the draws apply unchanged.
+    held = Likelihood(lik.structure, test, noise=lik.noise, priors=lik.priors,
+                      scaling=lik.scaling, require_points=False)
+    draws = post.samples_scaled
+    pointwise = held.pointwise(draws)
+    lpd = logsumexp(pointwise, axis=0) - np.log(draws.shape[0])
+    model = lik.structure.response(post.map_theta[: lik.structure.n_params], test.omega, test.kind)
+    rmse = float(np.sqrt(np.sum(np.abs(test.response - model) ** 2)) / test.n_frequencies)
+    return {"holdout_lpd": float(lpd.sum()), "holdout_lpd_pointwise": lpd.tolist(),
+            "holdout_rmse": rmse, "holdout_omega": test.omega.tolist()}
+
+
+#: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by the
+#: optimiser and the sampler has missed part of the posterior (1 000 particles of a posterior
+#: reach within a few nats of its maximum).
+LADDER_SHORTFALL = 5.0
+
+
+def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
+              best_log_likelihood: float | None = None) -> dict:
+    out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": []}
+    # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
+    # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
+    # from the prior instead (ladder_evidence), proposing from the draws as well so that it
+    # keeps the narrow modes the walkers found.
+    ladder = route == "ladder" or (route == "auto" and not post.converged)
+    try:
+        if ladder:
+            try:
+                out["evidence"] = ladder_evidence(lik, seed=seed, guide=post)
+            except InputError as exc:
+                if route == "ladder":
+                    raise
+                warnings.warn(f"{post.structure}: tempered ladder failed ({exc}); ln Z from the "
+                              "emcee draws instead", EvidenceWarning, stacklevel=3)
+                out["evidence"] = bridge_evidence(lik, post, seed=seed)
+        else:
+            out["evidence"] = bridge_evidence(lik, post, seed=seed)
+    except InputError as exc:
+        warnings.warn(f"{post.structure}: no evidence: {exc}", EvidenceWarning, stacklevel=3)
+        return out
+    ev = out["evidence"]
+    if (ev.reached_log_likelihood is not None and best_log_likelihood is not None
+            and ev.reached_log_likelihood < best_log_likelihood - LADDER_SHORTFALL):
+        message = (f"{post.structure}: a tempered-ladder run ended "
+                   f"{best_log_likelihood - ev.reached_log_likelihood:.1f} nats below the best "
+                   "fit, so its ln Z may be too low")
+        out["warnings"].append(message)
+        warnings.warn(message, EvidenceWarning, stacklevel=3)
+    if not post.converged and ev.method == "bridge":
+        out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
+    if check:
+        # Uniform draws from bounding ellipsoids where emcee found one compact mode; slice
+        # sampling where it did not converge (ridges, several modes), on which uniform draws
+        # stall (see nested_evidence).
+        how = {} if post.converged else {"sample": "rslice", "slices": max(25, 5 * lik.ndim)}
+        nested = nested_evidence(lik, seed=seed, **how)
+        out["evidence_check"] = nested
+        combined = math.hypot(out["evidence"].log_z_err, nested.log_z_err)
+        agree = abs(out["evidence"].log_z - nested.log_z) <= 2 * combined
+        out["evidence_agree"] = bool(agree)
+        if not agree:
+            method = out["evidence"].method
+            out["warnings"].append(f"{post.structure}: {method} and nested ln Z disagree")
+            warnings.warn(
+                f"{post.structure}: {method} ln Z = {out['evidence'].log_z:.2f} ± "
+                f"{out['evidence'].log_z_err:.2f} and nested ln Z = {nested.log_z:.2f} ± "
+                f"{nested.log_z_err:.2f} disagree", EvidenceWarning, stacklevel=3)
+    return out
+
+
+def _model_probabilities(results, prior_odds: dict) -> None:
+    """Posterior model probabilities from ln Z and the prior odds, in place."""
+    with_z = [r for r in results if r.error is None and r.criteria.get("evidence") is not None]
+    unknown = set(prior_odds) - {r.name for r in results}
+    if unknown:
+        raise InputError(f"prior odds given for unknown structure '{sorted(unknown)[0]}'")
+    if not with_z:
+        return
+    log_w = np.array([r.criteria["evidence"].log_z + math.log(prior_odds.get(r.name, 1.0))
+                      for r in with_z])
+    p = np.exp(log_w - log_w.max())
+    p /= p.sum()
+    for r, prob in zip(with_z, p, strict=True):
+        r.criteria["posterior_probability"] = float(prob)
+

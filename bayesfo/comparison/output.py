@@ -1,0 +1,101 @@
+"""The output directory of a comparison: one NetCDF per structure, figures, report.html,
+ranking.csv and summary.json, swapped in as one run (:mod:`bayesfo.outdir`)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .._io import atomic_write_text
+from ..inference import save_netcdf
+from ..outdir import final_path, staged_run
+from .results import RANKING_FIELDS, Comparison
+
+
+def ranking_csv(comparison: Comparison) -> str:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=RANKING_FIELDS, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    for row in comparison.table():
+        # No literal nan or inf: an undefined number is an empty cell, as null in summary.json.
+        writer.writerow({k: ("" if v is None else v)
+                         for k, v in _finite({k: row.get(k) for k in RANKING_FIELDS}).items()})
+    return buf.getvalue()
+
+
+def _json_default(obj):
+    if isinstance(obj, (np.floating, np.integer)):
+        return obj.item()
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+def _finite(obj):
+    """JSON has no NaN or infinity: such numbers become null."""
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if isinstance(obj, (float, np.floating)) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
+                  formats=("png", "pdf"), pool=None) -> dict[str, Path]:
+    """Write everything a comparison produced into ``out_dir``.
+
+    One NetCDF per structure, the figures (``formats``; see
+    :func:`bayesfo.plotting.write_figures`), ``report.html`` (self-contained, figures embedded),
+    ``ranking.csv`` and ``summary.json``. Everything is written into a staging directory inside
+    ``out_dir`` and swapped in at the end (:mod:`bayesfo.outdir`), so ``out_dir`` always holds the
+    complete output of one run: an interrupted run leaves the earlier output as it was, and the
+    outputs of an earlier run that this one does not write (a structure left out) are removed.
+    Files of the user's own in ``out_dir`` are never touched.
+
+    Parameters
+    ----------
+    comparison : Comparison
+    out_dir : path
+        Created if missing.
+    figures : bool
+        Draw the figures and the report (matplotlib; a few seconds per structure).
+    formats : sequence of str
+        Figure file formats.
+    pool : concurrent.futures.Executor, optional
+        Draw the figures in these worker processes (from :func:`process_pool`).
+
+    Returns
+    -------
+    dict
+        ``{name: path}`` of the files written (figures: ``{name: [paths]}``).
+    """
+    out_dir = Path(out_dir)
+    written = {}
+    with staged_run(out_dir) as stage:
+        for r in comparison.results:
+            if r.posterior is not None:
+                written[r.name] = save_netcdf(r.posterior.idata, stage / f"{r.name}.nc")
+        if figures:
+            from ..plotting import write_figures
+            from ..report import write_report
+
+            drawn = write_figures(comparison, stage / "figures", formats=formats,
+                                  seed=comparison.seed, pool=pool)
+            written.update(drawn)
+            written["report.html"] = write_report(comparison, stage, drawn)
+        written["ranking.csv"] = atomic_write_text(stage / "ranking.csv", ranking_csv(comparison))
+        text = json.dumps(_finite(comparison.to_summary()), indent=2, default=_json_default,
+                          allow_nan=False)
+        written["summary.json"] = atomic_write_text(stage / "summary.json", text + "\n")
+    return {name: [final_path(p, stage, out_dir) for p in paths] if isinstance(paths, list)
+            else final_path(paths, stage, out_dir) for name, paths in written.items()}
+

@@ -1,0 +1,248 @@
+"""What a comparison produced: one :class:`StructureResult` per structure and the
+:class:`Comparison` that ranks them (tables, summary.json contract, baselines, families)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..identify.optimize import FitResult
+from ..inference import PosteriorResult
+from ..structures import Structure
+
+
+@dataclass(frozen=True, eq=False)
+class StructureResult:
+    """Everything computed for one structure on one data set.
+
+    ``error`` holds the reason when the structure could not be run (the other fields are None).
+    """
+
+    structure: Structure
+    fit: FitResult | None = None
+    posterior: PosteriorResult | None = None
+    criteria: dict = field(default_factory=dict)
+    error: str | None = None
+
+    @property
+    def name(self) -> str:
+        return self.structure.name
+
+    def to_dict(self) -> dict:
+        s = self.structure
+        out = {
+            "name": s.name, "family": s.family, "formula": s.formula, "inverted": s.inverted,
+            "integer": s.integer, "parent": _parent(s), "n_params": s.n_params,
+        }
+        if self.error is not None:
+            out["error"] = self.error
+            return out
+        post = self.posterior
+        ev = self.criteria.get("evidence")
+        check = self.criteria.get("evidence_check")
+        out.update(
+            parameters={k: v.to_dict() for k, v in post.summary.items()},
+            priors=self.criteria["priors"],
+            noise=post.noise, noise_reason=post.noise_reason,
+            log_evidence=None if ev is None else ev.log_z,
+            log_evidence_err=None if ev is None else ev.log_z_err,
+            evidence_method=None if ev is None else ev.method,
+            log_prior_support=None if ev is None else ev.log_support,
+            evidence_check=None if check is None else check.to_dict(),
+            evidence_agree=self.criteria.get("evidence_agree"),
+            posterior_probability=self.criteria.get("posterior_probability"),
+        )
+        for key in ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
+                    "pareto_k_max", "rmse"):
+            out[key] = self.criteria[key]
+        for key in ("holdout_lpd", "holdout_rmse", "holdout_lpd_pointwise", "holdout_omega"):
+            if key in self.criteria:
+                out[key] = self.criteria[key]
+        out.update(
+            rhat_max=post.rhat_max, ess_min=post.ess_min, ess_bulk_min=post.ess_bulk_min,
+            ess_tail_min=post.ess_tail_min, converged=post.converged, tau_max=float(np.max(post.tau)),
+            n_steps=post.n_steps, n_draws=int(post.samples.shape[0]), messages=list(post.messages),
+            warnings=self.criteria["warnings"],
+            optimum={"parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
+                     "rmse": self.fit.rmse, "starts": self.fit.n_starts,
+                     "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible},
+        )
+        return out
+
+
+def _parent(structure) -> str | None:
+    """The fractional structure an integer baseline comes from (``zener-int`` → ``zener``)."""
+    return structure.name[: -len("-int")] if structure.integer else None
+
+
+@dataclass(frozen=True, eq=False)
+class Comparison:
+    """Results of :func:`compare`: the data, one :class:`StructureResult` per structure."""
+
+    data: FrequencyResponse
+    results: tuple[StructureResult, ...]
+    seed: int
+    ranked_by: str = "log_evidence"
+    holdout: FrequencyResponse | None = None
+
+    @property
+    def ranking(self) -> list[str]:
+        """Structure names, best first by ln Z (those without an evidence after them, by
+        PSIS-LOO); structures that failed are left out."""
+        ok = [r for r in self.results if r.error is None]
+
+        def key(r):
+            ev = r.criteria.get("evidence")
+            value = ev.log_z if ev is not None else r.criteria["loo"]
+            return (ev is None, not math.isfinite(value), -value if math.isfinite(value) else 0)
+
+        return [r.name for r in sorted(ok, key=key)]
+
+    def __getitem__(self, name: str) -> StructureResult:
+        for r in self.results:
+            if r.name == name:
+                return r
+        raise KeyError(name)
+
+    def table(self) -> list[dict]:
+        """One row per structure, best first (failed structures last), for printing or CSV."""
+        order = {n: i for i, n in enumerate(self.ranking)}
+        rows = []
+        ok = [r for r in self.results if r.error is None]
+        best_loo = max((r.criteria["loo"] for r in ok if math.isfinite(r.criteria["loo"])),
+                       default=math.nan)
+        evs = [r.criteria["evidence"].log_z for r in ok if r.criteria.get("evidence") is not None]
+        best_z = max(evs, default=math.nan)
+        ranks = {}
+        for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
+            # An undefined criterion (NaN, with its reason among the warnings) ranks last.
+            ordered = sorted(ok, key=lambda r, c=crit, g=sign: (
+                not math.isfinite(r.criteria[c]),
+                g * r.criteria[c] if math.isfinite(r.criteria[c]) else 0))
+            ranks[crit] = {r.name: i + 1 for i, r in enumerate(ordered)}
+        for r in sorted(self.results, key=lambda r: order.get(r.name, len(order))):
+            if r.error is not None:
+                rows.append({"rank": None, "structure": r.name, "n_params": r.structure.n_params,
+                             "error": r.error})
+                continue
+            c, p = r.criteria, r.posterior
+            q = p.summary.get("q") or p.summary.get("beta")
+            ev = c.get("evidence")
+            log_z = None if ev is None else ev.log_z
+            rows.append({
+                "rank": order[r.name] + 1, "structure": r.name, "n_params": r.structure.n_params,
+                "parent": _parent(r.structure), "log_evidence": log_z, "log_evidence_err": None if ev is None else ev.log_z_err,
+                "evidence_method": None if ev is None else ev.method,
+                "delta_log_evidence": None if ev is None else log_z - best_z,
+                "bayes_factor": None if ev is None else math.exp(log_z - best_z),
+                "posterior_probability": c.get("posterior_probability"),
+                "evidence_agree": c.get("evidence_agree"),
+                **{f"rank_{k}": v[r.name] for k, v in ranks.items()},
+                "loo": c["loo"], "loo_se": c["loo_se"], "delta_loo": c["loo"] - best_loo,
+                "waic": c["waic"], "aic": c["aic"], "aicc": c["aicc"], "bic": c["bic"],
+                "max_log_likelihood": c["max_log_likelihood"], "rmse": c["rmse"],
+                "holdout_lpd": c.get("holdout_lpd"), "holdout_rmse": c.get("holdout_rmse"),
+                "q_mean": None if q is None else q.mean, "q_sd": None if q is None else q.sd,
+                "pareto_k_max": c["pareto_k_max"], "rhat_max": p.rhat_max, "ess_min": p.ess_min,
+                "converged": p.converged, "error": "",
+            })
+        return rows
+
+    def to_dataframe(self):
+        """The ranking table as a ``pandas.DataFrame`` with a ``data`` column naming the data
+        set, so tables of several comparisons combine with ``pandas.concat``.
+
+        Examples
+        --------
+        >>> tables = [compare(d, structures).to_dataframe() for d in datasets]  # doctest: +SKIP
+        >>> combined = pandas.concat(tables, ignore_index=True)  # doctest: +SKIP
+        """
+        import pandas as pd
+
+        rows = [{"data": self.data.label, **row} for row in self.table()]
+        return pd.DataFrame(rows, columns=["data", *RANKING_FIELDS])
+
+    def to_summary(self) -> dict:
+        """The ``summary.json`` contract."""
+        summary = {
+            "data": {"path": self.data.source, "name": self.data.label,
+                     "n_frequencies": self.data.n_frequencies, "kind": self.data.kind,
+                     "units": self.data.units, "omega_min": float(self.data.omega.min()),
+                     "omega_max": float(self.data.omega.max())},
+            "seed": self.seed,
+            "ranked_by": self.ranked_by,
+            "structures": [r.to_dict() for r in self.results],
+            "ranking": self.ranking,
+            "families": self.families(),
+            "baselines": self.baselines(),
+        }
+        if self.holdout is not None:
+            summary["data"]["holdout_omega"] = self.holdout.omega.tolist()
+        return summary
+
+    def baselines(self) -> list[dict]:
+        """Each integer baseline next to its fractional parent (both run on these data).
+
+        Returns one dict per pair: ``parent``, ``baseline``, ``delta_log_evidence`` (ln Z of the
+        parent minus the baseline's; > 0 favours the fractional order), ``bayes_factor`` (parent
+        over baseline), the parent's posterior order ``order`` (``q``, or ``beta`` for the
+        Maxwell) with ``order_mean``, ``order_hdi`` (94 %) and ``order_hdi_includes_1``: whether
+        q = 1, the baseline, is inside the parent's HDI.
+        """
+        done = {r.name: r for r in self.results if r.error is None}
+        out = []
+        for r in self.results:
+            parent = _parent(r.structure)
+            if parent is None or r.name not in done or parent not in done:
+                continue
+            p = done[parent]
+            ev_p, ev_b = p.criteria.get("evidence"), r.criteria.get("evidence")
+            d = None if ev_p is None or ev_b is None else ev_p.log_z - ev_b.log_z
+            order = next((k for k in ("q", "beta") if k in p.posterior.summary), None)
+            row = {"parent": parent, "baseline": r.name, "delta_log_evidence": d,
+                   "delta_log_evidence_err": None if d is None
+                   else math.hypot(ev_p.log_z_err, ev_b.log_z_err),
+                   "bayes_factor": None if d is None else math.exp(min(d, 700.0)),
+                   "order": order}
+            if order is not None:
+                o = p.posterior.summary[order]
+                row.update(order_mean=o.mean, order_hdi=[o.hdi_low, o.hdi_high],
+                           order_hdi_includes_1=bool(o.hdi_low <= 1.0 <= o.hdi_high))
+            out.append(row)
+        return out
+
+    def families(self) -> list[dict]:
+        """Evidence of each family with several members (e.g. the max-order family), with equal
+        prior weight on its members: ln Z_family = ln mean_i Z_i."""
+        groups: dict[str, list] = {}
+        for r in self.results:
+            if r.error is None and r.criteria.get("evidence") is not None:
+                groups.setdefault(r.structure.family, []).append(r)
+        out = []
+        for family, members in groups.items():
+            if len(members) < 2:
+                continue
+            z = np.array([m.criteria["evidence"].log_z for m in members])
+            err = np.array([m.criteria["evidence"].log_z_err for m in members])
+            top = z.max()
+            w = np.exp(z - top)
+            log_z = float(top + np.log(w.mean()))
+            out.append({
+                "family": family, "members": [m.name for m in members], "log_evidence": log_z,
+                "log_evidence_err": float(np.sqrt(np.sum((w / w.sum() * err) ** 2))),
+                "posterior_probability": float(sum(m.criteria.get("posterior_probability") or 0.0
+                                                   for m in members)),
+            })
+        return sorted(out, key=lambda f: -f["log_evidence"])
+
+
+RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "log_evidence_err",
+                  "evidence_method", "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
+                  "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
+                  "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",
+                  "holdout_lpd", "holdout_rmse", "q_mean",
+                  "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "error")
+

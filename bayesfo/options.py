@@ -1,0 +1,162 @@
+"""Options of a comparison, checked before any work: the same checks for ``compare``, ``batch``
+(command line and manifests) and the API.
+
+The options travel as a plain dict (picklable, JSON for a batch task's fingerprint); every value
+is checked and put in canonical form by :func:`check_options`, so a misspelt option or a bad
+value fails at once, naming where it came from, and never inside a worker.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+DEFAULT_STRUCTURES = "voigt,zener,maxwell,voigt-int,zener-int,maxwell-int"
+
+
+def parse_floats(text: str, option: str) -> list[float]:
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"{option} takes comma-separated numbers, got {text!r}") from None
+
+
+def parse_priors(specs) -> dict:
+    from .priors import prior_from_dict
+
+    out = {}
+    for spec in specs:
+        name, _, rest = spec.partition("=")
+        parts = rest.split(":")
+        if not name or len(parts) != 3:
+            raise InputError(f"--prior takes NAME=TYPE:A:B (e.g. q=uniform:0.2:1), got {spec!r}")
+        kind, a, b = parts
+        keys = ("mu", "sd") if kind == "normal" else ("low", "high")
+        try:
+            values = {keys[0]: float(a), keys[1]: float(b)}
+        except ValueError:
+            raise InputError(f"--prior {spec!r}: the bounds must be numbers") from None
+        if name.strip() in out:
+            raise InputError(f"--prior {spec!r}: a prior for '{name.strip()}' is already given; "
+                             "give one --prior per parameter")
+        out[name.strip()] = prior_from_dict({"prior": kind, **values}, f"--prior {spec!r}")
+    return out
+
+
+
+#: Options of one data set, with the defaults of ``bayesfo compare``.
+DEFAULT_OPTIONS = {
+    "kind": None,            # None: the file's '# kind:' line, else generic
+    "reciprocal": False,     # compare 1/G of the data
+    "structures": None,      # comma list; None: DEFAULT_STRUCTURES of the command line
+    "noise": "auto",
+    "priors": (),            # NAME=TYPE:A:B specifications
+    "holdout": None,         # angular frequencies [rad/s] left out of the fit
+    "evidence": "auto",      # ln Z from the emcee draws (bridge), a tempered ladder, or auto
+    "evidence_check": False,
+    "models": (),            # extra structure cards (paths)
+    "figures": True,         # per-data-set figures and report.html, as bayesfo compare
+}
+
+
+KINDS = ("compliance", "modulus", "generic")
+
+
+EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
+
+
+NOISE_MODELS = ("auto", "known", "constant", "proportional")
+
+
+def check_options(options: dict, where: str) -> dict:
+    """Check the options of one data set before any work and put them in canonical form.
+
+    Parameters
+    ----------
+    options : dict
+        Keys of :data:`DEFAULT_OPTIONS` (missing keys take the defaults).
+    where : str
+        Names the source of the options in messages (e.g. ``"manifest 'm.csv', line 3"``).
+
+    Returns
+    -------
+    dict
+        The options with ``structures`` as a tuple of structure names, ``priors`` a tuple of
+        specifications, ``holdout`` a tuple of floats or None, ``models`` a tuple of absolute
+        paths.
+
+    Raises
+    ------
+    InputError
+        For an unknown option, kind, noise model or structure, a malformed or unused prior, or a
+        hold-out frequency that is not a positive number; the message starts with ``where``.
+    """
+    from .structures import default_library, load_library, resolve_structures
+
+    unknown = set(options) - set(DEFAULT_OPTIONS)
+    if unknown:
+        raise InputError(f"{where}: unknown option '{sorted(unknown)[0]}'")
+    opts = {**DEFAULT_OPTIONS, **options}
+    if opts["kind"] is not None and opts["kind"] not in KINDS:
+        raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {opts['kind']!r}")
+    if opts["noise"] not in NOISE_MODELS:
+        raise InputError(f"{where}: noise must be one of {', '.join(NOISE_MODELS)}, "
+                         f"got {opts['noise']!r}")
+    models = tuple(str(Path(m).resolve()) for m in opts["models"])
+    try:
+        library = load_library(extra=models) if models else default_library()
+        spec = opts["structures"] or DEFAULT_STRUCTURES
+        names = spec if isinstance(spec, str) else ",".join(spec)
+        structures = resolve_structures(names, library)
+        priors = tuple(opts["priors"])
+        parsed = parse_priors(priors)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+    known = {p for s in structures for p in s.param_names} | {"sigma", "sigma_rel"}
+    unused = [k for k in parsed if k not in known]
+    if unused:
+        raise InputError(f"{where}: prior '{unused[0]}' names a parameter no selected "
+                         "structure has")
+    holdout = opts["holdout"]
+    if holdout is not None:
+        holdout = tuple(float(w) for w in holdout)
+        if not holdout:
+            holdout = None
+        elif not all(math.isfinite(w) and w > 0 for w in holdout):
+            raise InputError(f"{where}: hold-out frequencies must be positive numbers, "
+                             f"got {holdout}")
+    return {"kind": opts["kind"], "reciprocal": bool(opts["reciprocal"]),
+            "structures": tuple(s.name for s in structures), "noise": opts["noise"],
+            "priors": priors, "holdout": holdout, "evidence": opts["evidence"],
+            "evidence_check": bool(opts["evidence_check"]),
+            "models": models, "figures": bool(opts["figures"])}
+
+
+#: Seeds are 32-bit: every random generator in the chain (numpy, scipy, emcee) accepts them.
+MAX_SEED = 2**32 - 1
+
+
+def check_seed(seed, where: str) -> int:
+    if (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))
+            or not 0 <= seed <= MAX_SEED):
+        raise InputError(f"{where}: the seed must be an integer from 0 to {MAX_SEED}, "
+                         f"got {seed!r}")
+    return int(seed)
+
+
+def seed_argument(text: str) -> int:
+    """argparse type of ``--seed``."""
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"expected an integer from 0 to {MAX_SEED}, got {text!r}")
+    return value
+

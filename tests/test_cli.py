@@ -108,3 +108,13 @@ def test_identify_max_order_loop(run_cli, gspec_csv):
     assert res["best_by_rmse"] == min(rmse, key=rmse.get)
     # The true structure already fits to the noise level: RMSE ≈ sqrt(25·2e-8)/25 = 2.8e-5.
     assert rmse["max-n1m0"] < 4e-5
+
+
+def test_models_option_before_or_after_the_command(tmp_path, run_cli):
+    card = (Path(__file__).parents[1] / "models" / "voigt.toml").read_text()
+    (tmp_path / "kv.toml").write_text(card.replace('name = "voigt"', 'name = "kv2"'))
+    for argv in (["--models", tmp_path, "structures"], ["structures", "--models", tmp_path]):
+        status, out, _ = run_cli(*argv)
+        assert status == 0 and "kv2 " in out and "kv2-int " in out
+    status, out, _ = run_cli("structures")
+    assert "kv2" not in out

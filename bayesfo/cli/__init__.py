@@ -41,7 +41,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     for name in COMMANDS:
-        importlib.import_module(f"{__name__}.{name}").add_parser(sub)
+        p = importlib.import_module(f"{__name__}.{name}").add_parser(sub)
+        # Also after the command (bayesfo structures --models DIR); SUPPRESS keeps a value
+        # given before the command instead of resetting it to the default.
+        p.add_argument("--models", action="append", default=argparse.SUPPRESS, metavar="PATH",
+                       help="extra structure card (.toml) or directory of cards; repeatable")
     return parser
 
 

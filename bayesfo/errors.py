@@ -32,6 +32,10 @@ class NonlinearityWarning(UserWarning):
     """A sine record whose harmonics show that the system is not linear at that amplitude."""
 
 
+class DataWarning(UserWarning):
+    """The data hold points that no structure of the kind can fit (e.g. negative loss)."""
+
+
 class ConvergenceWarning(UserWarning):
     """The sampler stopped before its diagnostics reached the targets."""
 

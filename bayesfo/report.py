@@ -137,9 +137,10 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     """
     rows = [r for r in comparison.table() if r.get("rank") is not None]
     failed = [r for r in comparison.results if r.error is not None]
-    out: list[tuple[str, bool]] = []
+    out: list[tuple[str, bool]] = [(f"Data: {w.split(': ', 1)[1]}.", True)
+                                   for w in comparison.data_warnings]
     if not rows:
-        return [("No structure could be run on these data.", True)]
+        return out + [("No structure could be run on these data.", True)]
     best = rows[0]
     name = best["structure"]
     result = comparison[name]

@@ -246,3 +246,34 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
     assert result.table()[0]["evidence_method"] == "bridge"
     with pytest.raises(InputError, match="evidence must be"):
         compare(data, voigt, evidence="nested")
+
+
+# The flipped point is also an outlier for PSIS-LOO (Pareto k above 0.7 there), as it should be.
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_data_problems_are_warned_and_stated(tmp_path):
+    """A point of negative loss (G'' < 0) in modulus data: warned by compare, stated in
+    summary.json and first in the report's verdict."""
+    from bayesfo.data import read_csv
+    from bayesfo.errors import DataWarning
+    from bayesfo.report import verdict
+
+    lines = (Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" /
+             "Tp150C.csv").read_text().splitlines()
+    first = next(i for i, line in enumerate(lines) if line and line[0].isdigit())
+    cells = lines[first + 2].split(",")
+    cells[2] = str(-float(cells[2]))  # the loss modulus of the third frequency
+    lines[first + 2] = ",".join(cells)
+    path = tmp_path / "flipped.csv"
+    path.write_text("\n".join(lines) + "\n")
+    data = read_csv(path)
+    w3 = data.omega[2]
+    message = (f"{data.label}: 1 of 17 points have negative loss (Im G < 0), impossible for a "
+               f"passive modulus, at omega = {w3:.4g} rad/s; no passive structure can fit them")
+    with pytest.warns(DataWarning) as record:
+        result = compare(data, "voigt", seed=1, workers=1, progress=False)
+    assert [str(w.message) for w in record if w.category is DataWarning] == [message]
+    summary = result.to_summary()
+    assert summary["data"]["warnings"] == [message]
+    assert summary["data"]["dissipation_violations_omega"] == [w3]
+    text, flagged = verdict(result)[0]
+    assert flagged and text.startswith("Data: 1 of 17 points have negative loss")

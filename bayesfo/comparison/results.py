@@ -78,6 +78,21 @@ def _parent(structure) -> str | None:
     return structure.name[: -len("-int")] if structure.integer else None
 
 
+def data_problems(data: FrequencyResponse) -> list[str]:
+    """What is wrong with ``data`` for every structure: points with the loss of the wrong sign
+    for a passive material (an instrument artefact or noise that no passive structure fits)."""
+    out = []
+    bad = data.omega[data.dissipation_violations()]
+    if bad.size:
+        loss = "Im J > 0" if data.kind == "compliance" else "Im G < 0"
+        shown = ", ".join(f"{w:.4g}" for w in bad[:6]) + (f" and {bad.size - 6} more"
+                                                           if bad.size > 6 else "")
+        out.append(f"{data.label}: {bad.size} of {data.n_frequencies} points have negative loss "
+                   f"({loss}), impossible for a passive {data.kind}, at omega = {shown} rad/s; "
+                   "no passive structure can fit them")
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class Comparison:
     """Results of :func:`compare`: the data, one :class:`StructureResult` per structure."""
@@ -87,6 +102,12 @@ class Comparison:
     seed: int
     ranked_by: str = "log_evidence"
     holdout: FrequencyResponse | None = None
+
+    @property
+    def data_warnings(self) -> list[str]:
+        """Problems of the data that no structure can mend, in plain words (also warned by
+        :func:`compare` and stated in ``summary.json["data"]["warnings"]``)."""
+        return data_problems(self.data)
 
     @property
     def ranking(self) -> list[str]:
@@ -171,7 +192,10 @@ class Comparison:
             "data": {"path": self.data.source, "name": self.data.label,
                      "n_frequencies": self.data.n_frequencies, "kind": self.data.kind,
                      "units": self.data.units, "omega_min": float(self.data.omega.min()),
-                     "omega_max": float(self.data.omega.max())},
+                     "omega_max": float(self.data.omega.max()),
+                     "warnings": self.data_warnings,
+                     "dissipation_violations_omega":
+                         self.data.omega[self.data.dissipation_violations()].tolist()},
             "seed": self.seed,
             "ranked_by": self.ranked_by,
             "structures": [r.to_dict() for r in self.results],

@@ -24,13 +24,13 @@ import sys
 import warnings
 
 from ..data import FrequencyResponse
-from ..errors import InputError
+from ..errors import DataWarning, InputError
 from ..identify.optimize import fit_structure
 from ..inference import Likelihood, run_posterior
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
 from .criteria import _criteria, _evidence, _holdout, _model_probabilities
-from .results import Comparison, StructureResult
+from .results import Comparison, StructureResult, data_problems
 
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
@@ -95,6 +95,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     test = None
     if holdout is not None and len(holdout):
         data, test = data.split(holdout)
+    for problem in data_problems(data):
+        warnings.warn(problem, DataWarning, stacklevel=2)
     if progress is None:
         progress = sys.stderr.isatty()
     n_proc = min(workers or available_cpus(), len(structures))

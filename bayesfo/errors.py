@@ -40,6 +40,11 @@ class ConvergenceWarning(UserWarning):
     """The sampler stopped before its diagnostics reached the targets."""
 
 
+class CertifiedWarning(UserWarning):
+    """A posterior is reported from another sampler than emcee (the tempered ladder's
+    particles), certified by the agreement of independent runs."""
+
+
 class PredictiveWarning(UserWarning):
     """PSIS-LOO is unreliable for some frequency (Pareto k above 0.7)."""
 

@@ -396,10 +396,16 @@ def _diagnostics_section(comparison) -> str:
         status = ("converged" if post.converged
                   else "<span class='flag'>not converged</span>")
         tau = max(post.tau) if len(post.tau) else float("nan")
+        if getattr(post, "sampler", "emcee") == "ladder":
+            how = (f"{post.n_walkers} independent tempered-ladder runs × "
+                   f"{post.samples.shape[0] // post.n_walkers} particles (R-hat and ESS across "
+                   "the runs)")
+        else:
+            how = (f"{post.n_walkers} walkers × {post.n_steps} steps, τ max "
+                   f"{_num(tau, '.0f')}, acceptance {_num(post.acceptance, '.2f')}")
         line = (f"<b>{_e(r.name)}</b>: {status}; R-hat {_num(post.rhat_max, '.3f')}, ESS bulk "
                 f"{_num(post.ess_bulk_min, '.0f')}, tail {_num(post.ess_tail_min, '.0f')}, "
-                f"{post.n_walkers} walkers × {post.n_steps} steps, τ max {_num(tau, '.0f')}, "
-                f"acceptance {_num(post.acceptance, '.2f')}")
+                f"{how}")
         if r.criteria.get("evidence_agree") is False:
             line += "; <span class='flag'>the two ln Z estimates (default and nested) disagree</span>"
         ev = r.criteria.get("evidence")
@@ -414,10 +420,29 @@ def _diagnostics_section(comparison) -> str:
     return f"<ul>{''.join(items)}</ul>"
 
 
-def _caption(name: str) -> str:
+def _caption(name: str, comparison=None) -> str:
     if name in CAPTIONS:
         return CAPTIONS[name]
     kind, _, structure = name.partition("_")
+    post = None
+    if comparison is not None and kind == "trace":
+        try:
+            post = comparison[structure].posterior
+        except KeyError:
+            post = None
+    if post is not None:
+        diag = f"R-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f}"
+        if getattr(post, "sampler", "emcee") == "ladder":
+            return (f"Particles of {structure} from {post.n_walkers} independent tempered-ladder "
+                    f"runs, one histogram per run: "
+                    + ("they agree, which certifies the posterior" if post.converged else
+                       "they disagree, so the posterior is not certified") + f" ({diag}).")
+        if post.converged:
+            return (f"Walker traces of {structure} after burn-in: the walkers overlap and show "
+                    f"no trend ({diag}).")
+        return (f"Walker traces of {structure} after burn-in: the walkers have not converged "
+                f"({diag}; the targets are R-hat < 1.01 and ESS ≥ 400), so they drift or do "
+                "not overlap and the posterior is flagged.")
     if kind == "corner":
         return (f"Posterior of {structure}: marginal and pairwise distributions (log10 of "
                 "parameters with a log-uniform prior; contours hold 50 % and 90 %), with the "
@@ -434,12 +459,12 @@ def _paths(value) -> list[Path]:
     return [Path(v) for v in value]
 
 
-def _figures_section(figures: dict) -> str:
+def _figures_section(figures: dict, comparison=None) -> str:
     parts = []
     for name, value in figures.items():
         paths = _paths(value)
         png = next((p for p in paths if p.suffix.lower() == ".png"), None)
-        caption = _caption(name)
+        caption = _caption(name, comparison)
         if png is None:
             parts.append(f"<p class='small'>{_e(name)}: {_e(caption)} (not embedded: written as "
                          f"{_e(', '.join(p.name for p in paths))})</p>")
@@ -495,7 +520,7 @@ def render_report(comparison, figures: dict | None = None) -> str:
         f"<h2 id='diagnostics'>Warnings and convergence</h2>{_diagnostics_section(comparison)}",
     ]
     if figures:
-        sections.append(f"<h2 id='figures'>Figures</h2>{_figures_section(figures)}")
+        sections.append(f"<h2 id='figures'>Figures</h2>{_figures_section(figures, comparison)}")
     from . import __version__
 
     return (

@@ -158,9 +158,12 @@ def test_thesis_simulation_quick(tmp_path, capsys):
     # |G| from 0.05 to 0.6: Table A.7's optimisation gives var q = 4.5e-5, sd 0.007).
     q1 = rows["voigt"]["parameters"]["q"]
     assert q1["hdi_low"] < 0.5 < q1["hdi_high"] and q1["hdi_high"] - q1["hdi_low"] < 0.05
-    # n = m = 2 reproduces G_spec at q = 1/4 as well as 1/2: its HDI is many times wider.
+    # n = m = 2 reproduces G_spec exactly at q = 1/4 as well as 1/2, yet nearly all of its
+    # posterior mass lies at q = 1/2: dynesty (500 live points, slice sampling) on this data set
+    # puts 0.962 of it within ±0.03 of 0.5, 2e-29 near 0.25 and 0.038 elsewhere. The walkers
+    # of the quick run do not converge here; the ladder's particles are the posterior.
     q2 = rows["max-n2m2"]["parameters"]["q"]
-    assert q2["hdi_high"] - q2["hdi_low"] > 5 * (q1["hdi_high"] - q1["hdi_low"])
+    assert 0.44 < q2["hdi_low"] < 0.5 < q2["hdi_high"] < 0.56
     assert rows["voigt"]["log_evidence"] > rows["max-n2m2"]["log_evidence"]
     out = capsys.readouterr().out
     assert "table-a.7" in out and "aliases" in out

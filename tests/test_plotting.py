@@ -18,10 +18,7 @@ from scipy.integrate import trapezoid  # noqa: E402
 
 from bayesfo.comparison import StructureResult, compare  # noqa: E402
 from bayesfo.data import FrequencyResponse  # noqa: E402
-from bayesfo.errors import (
-    InputError,  # noqa: E402
-    PredictiveWarning,
-)
+from bayesfo.errors import DataWarning, InputError, PredictiveWarning  # noqa: E402
 from bayesfo.inference._arviz import arviz  # noqa: E402
 from bayesfo.plotting import (  # noqa: E402
     plot_bode,
@@ -53,8 +50,10 @@ def comparison():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = compare(data, structures, seed=0, progress=False, holdout=HOLDOUT)
-    # The misspecified structures may get unreliable PSIS-LOO; nothing else may warn.
-    assert all(w.category is PredictiveWarning for w in caught), [str(w.message) for w in caught]
+    # The misspecified structures may get unreliable PSIS-LOO, and the 5 % noise turns the
+    # loss of one point positive (a data warning); nothing else may warn.
+    assert all(w.category in (PredictiveWarning, DataWarning) for w in caught), \
+        [str(w.message) for w in caught]
     return result
 
 

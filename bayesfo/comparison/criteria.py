@@ -14,7 +14,7 @@ from ..errors import EvidenceWarning, InputError, PredictiveWarning
 from ..identify.optimize import FitResult
 from ..inference import Likelihood, PosteriorResult
 from ..inference._arviz import arviz
-from ..inference.evidence import bridge_evidence, ladder_evidence, nested_evidence
+from ..inference.evidence import bridge_evidence, ladder_runs, nested_evidence
 
 PARETO_K_WARN = 0.7
 
@@ -109,7 +109,8 @@ LADDER_SHORTFALL = 5.0
 
 def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
               best_log_likelihood: float | None = None) -> dict:
-    out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": []}
+    out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": [],
+           "ladder_runs": None}
     # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
     # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
     # from the prior instead (ladder_evidence), proposing from the draws as well so that it
@@ -118,7 +119,7 @@ def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
     try:
         if ladder:
             try:
-                out["evidence"] = ladder_evidence(lik, seed=seed, guide=post)
+                out["evidence"], out["ladder_runs"] = ladder_runs(lik, seed=seed, guide=post)
             except InputError as exc:
                 if route == "ladder":
                     raise

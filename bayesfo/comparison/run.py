@@ -24,9 +24,10 @@ import sys
 import warnings
 
 from ..data import FrequencyResponse
-from ..errors import DataWarning, InputError
+from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputError
 from ..identify.optimize import fit_structure
 from ..inference import Likelihood, run_posterior
+from ..inference.posterior import posterior_from_particles
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
 from .criteria import _criteria, _evidence, _holdout, _model_probabilities
@@ -162,6 +163,28 @@ def _run_in_pool(pool, structures, data, options, bar) -> list:
     return [futures[i].result() for i in range(len(structures))]
 
 
+def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
+    """Where the emcee walkers did not converge, the final particles of the independent
+    tempered-ladder runs (which gave ln Z) are the posterior, if the runs agree: summaries,
+    HDIs, figures, LOO and WAIC then come from them. Returns (posterior, criteria)."""
+    ladder = posterior_from_particles(lik, runs, seed=seed)
+    if not ladder.converged:
+        note = (f"{lik.structure.name}: the tempered-ladder runs do not certify the posterior "
+                f"either ({'; '.join(m.split(': ', 1)[1] for m in ladder.messages)}); the "
+                "emcee draws are reported, flagged")
+        warnings.warn(note, ConvergenceWarning, stacklevel=3)
+        criteria["warnings"].append(note)
+        return post, criteria
+    note = (f"{lik.structure.name}: the posterior reported is that of {ladder.n_walkers} "
+            f"independent tempered-ladder runs of {ladder.samples.shape[0] // ladder.n_walkers} "
+            f"particles, which agree (R-hat {ladder.rhat_max:.3f}, ESS {ladder.ess_min:.0f}); "
+            "the emcee walkers did not converge")
+    criteria = _criteria(lik, fit, ladder)
+    criteria["warnings"].append(note)
+    warnings.warn(note, CertifiedWarning, stacklevel=3)
+    return ladder, criteria
+
+
 def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
     """Optimisation, posterior, criteria and evidence of one structure (runs in a worker process
     when ``compare`` has several). Returns the result and the warnings raised on the way."""
@@ -177,10 +200,13 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
             post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
                                     fit=fit, progress=False, **options["sampler_kwargs"])
             criteria = _criteria(lik, fit, post)
-            if test is not None:
-                criteria.update(_holdout(lik, post, test))
             extra = _evidence(lik, post, seed, options["evidence_check"], options["evidence"],
                               best_log_likelihood=criteria["max_log_likelihood"])
+            runs = extra.pop("ladder_runs")
+            if runs is not None and not post.converged:
+                post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
+            if test is not None:
+                criteria.update(_holdout(lik, post, test))
             criteria["warnings"].extend(extra.pop("warnings"))
             criteria.update(extra)
             result = StructureResult(s, fit, post, criteria)

@@ -207,13 +207,27 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
     mode found by the optimiser and the walkers is not lost on the way; the moves keep every
     rung exact, so a poor guide costs efficiency, never correctness.
     """
+    return ladder_runs(lik, seed=seed, n_particles=n_particles, n_runs=n_runs, guide=guide,
+                       **ladder_kwargs)[0]
+
+
+def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_runs: int = 2,
+                guide: PosteriorResult | None = None, **ladder_kwargs) -> tuple:
+    """:func:`ladder_evidence` and the runs it came from (their final particles are
+    independent sets of posterior draws: see
+    :func:`~bayesfo.inference.posterior.posterior_from_particles`).
+
+    Returns
+    -------
+    (Evidence, list of LadderRun)
+    """
     t0 = time.perf_counter()
     if n_runs < 2:
         raise ValueError("n_runs must be at least 2 (their spread is part of the error)")
-    runs = np.random.SeedSequence(seed).spawn(n_runs)
-    values, errors, calls, reached = [], [], 0, []
+    children = np.random.SeedSequence(seed).spawn(n_runs)
+    values, errors, calls, reached, runs = [], [], 0, [], []
     guide_u = None if guide is None else _Transform(lik).to_u(guide.samples_scaled)
-    for i, child in enumerate(runs):
+    for i, child in enumerate(children):
         run = ladder_run(lik, np.random.default_rng(child), n_particles=n_particles,
                          guide=guide_u, **ladder_kwargs)
         ev = _bridge(lik, run.particles[None], seed=seed + i)
@@ -221,6 +235,7 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
         errors.append(ev.log_z_err)
         calls += run.n_likelihood + ev.n_likelihood
         reached.append(float(np.max(run.log_likelihood)))
+        runs.append(run)
     values, errors = np.array(values), np.array(errors)
     err = math.sqrt((np.mean(errors**2) + np.var(values, ddof=1)) / n_runs)
     return Evidence(
@@ -231,7 +246,7 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
         n_likelihood=int(calls),
         seconds=time.perf_counter() - t0,
         reached_log_likelihood=min(reached),
-    )
+    ), runs
 
 
 def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: float = 0.1,

@@ -95,6 +95,9 @@ class PosteriorResult:
     converged : bool
     messages : tuple of str
         Warnings raised during the run.
+    sampler : str
+        ``"emcee"``, or ``"ladder"`` for the final particles of independent tempered-ladder
+        runs (:func:`posterior_from_particles`; each run is one chain of the diagnostics).
     idata : arviz.InferenceData
         Posterior, log_likelihood (per frequency), posterior_predictive, observed_data and
         sample_stats, coordinates named by frequency.
@@ -122,6 +125,7 @@ class PosteriorResult:
     converged: bool
     messages: tuple[str, ...] = ()
     idata: object = field(default=None, repr=False)
+    sampler: str = "emcee"
 
     @property
     def ess_min(self) -> float:
@@ -141,6 +145,7 @@ class PosteriorResult:
             "rhat_max": self.rhat_max, "ess_bulk_min": self.ess_bulk_min,
             "ess_tail_min": self.ess_tail_min, "ess_min": self.ess_min,
             "converged": self.converged, "messages": list(self.messages),
+            "sampler": self.sampler,
         }
 
 
@@ -441,6 +446,83 @@ def sample_posterior(
         converged=converged,
         messages=tuple(messages),
         idata=idata,
+    )
+
+
+def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
+                             predictive: bool = True) -> PosteriorResult:
+    """The posterior as the final particles of independent tempered-ladder runs.
+
+    Each run (a :class:`~bayesfo.inference.smc.LadderRun`, or its particles in the sampling
+    coordinates) carries prior draws to the posterior through resampling and Metropolis moves,
+    so its particles are posterior draws that no walker had to reach by a long chain; where
+    the emcee walkers did not converge (ridges, several modes) they are the posterior that is
+    reported. The certificate is the agreement of the runs: each run is one chain of the
+    rank-normalised split R-hat, and the bulk and tail ESS are computed over the runs (the
+    particles of a run are put in random order first: their order after resampling follows
+    their ancestors, not a chain). The ESS is capped by the number of distinct particles, since
+    resampling duplicates some.
+
+    Parameters
+    ----------
+    lik : Likelihood
+    runs : sequence of LadderRun or of ndarray, shape (n_particles, ndim)
+        At least two runs, the same number of particles each.
+    seed : int
+        Seed of the shuffle and of the posterior predictive draws.
+    predictive : bool
+        Store the posterior predictive and the model response in the InferenceData.
+
+    Returns
+    -------
+    PosteriorResult
+        With ``sampler="ladder"``; ``n_walkers`` is the number of runs, ``n_steps`` 0 and
+        ``tau`` NaN (no chain); ``converged`` when R-hat < 1.01 and the ESS ≥ 400.
+    """
+    az = arviz()
+    rng = np.random.default_rng(seed)
+    tr = _Transform(lik)
+    chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
+    n_runs, n_kept, ndim = chain_u.shape
+    if n_runs < 2:
+        raise ValueError("at least two runs are needed to certify the posterior")
+    chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
+    flat_u = chain_u.reshape(-1, ndim)  # run-major: chain = run
+    flat_scaled = tr.to_theta(flat_u)
+    pointwise = lik.pointwise(flat_scaled)
+    loglik = pointwise.sum(axis=1)
+    flat_phys = lik.to_physical(flat_scaled)
+    lp_flat = _log_prob_fn(lik, tr)(flat_u)
+    post = {name: flat_phys[:, i].reshape(n_runs, n_kept)
+            for i, name in enumerate(lik.param_names)}
+    chains = az.convert_to_dataset({name: tr.to_theta(chain_u)[:, :, i]
+                                    for i, name in enumerate(lik.param_names)})
+    rhat_max = max(float(v) for v in az.rhat(chains).data_vars.values())
+    distinct = float(len(np.unique(flat_u, axis=0)))
+    ess_bulk = min(distinct, min(float(v) for v in az.ess(chains, method="bulk").data_vars.values()))
+    ess_tail = min(distinct, min(float(v) for v in az.ess(chains, method="tail").data_vars.values()))
+    messages = []
+    if not rhat_max < RHAT_MAX:
+        messages.append(f"{lik.structure.name}: the tempered-ladder runs disagree (R-hat "
+                        f"{rhat_max:.3f} is not below {RHAT_MAX})")
+    if not min(ess_bulk, ess_tail) >= ESS_MIN:
+        messages.append(f"{lik.structure.name}: the tempered-ladder particles give an effective "
+                        f"sample size of {min(ess_bulk, ess_tail):.0f}, below {ESS_MIN}")
+    best = int(np.argmax(lp_flat))
+    map_theta = flat_phys[best]
+    summary = _summaries(lik, tr, flat_phys, flat_u, map_theta)
+    idata = _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_runs, n_kept,
+                            rng if predictive else None)
+    idata.posterior.attrs.update(sampler="tempered ladder", runs=n_runs)
+    acceptance = [float(np.mean(r.acceptance[-1:])) for r in runs if hasattr(r, "acceptance")]
+    return PosteriorResult(
+        structure=lik.structure.name, param_names=lik.param_names, noise=lik.noise,
+        noise_reason=lik.noise_reason, samples=flat_phys, samples_scaled=flat_scaled,
+        log_likelihood=loglik, summary=summary, map_theta=map_theta,
+        max_log_likelihood=float(loglik.max()), tau=np.full(ndim, np.nan), n_steps=0, burn=0,
+        thin=1, n_walkers=n_runs, acceptance=float(np.mean(acceptance)) if acceptance else np.nan,
+        rhat_max=rhat_max, ess_bulk_min=ess_bulk, ess_tail_min=ess_tail,
+        converged=not messages, messages=tuple(messages), idata=idata, sampler="ladder",
     )
 
 

@@ -196,6 +196,8 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     if hasattr(post.idata, "sample_stats") and "lp" in post.idata.sample_stats:
         lp = np.asarray(post.idata.sample_stats["lp"].values)
     color = color or "#0072B2"
+    if getattr(post, "sampler", "emcee") == "ladder":
+        return _plot_particles(result, fig, ds, lp, labels, is_log)
     values, artists = {}, {}
     with style():
         n_rows = len(post.param_names) + (lp is not None)
@@ -224,6 +226,47 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
             title += ": not converged"
         fig.suptitle(title, color=FLAG_COLOR if not post.converged else "black", fontsize=7.5)
         fig.align_ylabels(axes)
+    return Drawn.build(fig, axes, values, artists)
+
+
+def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
+    """:func:`plot_trace` for a posterior made of tempered-ladder particles: the particles of
+    each run as one histogram per row (there is no chain to trace); the runs certify the
+    posterior by agreeing."""
+    post = result.posterior
+    runs = ds.sizes["chain"]
+    colors = ("#0072B2", "#E69F00", "#009E73", "#CC79A7")
+    values, artists = {}, {}
+    with style():
+        n_rows = len(post.param_names) + (lp is not None)
+        fig = new_figure(fig, (COLUMN_WIDTH, 0.55 + 0.62 * n_rows))
+        axes = np.atleast_1d(fig.subplots(n_rows, 1))
+        rows = [(name, label, log) for name, label, log in zip(post.param_names, labels, is_log)]
+        for ax, (name, label, log) in zip(axes, rows):
+            y = np.asarray(ds[name].transpose("chain", "draw").values)
+            values[name] = y
+            shown = to_coordinates(y, log)
+            e = decade_exponent(shown)
+            bins = np.histogram_bin_edges(shown / 10.0**e, bins=40)
+            artists[name] = [ax.hist(shown[i] / 10.0**e, bins=bins, histtype="step",
+                                     color=colors[i % len(colors)], lw=0.8,
+                                     label=f"run {i + 1}")[2][0] for i in range(runs)]
+            ax.set_xlabel(scaled_label(label, e), labelpad=1)
+            ax.set_yticks([])
+        if lp is not None:
+            values["lp"] = lp
+            artists["lp"] = [axes[-1].hist(lp[i], bins=40, histtype="step", lw=0.8,
+                                           color=colors[i % len(colors)])[2][0]
+                             for i in range(runs)]
+            axes[-1].set_xlabel("log posterior density", labelpad=1)
+            axes[-1].set_yticks([])
+        axes[0].legend(fontsize=6, frameon=False, loc="upper right")
+        values["draw"] = np.arange(ds.sizes["draw"])
+        title = (f"{result.name}: {runs} tempered-ladder runs × {ds.sizes['draw']} particles\n"
+                 f"R-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f} across the runs")
+        if not post.converged:
+            title += ": the runs disagree"
+        fig.suptitle(title, color=FLAG_COLOR if not post.converged else "black", fontsize=7.5)
     return Drawn.build(fig, axes, values, artists)
 
 

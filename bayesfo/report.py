@@ -122,6 +122,41 @@ def _digits(sd: float) -> int:
     return min(8, max(0, 1 - math.floor(math.log10(sd))))
 
 
+def _sentence(text: str) -> str:
+    return text if text.endswith(".") else text + "."
+
+
+def _adequacy_sentences(comparison, rows) -> list[tuple[str, bool]]:
+    """Whether the best-supported structure, and any candidate, describes the data (posterior
+    predictive checks, :mod:`bayesfo.inference.adequacy`)."""
+    checked = [(r["structure"], comparison[r["structure"]].adequacy) for r in rows]
+    checked = [(n, a) for n, a in checked if a is not None]
+    if not checked:
+        return []
+    name, best = checked[0]
+    level = f"{100 * best.level:g} %"
+    if not any(a.adequate for _, a in checked):
+        small = [n for n, a in checked if a.misfit_small]
+        text = ("None of the candidates describes these data: every structure fails the "
+                f"posterior predictive checks at the {level} level, so the ranking says only "
+                "which misfits least." + (f" {name}: {_sentence(best.reasons[0])}"
+                                          if best.reasons else ""))
+        if small:
+            text += (f" The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
+                     f"{_join(small)}.")
+        return [(text.rstrip(), True)]
+    if best.adequate:
+        return [(f"{name} describes the data: its posterior predictive checks pass at the "
+                 f"{level} level (largest misfit {best.max_phase_error_deg:.1f}° in phase, "
+                 f"{100 * (10 ** best.max_log10_magnitude_error - 1):.1f} % in magnitude).",
+                 False)]
+    good = [n for n, a in checked if a.adequate]
+    text = (f"{name} is best supported but does not describe the data: "
+            f"{_sentence(best.reasons[0] if best.reasons else best.summary)}")
+    text += f" Structures that pass the checks: {_join(good)}."
+    return [(text, True)]
+
+
 def verdict(comparison) -> list[tuple[str, bool]]:
     """The plain-language verdict, as sentences ``(text, flagged)``.
 
@@ -169,6 +204,8 @@ def verdict(comparison) -> list[tuple[str, bool]]:
             if d < 2 * err:
                 out.append((f"The difference from {second['structure']} is within twice its "
                             "estimation error: the evidence does not separate the two.", True))
+    out.extend(_adequacy_sentences(comparison, rows))
+    if len(rows) > 1:
         agree = [c for c in CRITERIA_NAMES if best.get(f"rank_{c}") == 1]
         disagree = {}
         for c in CRITERIA_NAMES:

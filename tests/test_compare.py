@@ -278,3 +278,32 @@ def test_data_problems_are_warned_and_stated(tmp_path):
     assert summary["data"]["dissipation_violations_omega"] == [w3]
     text, flagged = verdict(result)[0]
     assert flagged and text.startswith("Data: 1 of 17 points have negative loss")
+
+
+def test_adequacy_of_every_structure(voigt_comparison):
+    """Posterior predictive checks on Voigt data (2 % noise, σ known): the Voigt and its
+    superset the Zener describe them, the integer Voigt misses the phase by tens of degrees."""
+    import dataclasses
+
+    from bayesfo.report import verdict
+
+    result, out = voigt_comparison
+    fits = {r.name: r.fits for r in result.results}
+    assert fits == {"voigt": "yes", "zener": "yes", "voigt-int": "no"}
+    bad = result["voigt-int"].adequacy
+    assert bad.p_values["autocorrelation"] < 1e-3 and bad.max_phase_error_deg > 30
+    assert bad.systematic_at_omega and bad.reasons[0].startswith("residuals are correlated")
+    summary = json.loads((out / "summary.json").read_text())
+    blocks = {s["name"]: s["adequacy"] for s in summary["structures"]}
+    assert blocks["voigt"]["adequate"] is True and blocks["voigt-int"]["adequate"] is False
+    assert set(blocks["voigt"]["p_values"]) == {"chi2", "autocorrelation", "scan"}
+    with open(out / "ranking.csv", newline="") as fh:
+        rows = {r["structure"]: r for r in csv.DictReader(fh)}
+    assert rows["voigt-int"]["fits"] == "no" and rows["voigt"]["adequate"] == "True"
+    best = result.ranking[0]
+    assert (f"{best} describes the data: its posterior predictive checks pass at the 1 % level"
+            in " ".join(t for t, _ in verdict(result)))
+    # With only the misspecified structure, the verdict says that nothing describes the data.
+    alone = dataclasses.replace(result, results=(result["voigt-int"],))
+    text, flagged = next((t, f) for t, f in verdict(alone) if t.startswith("None of"))
+    assert flagged and "voigt-int: residuals are correlated along frequency" in text

@@ -20,7 +20,8 @@ BATCH_FIELDS = ("dataset", "path", "temperature_C", "status", "structure", "rank
                 "posterior_probability", "loo", "loo_se", "waic", "aic", "aicc", "bic",
                 "max_log_likelihood", "rmse", "q_parameter", "q_mean", "q_sd", "q_hdi_low",
                 "q_hdi_high", "q_map", "rhat_max", "ess_min", "converged", "pareto_k_max",
-                "noise", "kind", "n_frequencies", "warnings", "error")
+                "noise", "kind", "n_frequencies", "sampler", "adequate",
+                "max_phase_error_deg", "warnings", "error")
 
 
 TEMPERATURE_FIELDS = ("temperature_C", "dataset", "structure", "rank", "best", "best_structure",
@@ -143,8 +144,11 @@ def summary_rows(summary: dict) -> list[dict]:
             noise=s.get("noise"), warnings="; ".join(s.get("warnings", [])),
         )
         for key in ("loo", "loo_se", "waic", "aic", "aicc", "bic", "max_log_likelihood", "rmse",
-                    "rhat_max", "ess_min", "converged", "pareto_k_max"):
+                    "rhat_max", "ess_min", "converged", "pareto_k_max", "sampler"):
             row[key] = s.get(key)
+        adequacy = s.get("adequacy") or {}
+        row["adequate"] = adequacy.get("adequate")
+        row["max_phase_error_deg"] = adequacy.get("max_phase_error_deg")
         rows.append(row)
     return rows
 

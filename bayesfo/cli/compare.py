@@ -87,9 +87,11 @@ def run(args) -> int:
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
         print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "
-              "log-evidence ln Z (bridge sampling; L: from a tempered ladder); P = posterior probability, equal prior odds")
+              "log-evidence ln Z (bridge sampling; L: from a tempered ladder); P = posterior "
+              "probability, equal prior odds; ok = posterior certified; fits = posterior "
+              "predictive checks pass (small: a systematic misfit within 2° and 3.5 %)")
         print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
-              f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3}")
+              f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3} {'fits':>5}")
         for row in result.table():
             if row.get("error"):
                 print(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  skipped: {row['error']}")
@@ -104,7 +106,8 @@ def run(args) -> int:
                 p = f"{row['posterior_probability']:.3f}"
             print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} {dz:>8} "
                   f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>16} "
-                  f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3}")
+                  f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3} "
+                  f"{(row['fits'] or '-').replace('no', 'NO'):>5}")
         pairs = result.baselines()
         if pairs:
             print("integer baselines (q = 1) against their fractional parents:")

@@ -31,6 +31,21 @@ class StructureResult:
     def name(self) -> str:
         return self.structure.name
 
+    @property
+    def adequacy(self):
+        """The posterior predictive checks (:class:`~bayesfo.inference.adequacy.Adequacy`), or
+        None when they could not be run."""
+        return self.criteria.get("adequacy")
+
+    @property
+    def fits(self) -> str | None:
+        """``"yes"`` (adequate), ``"small"`` (a systematic misfit within 2° and 3.5 %),
+        ``"no"``, or None without a check."""
+        a = self.adequacy
+        if a is None:
+            return None
+        return "yes" if a.adequate else ("small" if a.misfit_small else "no")
+
     def to_dict(self) -> dict:
         s = self.structure
         out = {
@@ -65,6 +80,8 @@ class StructureResult:
             rhat_max=post.rhat_max, ess_min=post.ess_min, ess_bulk_min=post.ess_bulk_min,
             ess_tail_min=post.ess_tail_min, converged=post.converged, tau_max=float(np.max(post.tau)),
             n_steps=post.n_steps, n_draws=int(post.samples.shape[0]), messages=list(post.messages),
+            sampler=getattr(post, "sampler", "emcee"),
+            adequacy=None if self.adequacy is None else self.adequacy.to_dict(),
             warnings=self.criteria["warnings"],
             optimum={"parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
                      "rmse": self.fit.rmse, "starts": self.fit.n_starts,
@@ -168,7 +185,14 @@ class Comparison:
                 "holdout_lpd": c.get("holdout_lpd"), "holdout_rmse": c.get("holdout_rmse"),
                 "q_mean": None if q is None else q.mean, "q_sd": None if q is None else q.sd,
                 "pareto_k_max": c["pareto_k_max"], "rhat_max": p.rhat_max, "ess_min": p.ess_min,
-                "converged": p.converged, "error": "",
+                "converged": p.converged, "sampler": getattr(p, "sampler", "emcee"),
+                "fits": r.fits, "adequate": None if r.adequacy is None else r.adequacy.adequate,
+                "adequacy_p_min": None if r.adequacy is None else min(r.adequacy.p_values.values()),
+                "max_phase_error_deg": None if r.adequacy is None
+                else r.adequacy.max_phase_error_deg,
+                "max_log10_magnitude_error": None if r.adequacy is None
+                else r.adequacy.max_log10_magnitude_error,
+                "error": "",
             })
         return rows
 
@@ -268,5 +292,7 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
                   "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",
                   "holdout_lpd", "holdout_rmse", "q_mean",
-                  "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "error")
+                  "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
+                  "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
+                  "max_log10_magnitude_error", "error")
 

@@ -27,6 +27,7 @@ from ..data import FrequencyResponse
 from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputError
 from ..identify.optimize import fit_structure
 from ..inference import Likelihood, run_posterior
+from ..inference.adequacy import check_adequacy
 from ..inference.posterior import posterior_from_particles
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
@@ -205,6 +206,11 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
             runs = extra.pop("ladder_runs")
             if runs is not None and not post.converged:
                 post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
+            try:
+                criteria["adequacy"] = check_adequacy(lik, post, seed=seed)
+            except InputError as exc:  # e.g. too few frequencies for the statistics
+                criteria["adequacy"] = None
+                criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
             if test is not None:
                 criteria.update(_holdout(lik, post, test))
             criteria["warnings"].extend(extra.pop("warnings"))

@@ -57,6 +57,7 @@ DEFAULT_OPTIONS = {
     "priors": (),            # NAME=TYPE:A:B specifications
     "holdout": None,         # angular frequencies [rad/s] left out of the fit
     "evidence": "auto",      # ln Z from the emcee draws (bridge), a tempered ladder, or auto
+    "sampler": "auto",       # importance sampling where certified, else emcee; or emcee
     "evidence_check": False,
     "models": (),            # extra structure cards (paths)
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
@@ -67,6 +68,7 @@ KINDS = ("compliance", "modulus", "generic")
 
 
 EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
+SAMPLERS = ("auto", "emcee")
 
 
 NOISE_MODELS = ("auto", "known", "constant", "proportional")
@@ -103,6 +105,9 @@ def check_options(options: dict, where: str) -> dict:
     opts = {**DEFAULT_OPTIONS, **options}
     if opts["kind"] is not None and opts["kind"] not in KINDS:
         raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {opts['kind']!r}")
+    if opts["sampler"] not in SAMPLERS:
+        raise InputError(f"{where}: sampler must be one of {', '.join(SAMPLERS)}, "
+                         f"got {opts['sampler']!r}")
     if opts["noise"] not in NOISE_MODELS:
         raise InputError(f"{where}: noise must be one of {', '.join(NOISE_MODELS)}, "
                          f"got {opts['noise']!r}")
@@ -132,6 +137,7 @@ def check_options(options: dict, where: str) -> dict:
     return {"kind": opts["kind"], "reciprocal": bool(opts["reciprocal"]),
             "structures": tuple(s.name for s in structures), "noise": opts["noise"],
             "priors": priors, "holdout": holdout, "evidence": opts["evidence"],
+            "sampler": opts["sampler"],
             "evidence_check": bool(opts["evidence_check"]),
             "models": models, "figures": bool(opts["figures"])}
 

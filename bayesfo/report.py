@@ -437,6 +437,11 @@ def _diagnostics_section(comparison) -> str:
             how = (f"{post.n_walkers} independent tempered-ladder runs × "
                    f"{post.samples.shape[0] // post.n_walkers} particles (R-hat and ESS across "
                    "the runs)")
+        elif getattr(post, "sampler", "emcee") == "importance":
+            info = r.criteria.get("importance") or {}
+            how = (f"importance sampling from {info.get('n_modes', '?')} optimum(s), "
+                   f"{info.get('n_proposals', 0):,} proposal draws, Pareto k̂ "
+                   f"{_num(info.get('k_hat'), '.2f')} (certified below 0.7), ESS of the weights")
         else:
             how = (f"{post.n_walkers} walkers × {post.n_steps} steps, τ max "
                    f"{_num(tau, '.0f')}, acceptance {_num(post.acceptance, '.2f')}")
@@ -469,6 +474,9 @@ def _caption(name: str, comparison=None) -> str:
             post = None
     if post is not None:
         diag = f"R-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f}"
+        if getattr(post, "sampler", "emcee") == "importance":
+            return (f"Posterior draws of {structure} resampled from importance weights (ESS "
+                    f"{post.ess_min:.0f}; no chain to trace): the marginal of each parameter.")
         if getattr(post, "sampler", "emcee") == "ladder":
             return (f"Particles of {structure} from {post.n_walkers} independent tempered-ladder "
                     f"runs, one histogram per run: "

@@ -28,10 +28,12 @@ def runs():
     with warnings.catch_warnings():
         # Pareto k near 0.7 at the lowest frequency, depending on the draws.
         warnings.simplefilter("ignore", PredictiveWarning)
-        reference = bf.compare(data, "zener", seed=2, workers=1, progress=False)
+        reference = bf.compare(data, "zener", seed=2, workers=1, progress=False,
+                               sampler="emcee")
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
-        short = bf.compare(data, "zener", seed=1, workers=1, progress=False, max_steps=300)
+        short = bf.compare(data, "zener", seed=1, workers=1, progress=False, max_steps=300,
+                           sampler="emcee")
     assert {w.category for w in record} <= {ConvergenceWarning, CertifiedWarning,
                                              PredictiveWarning}
     return reference["zener"], short["zener"], record
@@ -77,3 +79,29 @@ def test_particles_are_drawn_as_histograms_per_run(runs):
     assert "tempered-ladder runs × 1000 particles" in drawn.figure._suptitle.get_text()
     assert len(drawn.artists["q"]) == 2
     assert np.asarray(drawn.values["q"]).shape == (2, 1000)
+
+
+def test_importance_route_agrees_with_converged_emcee(runs):
+    """The default route for a well-posed structure: importance sampling from the optimum,
+    certified by its weights, against the converged emcee run on the same data."""
+    reference, _, _ = runs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PredictiveWarning)
+        fast = bf.compare(bf.read(DATA), "zener", seed=3, workers=1, progress=False)["zener"]
+    post, b = fast.posterior, reference.posterior
+    info = fast.criteria["importance"]
+    assert post.sampler == "importance" and post.converged
+    assert info["k_hat"] < 0.7 and info["ess"] >= 1000
+    for i, name in enumerate(b.param_names):
+        # In the sampling coordinates (log for the log-uniform coefficients): b1 has a long
+        # tail towards its upper values whose physical sd is dominated by a few draws.
+        xa, xb = post.samples[:, i], b.samples[:, i]
+        if name != "q":
+            xa, xb = np.log(xa), np.log(xb)
+        # The resampled draws (2000) carry the Monte Carlo error of the mean.
+        se = xb.std() * math.sqrt(1 / min(post.ess_min, post.samples.shape[0]) + 1 / b.ess_min)
+        assert abs(xa.mean() - xb.mean()) < 5 * se, name
+        assert xa.std() == pytest.approx(xb.std(), rel=0.1), name
+    ea, eb = fast.criteria["evidence"], reference.criteria["evidence"]
+    assert ea.method == "importance"
+    assert abs(ea.log_z - eb.log_z) < 3 * math.hypot(ea.log_z_err, eb.log_z_err) + 0.05

@@ -163,3 +163,32 @@ def test_bridge_proposal_finds_the_components_of_a_mixture():
     assert np.mean(draws[:, 0] > 4) == pytest.approx(0.3, abs=0.01)
     # One compact cloud stays one normal.
     assert len(_GaussianMixture.fit(a, rng).weights) == 1
+
+
+def test_importance_sampling_matches_closed_form(linear_case):
+    """The importance route: ln Z and the posterior (Gaussian here, with a closed form too)."""
+    from bayesfo.identify.optimize import fit_structure
+    from bayesfo.inference.importance import importance_posterior
+
+    s, data, lik, exact = linear_case
+    fit = fit_structure(s, data, rng=1, scaling=lik.scaling)
+    post, ev, info = importance_posterior(lik, fit.optima, seed=1)
+    assert post is not None and post.sampler == "importance"
+    assert info["k_hat"] < 0.7 and info["ess"] > 5000  # a Gaussian posterior: weights near 1
+    assert ev.method == "importance" and ev.log_z_err < 0.01
+    assert abs(ev.log_z - exact) < max(4 * ev.log_z_err, 0.005)
+    # The exact posterior of (b0, b1): Gaussian prior × Gaussian likelihood, linear model.
+    w = data.omega
+    lam = (1j * w) ** 0.5
+    X = np.vstack([np.column_stack([np.ones(w.size), lam.real]),
+                   np.column_stack([np.zeros(w.size), lam.imag])])
+    y = np.r_[data.response.real, data.response.imag]
+    prec = np.linalg.inv(np.diag([0.25, 0.25])) + X.T @ X / (0.05**2 / 2)
+    cov = np.linalg.inv(prec)
+    mean = cov @ (np.linalg.inv(np.diag([0.25, 0.25])) @ [1.0, 0.5] + X.T @ y / (0.05**2 / 2))
+    sd = np.sqrt(np.diag(cov))
+    for i, name in enumerate(("b0", "b1")):
+        got = post.summary[name]
+        # Monte Carlo error of a mean from the resampled draws: about sd / sqrt(n_draws).
+        assert abs(got.mean - mean[i]) < 4 * sd[i] / np.sqrt(post.samples.shape[0]), name
+        assert got.sd == pytest.approx(sd[i], rel=0.08), name

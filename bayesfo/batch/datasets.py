@@ -20,7 +20,8 @@ from .temperature import parse_temperature, temperature_of_file
 
 #: Manifest columns; ``invert`` is another name for ``reciprocal``.
 MANIFEST_COLUMNS = ("path", "id", "kind", "reciprocal", "invert", "structures", "noise", "prior",
-                    "seed", "holdout", "evidence", "evidence_check", "temperature")
+                    "seed", "holdout", "evidence", "evidence_check", "temperature",
+                    "sampler")
 
 
 #: Files written at the top of the output directory (no data-set id may take these names).
@@ -235,6 +236,8 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
                     raise InputError(f"{here}: evidence must be one of "
                                      f"{', '.join(EVIDENCE_ROUTES)}, got {cell!r}")
                 opts["evidence"] = cell
+            elif col == "sampler":
+                opts["sampler"] = cell  # checked with the other options below
             elif col == "structures":
                 opts["structures"] = cell
             elif col == "noise":

@@ -85,7 +85,7 @@ def run_task(task: dict) -> dict:
             # worker, a daemonic process, could not start compare's own process pool).
             comparison = compare(data, structures, noise=opts["noise"], seed=task["seed"],
                                  priors=priors, progress=False,
-                                 evidence=opts["evidence"],
+                                 evidence=opts["evidence"], sampler=opts["sampler"],
                                  evidence_check=opts["evidence_check"],
                                  holdout=list(opts["holdout"]) if opts["holdout"] else None,
                                  workers=1)

@@ -10,6 +10,7 @@ from ..options import (
     EVIDENCE_ROUTES,
     KINDS,
     NOISE_MODELS,
+    SAMPLERS,
     parse_floats,
     seed_argument,
 )
@@ -60,6 +61,9 @@ def add_parser(subparsers):
     p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
                    help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
                         "ladder (ladder); auto: the ladder where the posterior did not converge")
+    p.add_argument("--sampler", default="auto", choices=SAMPLERS,
+                   help="posterior by importance sampling from the optima where its weights "
+                        "certify it, else emcee (auto), or emcee first (emcee)")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--no-figures", action="store_true",
@@ -83,6 +87,7 @@ def run(args) -> int:
                "noise": args.noise, "priors": tuple(args.prior),
                "holdout": parse_floats(args.holdout, "--holdout") if args.holdout else None,
                "evidence": args.evidence, "evidence_check": args.evidence_check,
+               "sampler": args.sampler,
                "models": tuple(getattr(args, "models", None) or ()),
                "figures": not args.no_figures}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,

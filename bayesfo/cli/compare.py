@@ -11,6 +11,7 @@ from ..errors import InputError
 from ..options import (
     DEFAULT_STRUCTURES,
     EVIDENCE_ROUTES,
+    SAMPLERS,
     parse_floats,
     parse_priors,
     seed_argument,
@@ -36,6 +37,9 @@ def add_parser(subparsers):
     p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
                    help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
                         "ladder (ladder); auto: the ladder where the posterior did not converge")
+    p.add_argument("--sampler", default="auto", choices=SAMPLERS,
+                   help="posterior by importance sampling from the optima where its weights "
+                        "certify it, else emcee (auto), or emcee first (emcee)")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
     p.add_argument("--workers", type=int, default=0, metavar="N",
@@ -70,7 +74,8 @@ def run(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
-                   evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout)
+                   evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,
+                   sampler=args.sampler)
     if args.workers < 0:
         raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
     n_proc = min(args.workers or available_cpus(), len(structures))

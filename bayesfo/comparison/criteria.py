@@ -108,7 +108,7 @@ LADDER_SHORTFALL = 5.0
 
 
 def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
-              best_log_likelihood: float | None = None) -> dict:
+              best_log_likelihood: float | None = None, importance=None) -> dict:
     out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": [],
            "ladder_runs": None}
     # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
@@ -117,7 +117,10 @@ def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
     # keeps the narrow modes the walkers found.
     ladder = route == "ladder" or (route == "auto" and not post.converged)
     try:
-        if ladder:
+        if importance is not None and route == "auto":
+            # The certified importance weights that gave the posterior give ln Z too.
+            out["evidence"] = importance
+        elif ladder:
             try:
                 out["evidence"], out["ladder_runs"] = ladder_runs(lik, seed=seed, guide=post)
             except InputError as exc:

@@ -28,7 +28,9 @@ from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputErr
 from ..identify.optimize import fit_structure
 from ..inference import Likelihood, run_posterior
 from ..inference.adequacy import check_adequacy
+from ..inference.importance import importance_posterior
 from ..inference.posterior import posterior_from_particles
+from ..options import SAMPLERS
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
 from .criteria import _criteria, _evidence, _holdout, _model_probabilities
@@ -38,7 +40,7 @@ from .results import Comparison, StructureResult, data_problems
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
             priors=None, progress: bool | None = None, evidence: str = "auto",
             evidence_check: bool = False, prior_odds: dict | None = None, holdout=None,
-            workers: int = 1, pool=None, **sampler_kwargs) -> Comparison:
+            workers: int = 1, pool=None, sampler: str = "auto", **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
     Parameters
@@ -58,6 +60,12 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         particles of a tempered ladder (``"ladder"``, sequential Monte Carlo from the prior,
         seconds per structure); ``"auto"`` takes the draws where the posterior converged and
         the ladder where it did not.
+    sampler : {"auto", "emcee"}
+        How each posterior is computed. ``"auto"``: importance sampling from the optima where
+        its weights certify it (Pareto k̂ < 0.7, ESS ≥ 1000; well-posed structures, a fraction
+        of a second), else emcee, and where the walkers do not converge the tempered ladder's
+        particles (see :mod:`bayesfo.inference.importance`). ``"emcee"``: emcee first, as
+        before 0.2.
     evidence_check : bool
         Also compute ln Z by dynesty nested sampling and flag disagreements with the default
         estimate larger than twice the combined error (slower: seconds to minutes each).
@@ -90,6 +98,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     _check_sampler_options(sampler_kwargs)
     if not structures:
         raise InputError("no structure to compare")
+    if sampler not in SAMPLERS:
+        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}")
     if evidence not in ("auto", "bridge", "ladder"):
         raise InputError(f"evidence must be 'auto', 'bridge' or 'ladder', got {evidence!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
@@ -104,7 +114,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     n_proc = min(workers or available_cpus(), len(structures))
     options = {"noise": noise, "priors": priors, "seed": seed, "evidence_check": evidence_check,
                "evidence": evidence,
-               "test": test, "sampler_kwargs": sampler_kwargs}
+               "test": test, "sampler": sampler, "sampler_kwargs": sampler_kwargs}
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
     if pool is None and n_proc <= 1:
         outcomes = []
@@ -198,11 +208,19 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
                    if k in s.param_names or k in ("sigma", "sigma_rel")}
             lik = Likelihood(s, data, noise=noise, priors=own)
             fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
-            post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
-                                    fit=fit, progress=False, **options["sampler_kwargs"])
+            post = ev = None
+            if options["sampler"] == "auto" and fit.optima.size:
+                modes = lik.structure.to_scaled(
+                    lik.structure.to_physical(fit.optima, fit.scaling), lik.scaling)
+                post, ev, info = importance_posterior(lik, modes, seed=seed)
+            if post is None:
+                post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
+                                        fit=fit, progress=False, **options["sampler_kwargs"])
             criteria = _criteria(lik, fit, post)
+            if post.sampler == "importance":
+                criteria["importance"] = info
             extra = _evidence(lik, post, seed, options["evidence_check"], options["evidence"],
-                              best_log_likelihood=criteria["max_log_likelihood"])
+                              best_log_likelihood=criteria["max_log_likelihood"], importance=ev)
             runs = extra.pop("ladder_runs")
             if runs is not None and not post.converged:
                 post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)

@@ -76,9 +76,11 @@ def _hessian(f, u0: np.ndarray, h: np.ndarray):
 def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: int = 4):
     """The mode near ``u0`` (a few Newton steps on the log posterior) and the covariance of
     the Laplace approximation there; None where the curvature is not that of a peak."""
-    u = u0.copy()
     span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u0))
     h = 1e-4 * span
+    # An optimum on a bound of the prior box (a coefficient at its smallest value) is moved just
+    # inside, so that the difference stencil stays in the box.
+    u = np.clip(u0, lo + 3 * h, hi - 3 * h)
     best = None
     for _ in range(newton_steps + 1):
         out = _hessian(f, u, h)
@@ -91,7 +93,7 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
             return None
         best = (f0, u, hess)
         cand = u + step
-        if not np.all(np.isfinite(cand)) or not np.all((cand > lo) & (cand < hi)):
+        if not np.all(np.isfinite(cand)) or not np.all((cand > lo + 3 * h) & (cand < hi - 3 * h)):
             break
         value = f(cand[None, :])[0]
         if not value > f0:
@@ -99,14 +101,16 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
         u = cand
     f0, u, hess = best
     w, v = np.linalg.eigh(-hess)
-    if not np.all(w > 0):
+    if not np.all(np.isfinite(w)):
         return None
+    # Directions without curvature (a parameter the data leave to its prior, a peak cut by a
+    # bound) get a variance that spreads the proposal over the prior box; the certificate of
+    # the weights decides whether that describes the posterior.
+    broad = (np.max(span[np.isfinite(span)]) / 4.0) ** 2
+    w = np.where(w > 1.0 / broad, w, 1.0 / broad)
     cov = (v / w) @ v.T
     # The approximation must fit inside the prior box: a mode whose 3-sd ellipse crosses a
     # bound sits on a boundary, where the curvature does not describe the posterior.
-    sd = np.sqrt(np.diag(cov))
-    if np.any(u - 3 * sd < lo) or np.any(u + 3 * sd > hi):
-        return None
     return f0, u, cov
 
 

@@ -96,8 +96,11 @@ class PosteriorResult:
     messages : tuple of str
         Warnings raised during the run.
     sampler : str
-        ``"emcee"``, or ``"ladder"`` for the final particles of independent tempered-ladder
-        runs (:func:`posterior_from_particles`; each run is one chain of the diagnostics).
+        ``"emcee"``; ``"ladder"`` for the final particles of independent tempered-ladder runs
+        (:func:`posterior_from_particles`; each run is one chain of the diagnostics);
+        ``"importance"`` for draws resampled from certified importance weights
+        (:func:`bayesfo.inference.importance.importance_posterior`; R-hat does not apply, the
+        ESS is that of the weights).
     idata : arviz.InferenceData
         Posterior, log_likelihood (per frequency), posterior_predictive, observed_data and
         sample_stats, coordinates named by frequency.
@@ -483,22 +486,14 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
     rng = np.random.default_rng(seed)
     tr = _Transform(lik)
     chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
-    n_runs, n_kept, ndim = chain_u.shape
+    n_runs, n_kept, _ = chain_u.shape
     if n_runs < 2:
         raise ValueError("at least two runs are needed to certify the posterior")
     chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
-    flat_u = chain_u.reshape(-1, ndim)  # run-major: chain = run
-    flat_scaled = tr.to_theta(flat_u)
-    pointwise = lik.pointwise(flat_scaled)
-    loglik = pointwise.sum(axis=1)
-    flat_phys = lik.to_physical(flat_scaled)
-    lp_flat = _log_prob_fn(lik, tr)(flat_u)
-    post = {name: flat_phys[:, i].reshape(n_runs, n_kept)
-            for i, name in enumerate(lik.param_names)}
     chains = az.convert_to_dataset({name: tr.to_theta(chain_u)[:, :, i]
                                     for i, name in enumerate(lik.param_names)})
     rhat_max = max(float(v) for v in az.rhat(chains).data_vars.values())
-    distinct = float(len(np.unique(flat_u, axis=0)))
+    distinct = float(len(np.unique(chain_u.reshape(-1, chain_u.shape[2]), axis=0)))
     ess_bulk = min(distinct, min(float(v) for v in az.ess(chains, method="bulk").data_vars.values()))
     ess_tail = min(distinct, min(float(v) for v in az.ess(chains, method="tail").data_vars.values()))
     messages = []
@@ -508,21 +503,47 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
     if not min(ess_bulk, ess_tail) >= ESS_MIN:
         messages.append(f"{lik.structure.name}: the tempered-ladder particles give an effective "
                         f"sample size of {min(ess_bulk, ess_tail):.0f}, below {ESS_MIN}")
+    acceptance = [float(np.mean(r.acceptance[-1:])) for r in runs if hasattr(r, "acceptance")]
+    post = result_from_draws(lik, chain_u, sampler="ladder", rhat=rhat_max, ess_bulk=ess_bulk,
+                             ess_tail=ess_tail, messages=tuple(messages),
+                             converged=not messages, seed=seed, predictive=predictive,
+                             acceptance=float(np.mean(acceptance)) if acceptance else np.nan)
+    post.idata.posterior.attrs.update(sampler="tempered ladder", runs=n_runs)
+    return post
+
+
+def result_from_draws(lik: Likelihood, chain_u, *, sampler: str, rhat: float, ess_bulk: float,
+                      ess_tail: float, messages: tuple, converged: bool, seed: int = 0,
+                      predictive: bool = True, acceptance: float = np.nan) -> PosteriorResult:
+    """A :class:`PosteriorResult` from posterior draws that another route than emcee produced
+    (``chain_u``: chains × draws × parameters in the sampling coordinates), with that route's
+    diagnostics. ``n_walkers`` is the number of chains, ``n_steps`` 0 and ``tau`` NaN."""
+    rng = np.random.default_rng(seed)
+    tr = _Transform(lik)
+    chain_u = np.asarray(chain_u, dtype=float)
+    n_chains, n_kept, ndim = chain_u.shape
+    flat_u = chain_u.reshape(-1, ndim)  # chain-major
+    flat_scaled = tr.to_theta(flat_u)
+    pointwise = lik.pointwise(flat_scaled)
+    loglik = pointwise.sum(axis=1)
+    flat_phys = lik.to_physical(flat_scaled)
+    lp_flat = _log_prob_fn(lik, tr)(flat_u)
+    post = {name: flat_phys[:, i].reshape(n_chains, n_kept)
+            for i, name in enumerate(lik.param_names)}
     best = int(np.argmax(lp_flat))
     map_theta = flat_phys[best]
     summary = _summaries(lik, tr, flat_phys, flat_u, map_theta)
-    idata = _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_runs, n_kept,
+    idata = _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_chains, n_kept,
                             rng if predictive else None)
-    idata.posterior.attrs.update(sampler="tempered ladder", runs=n_runs)
-    acceptance = [float(np.mean(r.acceptance[-1:])) for r in runs if hasattr(r, "acceptance")]
+    idata.posterior.attrs.update(sampler=sampler)
     return PosteriorResult(
         structure=lik.structure.name, param_names=lik.param_names, noise=lik.noise,
         noise_reason=lik.noise_reason, samples=flat_phys, samples_scaled=flat_scaled,
         log_likelihood=loglik, summary=summary, map_theta=map_theta,
         max_log_likelihood=float(loglik.max()), tau=np.full(ndim, np.nan), n_steps=0, burn=0,
-        thin=1, n_walkers=n_runs, acceptance=float(np.mean(acceptance)) if acceptance else np.nan,
-        rhat_max=rhat_max, ess_bulk_min=ess_bulk, ess_tail_min=ess_tail,
-        converged=not messages, messages=tuple(messages), idata=idata, sampler="ladder",
+        thin=1, n_walkers=n_chains, acceptance=acceptance, rhat_max=rhat, ess_bulk_min=ess_bulk,
+        ess_tail_min=ess_tail, converged=converged, messages=tuple(messages), idata=idata,
+        sampler=sampler,
     )
 
 

@@ -196,7 +196,7 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     if hasattr(post.idata, "sample_stats") and "lp" in post.idata.sample_stats:
         lp = np.asarray(post.idata.sample_stats["lp"].values)
     color = color or "#0072B2"
-    if getattr(post, "sampler", "emcee") == "ladder":
+    if getattr(post, "sampler", "emcee") in ("ladder", "importance"):
         return _plot_particles(result, fig, ds, lp, labels, is_log)
     values, artists = {}, {}
     with style():
@@ -230,10 +230,15 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
 
 
 def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
-    """:func:`plot_trace` for a posterior made of tempered-ladder particles: the particles of
-    each run as one histogram per row (there is no chain to trace); the runs certify the
-    posterior by agreeing."""
+    """:func:`plot_trace` for a posterior without a chain to trace: tempered-ladder particles
+    (one histogram per run: the runs certify the posterior by agreeing) or draws resampled
+    from importance weights (one histogram)."""
     post = result.posterior
+    ladder = post.sampler == "ladder"
+    if not ladder:  # importance sampling: one set of resampled draws, no runs to compare
+        ds = ds.stack(sample=("chain", "draw")).drop_vars(["chain", "draw", "sample"])
+        ds = ds.expand_dims(chain=1).rename({"sample": "draw"})
+        lp = None if lp is None else lp.reshape(1, -1)
     runs = ds.sizes["chain"]
     colors = ("#0072B2", "#E69F00", "#009E73", "#CC79A7")
     values, artists = {}, {}
@@ -260,10 +265,15 @@ def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
                              for i in range(runs)]
             axes[-1].set_xlabel("log posterior density", labelpad=1)
             axes[-1].set_yticks([])
-        axes[0].legend(fontsize=6, frameon=False, loc="upper right")
         values["draw"] = np.arange(ds.sizes["draw"])
-        title = (f"{result.name}: {runs} tempered-ladder runs × {ds.sizes['draw']} particles\n"
-                 f"R-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f} across the runs")
+        if ladder:
+            axes[0].legend(fontsize=6, frameon=False, loc="upper right")
+            title = (f"{result.name}: {runs} tempered-ladder runs × {ds.sizes['draw']} "
+                     f"particles\nR-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f} across "
+                     "the runs")
+        else:
+            title = (f"{result.name}: {ds.sizes['draw']} draws resampled from importance "
+                     f"weights\n(ESS of the weights {post.ess_min:.0f})")
         if not post.converged:
             title += ": the runs disagree"
         fig.suptitle(title, color=FLAG_COLOR if not post.converged else "black", fontsize=7.5)

@@ -92,7 +92,8 @@ def run(args) -> int:
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
         print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "
-              "log-evidence ln Z (bridge sampling; L: from a tempered ladder); P = posterior "
+              "log-evidence ln Z (importance or bridge sampling; L: from a tempered ladder); "
+              "P = posterior "
               "probability, equal prior odds; ok = posterior certified; fits = posterior "
               "predictive checks pass (small: a systematic misfit within 2° and 3.5 %)")
         print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "

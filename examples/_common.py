@@ -73,6 +73,11 @@ def order_parameter(result):
     return next(((k, summary[k]) for k in ("q", "beta") if k in summary), (None, None))
 
 
+def _num(x, fmt: str) -> str:
+    """'-' for a number that does not apply (R-hat of importance draws)."""
+    return "-" if x is None or not math.isfinite(x) else format(x, fmt)
+
+
 def print_table(comp, title: str, names=None) -> list[dict]:
     """Print the ranking (by ln Z) of ``comp``, or of the structures ``names`` only.
 
@@ -97,7 +102,7 @@ def print_table(comp, title: str, names=None) -> list[dict]:
         _, q = order_parameter(comp[r["structure"]])
         qs = "" if q is None else f"[{q.hdi_low:.3f}, {q.hdi_high:.3f}]"
         print(f"{i:>2} {r['structure']:<17} {r['n_params']:>2} {zs:>17} {dz:>9} {p:>6} "
-              f"{r['loo']:>10.2f} {r['bic']:>10.2f} {qs:>15} {r['rhat_max']:>6.3f} "
+              f"{r['loo']:>10.2f} {r['bic']:>10.2f} {qs:>15} {_num(r['rhat_max'], '.3f'):>6} "
               f"{'yes' if r['converged'] else 'NO':>3}")
     for r in failed:
         print(f" - {r['structure']:<17} {r['n_params']:>2}  not run: {r['error']}")

@@ -12,11 +12,24 @@ CSV contract (see DESIGN.md) is:
 
 Comment lines of the form ``# kind: modulus``, ``# units: MPa`` or ``# name: PP sample 3`` set the
 metadata of the response.
+
+Limits
+------
+The reader refuses, naming the file, line and column, what cannot be computed in double
+precision or in reasonable time (see :func:`read_csv` for the reasons):
+
+* ω from 1e-30 to 1e30 rad/s and |G| from 1e-30 to 1e30 (never exactly 0), each spanning at
+  most 30 decades within one data set (:data:`VALUE_RANGE`, :data:`MAX_SPAN`);
+* σ at most 100 times the largest |G| and at least 1e-15 times |G| on its line
+  (:data:`SIGMA_MAX_RATIO`, :data:`SIGMA_MIN_RATIO`);
+* phases within ±360 degrees (:data:`MAX_PHASE_DEG`);
+* at most 1000 frequencies (:data:`MAX_FREQUENCIES`), 100 000 data rows and 32 MiB;
+* numbers in plain ASCII decimal notation (no ``1_0``, no ``inf``/``nan``), no invisible
+  control characters, and only regular files (not a FIFO).
 """
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 import warnings
@@ -25,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._io import atomic_write_text, read_text_file
+from ._io import atomic_write_text, csv_cells, parse_number, read_text_file, show, split_lines
 from .errors import InputError
 
 KINDS = ("compliance", "modulus", "generic")
@@ -37,6 +50,54 @@ KNOWN_COLUMNS = FREQUENCY_COLUMNS + tuple(c for form in RESPONSE_FORMS for c in 
 
 #: Relative tolerance within which two frequencies count as the same one.
 FREQUENCY_RTOL = 1e-9
+
+#: Smallest and largest ω [rad/s] and nonzero |G| a data file may hold. Every measurable
+#: frequency response lies many decades inside (master curves of mechanical and dielectric spectra
+#: reach 1e-12 … 1e15 rad/s; moduli, compliances and other transfer functions in any common unit
+#: 1e-15 … 1e15), and within these bounds the squares and the products the fits form in physical
+#: units (|G|², σ², ω_ref^(n q)·g_ref for degrees n ≤ 6) stay far inside the normal range of
+#: float64 (2.2e-308 … 1.8e308), instead of overflowing to inf or underflowing to 0.
+VALUE_RANGE = (1e-30, 1e30)
+
+#: Largest ratio max/min of ω, and of |G|, within one data set: 30 decades, more than
+#: time-temperature master curves span (the bundled NREL DMA master curve spans 26). The fits
+#: work on ω̃ = ω/ω_ref and G̃ = G/g_ref (geometric mean and median), which then lie within 1e±30
+#: even for lopsided data; the linear methods form rows (λ^n·G̃)² with λ = (jω̃)^q that stay
+#: below 1e240 for the thesis' degrees n ≤ 3 and q ≤ 1, and the likelihood squares residuals
+#: weighted by 1/|G̃| (≤ 1e60). Beyond, scaling no longer keeps these finite.
+MAX_SPAN = 1e30
+
+#: σ may not exceed this multiple of the largest |G|: a point whose noise is a hundred times
+#: the largest response measured carries no information, and is a unit error (σ in other units
+#: than G) or the wrong column.
+SIGMA_MAX_RATIO = 100.0
+
+#: σ may not be below this multiple of |G| on its line: G itself is stored and the structures
+#: are evaluated with relative rounding errors of a few 1e-16, so a smaller σ claims a precision
+#: the arithmetic cannot reach (and 1/σ² overflows for σ → 0).
+SIGMA_MIN_RATIO = 1e-15
+
+#: Largest |phase| in degrees. A phase is an angle, and instruments report it wrapped into
+#: (−180°, 180°] or [0°, 360°); the unwrapped phase of a material (compliance −90…0°, modulus
+#: 0…90°) or of a max-order member up to n = 3 (at most 270° in magnitude for q ≤ 1) also lies
+#: within one turn. A larger value is a corrupted cell or a unit error, and loses digits: exp(i·φ)
+#: keeps none once |φ| reaches about 1e16 degrees.
+MAX_PHASE_DEG = 360.0
+
+#: Most frequencies (after averaging replicates) a data set may have. A likelihood evaluation
+#: costs time and memory proportional to the number of frequencies, and a comparison runs some
+#: 10⁵–10⁶ of them per structure (emcee up to 10 000 steps of 32+ walkers, the tempered ladder,
+#: PSIS-LOO over up to 2000 stored draws × frequencies). Measured in one process: zener and
+#: max-n2m2 together take 74 s at 200 frequencies and 315 s (0.8 GB) at 2000; voigt alone 11 s
+#: at 200 and 56 s (1.1 GB) at 5000, about 0.2 MB per frequency in every worker process. At
+#: 100 000 frequencies a comparison would run for hours and need tens of GB per worker.
+#: Rheometers and dynamic mechanical analysers give tens to a few hundred points (5–10 per
+#: decade), and a smooth response is determined by far fewer than 1000.
+MAX_FREQUENCIES = 1000
+
+#: Most data rows (replicates included) and bytes of a data file.
+MAX_ROWS = 100_000
+MAX_FILE_BYTES = 32 * 1024 * 1024
 
 
 def _as_1d(values, name: str, dtype) -> np.ndarray:
@@ -77,7 +138,9 @@ class FrequencyResponse:
     ------
     InputError
         If an array is not one-dimensional, lengths differ, a value is NaN or infinite, a
-        frequency is not positive or appears twice, a σ is not positive, or ``kind`` is unknown.
+        frequency is not positive or appears twice, the response is 0 everywhere, a σ is not
+        positive, or ``kind`` is unknown. (:func:`read_csv` checks more: the ranges a
+        computation in double precision needs.)
 
     Examples
     --------
@@ -109,6 +172,8 @@ class FrequencyResponse:
             raise InputError("argument 'omega' is empty: a frequency response needs at least one point")
         _check_finite(omega, "omega")
         _check_finite(response, "response")
+        if not np.any(response):
+            raise InputError("argument 'response' is 0 at every frequency: there is nothing to fit")
         bad = np.flatnonzero(omega <= 0)
         if bad.size:
             raise InputError(
@@ -378,7 +443,9 @@ def _check_distinct(omega: np.ndarray, name: str) -> None:
 def _mean_and_standard_error(groups) -> tuple[np.ndarray, np.ndarray | None]:
     """Mean of each group of complex values, and the standard error of that mean.
 
-    The standard error is None unless every group has at least two members.
+    The standard error is None unless every group has at least two members whose spread is
+    resolved in double precision (a standard error above 1e-15 of the mean's magnitude,
+    :data:`SIGMA_MIN_RATIO`): replicates identical to rounding give no σ.
     """
     mean = np.array([np.mean(g) for g in groups], dtype=complex)
     if min(len(g) for g in groups) < 2:
@@ -386,7 +453,7 @@ def _mean_and_standard_error(groups) -> tuple[np.ndarray, np.ndarray | None]:
     se = np.array(
         [math.sqrt(np.sum(np.abs(g - m) ** 2) / (len(g) - 1) / len(g)) for g, m in zip(groups, mean)]
     )
-    if np.any(se <= 0):
+    if np.any(se <= SIGMA_MIN_RATIO * np.abs(mean)) or not np.all(np.isfinite(se)):
         return mean, None
     return mean, se
 
@@ -419,9 +486,25 @@ def read_csv(
     ------
     InputError
         Naming the file, and the column and line where it applies, for: a missing or unreadable
-        file, a missing, unknown, duplicated or conflicting column, a non-numeric, NaN or
-        infinite cell, ω ≤ 0, a frequency given twice in a series, a negative magnitude or a
-        non-positive σ, and an unknown kind.
+        file, or one that is not a regular file (a FIFO would block), not UTF-8, holds an
+        invisible control character (a NUL byte) or is larger than 32 MiB; a missing, unknown,
+        duplicated or conflicting column; a cell that is not a plain decimal number (empty,
+        ``1_0``, Unicode digits, NaN, infinite, longer than 1000 characters); ω ≤ 0; a frequency
+        given twice in a series; a negative magnitude or a non-positive σ; an unknown kind; and
+        values that cannot be computed with:
+
+        * ω outside 1e-30 … 1e30 rad/s, or |G| outside 1e-30 … 1e30 (:data:`VALUE_RANGE`):
+          their squares and the products the fits form must stay finite and normal in float64;
+        * a response that is exactly 0 at some frequency, or everywhere: a measured value is
+          never exactly 0, and 1/|G| weights, proportional noise and reciprocals need |G| > 0;
+        * ω, or |G|, spanning more than 30 decades (:data:`MAX_SPAN`): the fits scale the data
+          by its geometric-mean frequency and median magnitude, and powers of the scaled values
+          (λ^n·G, squared) must stay finite;
+        * σ above 100·max|G| (:data:`SIGMA_MAX_RATIO`, a unit error) or below 1e-15·|G| of its
+          line (:data:`SIGMA_MIN_RATIO`, below double precision);
+        * a phase outside ±360 degrees (:data:`MAX_PHASE_DEG`);
+        * more than 1000 frequencies (:data:`MAX_FREQUENCIES`: the samplers' cost grows in
+          proportion; thin or average the data) or more than 100 000 data rows.
 
     Examples
     --------
@@ -429,13 +512,13 @@ def read_csv(
     """
     path = Path(path)
     where = f"file '{path}'"
-    text = read_text_file(path)
+    text = read_text_file(path, max_bytes=MAX_FILE_BYTES)
 
     meta: dict[str, str] = {}
     rows: list[tuple[int, list[str]]] = []
     header: list[str] | None = None
     header_line = 0
-    for lineno, line in enumerate(text.splitlines(), start=1):
+    for lineno, line in enumerate(split_lines(text), start=1):
         stripped = line.strip()
         if not stripped:
             continue
@@ -446,72 +529,98 @@ def read_csv(
                 if key.strip().lower() in ("kind", "units", "name"):
                     meta[key.strip().lower()] = value.strip()
             continue
-        cells = next(csv.reader([line]))
+        cells = csv_cells(line, where, lineno)
         if header is None:
             header, header_line = [c.strip().lower() for c in cells], lineno
         else:
             rows.append((lineno, cells))
+            if len(rows) > MAX_ROWS:
+                raise InputError(
+                    f"{where}, line {lineno}: more than {MAX_ROWS} data rows; a data set may "
+                    f"have at most {MAX_FREQUENCIES} frequencies: {_THIN_HINT}"
+                )
     if header is None:
         raise InputError(f"{where} is empty: expected a header row such as 'omega,real,imag'")
     if not rows:
         raise InputError(f"{where} has a header but no data rows")
 
     columns = _check_header(header, where, header_line)
+    if "series" not in columns and len(rows) > MAX_FREQUENCIES:
+        _too_many(where, len(rows))
     values: dict[str, np.ndarray] = {}
+    for lineno, cells in rows:
+        if len(cells) != len(header):
+            raise InputError(
+                f"{where}, line {lineno}: expected {len(header)} cells as in the header, "
+                f"got {len(cells)}"
+            )
     for col in columns:
         idx = header.index(col)
         out = np.empty(len(rows))
         for r, (lineno, cells) in enumerate(rows):
-            if len(cells) != len(header):
-                raise InputError(
-                    f"{where}, line {lineno}: expected {len(header)} cells as in the header, "
-                    f"got {len(cells)}"
-                )
-            cell = cells[idx].strip()
             try:
-                v = float(cell)
-            except ValueError:
-                problem = f"'{cell}' is not a number" if cell else "the cell is empty"
-                raise InputError(f"{where}, line {lineno}, column '{col}': {problem}") from None
-            if not math.isfinite(v):
-                raise InputError(f"{where}, line {lineno}, column '{col}': value is {cell}, "
-                                 "not a finite number")
-            out[r] = v
+                out[r] = parse_number(cells[idx])
+            except ValueError as exc:
+                raise InputError(f"{where}, line {lineno}, column '{col}': {exc}") from None
         values[col] = out
     linenos = np.array([ln for ln, _ in rows])
 
     kind = kind if kind is not None else meta.get("kind", "generic")
     if kind not in KINDS:
-        raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {kind!r}")
+        raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {show(str(kind))}")
 
     if "omega" in values:
         omega, fcol = values["omega"], "omega"
     else:
-        omega, fcol = 2 * np.pi * values["freq"], "freq"
+        fcol = "freq"
+        with np.errstate(over="ignore"):
+            omega = 2 * np.pi * values["freq"]
     _check_rows(omega <= 0, where, linenos, fcol, "frequency must be positive")
+    _check_frequency_range(omega, values.get("freq"), where, linenos, fcol)
 
     if "real" in values:
+        form = ("real", "imag")
         response = values["real"] + 1j * values["imag"]
     elif "magnitude" in values:
+        form = ("magnitude",)
         _check_rows(values["magnitude"] < 0, where, linenos, "magnitude", "magnitude is negative")
-        response = values["magnitude"] * np.exp(1j * np.radians(values["phase_deg"]))
+        phase = values["phase_deg"]
+        _check_rows(np.abs(phase) > MAX_PHASE_DEG, where, linenos, "phase_deg",
+                    f"a phase of {{value:g}} degrees is outside ±{MAX_PHASE_DEG:g}; a phase is an "
+                    "angle within one turn: wrap it into (-180, 180] by adding or subtracting "
+                    "multiples of 360", phase)
+        response = values["magnitude"] * np.exp(1j * np.radians(phase))
     else:
+        form = ("storage", "loss")
         sign = -1.0 if kind == "compliance" else 1.0
         response = values["storage"] + sign * 1j * values["loss"]
+    magnitude = _check_magnitudes(values, form, where, linenos)
     sigma = values.get("sigma")
     if sigma is not None:
         _check_rows(sigma <= 0, where, linenos, "sigma", "sigma must be positive")
+        _check_sigma(sigma, magnitude, where, linenos)
 
     notes: list[str] = []
     if "series" in values:
-        omega, response, sigma, n_rep = _average_series(
+        omega, response, sigma, n_rep, linenos = _average_series(
             omega, response, sigma, values["series"], linenos, where, fcol
         )
         notes.append(f"mean of {n_rep} replicate series")
         if sigma is None:
             notes.append("sigma unknown: some frequency has a single replicate")
+        zero = np.flatnonzero(response == 0)
+        if zero.size:
+            raise InputError(
+                f"{where}, line {linenos[zero[0]]}: the mean of the replicates at omega = "
+                f"{omega[zero[0]]:g} rad/s is exactly 0, which cannot be scaled or weighted; "
+                "check the replicates of this frequency"
+            )
+        if omega.size > MAX_FREQUENCIES:
+            _too_many(where, omega.size)
     else:
         _check_duplicates(omega, linenos, where, fcol)
+    _check_span(omega, linenos, where, f"column '{fcol}'", "the frequencies span", "rad/s")
+    _check_span(np.abs(response), linenos, where, _columns(form), "|G| spans", "")
 
     fr = FrequencyResponse(
         omega,
@@ -526,17 +635,123 @@ def read_csv(
     return fr.sorted()
 
 
+_THIN_HINT = (
+    "thin the data (e.g. 10 to 50 log-spaced frequencies per decade), or average neighbouring "
+    "frequencies, before the comparison"
+)
+
+
+def _too_many(where: str, n: int) -> None:
+    raise InputError(
+        f"{where} has {n} frequencies, more than the {MAX_FREQUENCIES} a comparison handles in "
+        f"reasonable time (the samplers' cost grows with the number of frequencies): {_THIN_HINT}"
+    )
+
+
+def _columns(form) -> str:
+    if len(form) == 1:
+        return f"column '{form[0]}'"
+    return f"columns '{form[0]}' and '{form[1]}'"
+
+
+def _check_frequency_range(omega, freq, where, linenos, col) -> None:
+    lo, hi = VALUE_RANGE
+    bad = np.flatnonzero((omega < lo) | (omega > hi))
+    if bad.size:
+        k = bad[0]
+        if freq is not None:
+            value = f"{freq[k]:g} Hz is outside {lo / (2 * np.pi):.3g} … {hi / (2 * np.pi):.3g} Hz"
+        else:
+            value = f"{omega[k]:g} rad/s is outside {lo:g} … {hi:g} rad/s"
+        raise InputError(
+            f"{where}, line {linenos[k]}, column '{col}': {value}, the range bayesfo computes "
+            "with in double precision; check the units of the column"
+        )
+
+
+def _check_magnitudes(values, form, where, linenos) -> np.ndarray:
+    """|G| per row, after checking it is nonzero and within :data:`VALUE_RANGE`."""
+    if len(form) == 1:
+        magnitude = values[form[0]]
+    else:
+        magnitude = np.hypot(values[form[0]], values[form[1]])
+    cols = _columns(form)
+    if np.all(magnitude == 0):
+        raise InputError(
+            f"{where}: the response is 0 at every frequency ({cols}): there is nothing to fit; "
+            "check that these columns hold the measured response"
+        )
+    zero = np.flatnonzero(magnitude == 0)
+    if zero.size:
+        raise InputError(
+            f"{where}, line {linenos[zero[0]]}, {cols}: the response is exactly 0; a measured "
+            "response never is (a placeholder for a missing value?), and a zero cannot be "
+            "scaled, weighted by 1/|G| or inverted: remove the row"
+        )
+    lo, hi = VALUE_RANGE
+    bad = np.flatnonzero((magnitude < lo) | (magnitude > hi))
+    if bad.size:
+        k = bad[0]
+        if len(form) == 2 and magnitude[k] > hi:
+            # Name the cell that is too large.
+            col = form[0] if abs(values[form[0]][k]) >= abs(values[form[1]][k]) else form[1]
+            cols = f"column '{col}'"
+            what = f"{values[col][k]:g}"
+        else:
+            what = f"|G| = {magnitude[k]:g}"
+        raise InputError(
+            f"{where}, line {linenos[k]}, {cols}: {what} is outside the magnitudes {lo:g} … "
+            f"{hi:g} bayesfo computes with in double precision (their squares must stay "
+            "finite and nonzero); check the units of the response"
+        )
+    return magnitude
+
+
+def _check_sigma(sigma, magnitude, where, linenos) -> None:
+    g_max = float(magnitude.max())
+    big = np.flatnonzero(sigma > SIGMA_MAX_RATIO * g_max)
+    if big.size:
+        k = big[0]
+        raise InputError(
+            f"{where}, line {linenos[k]}, column 'sigma': sigma = {sigma[k]:g} is more than "
+            f"{SIGMA_MAX_RATIO:g} times the largest |G| of the data ({g_max:g}); no measurement is "
+            "that noisy: check that sigma is the standard deviation of G, in the units of G"
+        )
+    small = np.flatnonzero(sigma < SIGMA_MIN_RATIO * magnitude)
+    if small.size:
+        k = small[0]
+        raise InputError(
+            f"{where}, line {linenos[k]}, column 'sigma': sigma = {sigma[k]:g} is less than "
+            f"{SIGMA_MIN_RATIO:g} times |G| = {magnitude[k]:g} on this line, below the precision "
+            "of a double; give the measurement's real standard deviation"
+        )
+
+
+def _check_span(values, linenos, where, cols: str, what: str, unit: str) -> None:
+    """At most :data:`MAX_SPAN` between the smallest and the largest of ``values`` (> 0)."""
+    i, j = int(np.argmin(values)), int(np.argmax(values))
+    if values[j] > MAX_SPAN * values[i]:
+        unit = f" {unit}" if unit else ""
+        decades = math.log10(values[j]) - math.log10(values[i])
+        raise InputError(
+            f"{where}, {cols}: {what} {decades:.1f} decades (from {values[i]:g}{unit} on "
+            f"line {linenos[i]} to {values[j]:g}{unit} on line {linenos[j]}), more than the "
+            f"{math.log10(MAX_SPAN):.0f} decades the scaled fits handle in double precision; "
+            "remove the outlying rows or check their units"
+        )
+
+
 def _check_header(header: list[str], where: str, lineno: int) -> list[str]:
     seen = set()
     for col in header:
         if col == "":
             raise InputError(f"{where}, line {lineno}: the header has an empty column name")
         if col in seen:
-            raise InputError(f"{where}, line {lineno}: column '{col}' appears twice in the header")
+            raise InputError(f"{where}, line {lineno}: column {show(col)} appears twice in the header")
         seen.add(col)
         if col not in KNOWN_COLUMNS:
             raise InputError(
-                f"{where}, line {lineno}: unknown column '{col}'; known columns are "
+                f"{where}, line {lineno}: unknown column {show(col)}; known columns are "
                 f"{', '.join(KNOWN_COLUMNS)}"
             )
     freq = [c for c in FREQUENCY_COLUMNS if c in seen]
@@ -563,9 +778,12 @@ def _check_header(header: list[str], where: str, lineno: int) -> list[str]:
     return [freq[0], *forms[0], *[c for c in OPTIONAL_COLUMNS if c in seen]]
 
 
-def _check_rows(bad: np.ndarray, where: str, linenos, col: str, message: str) -> None:
+def _check_rows(bad: np.ndarray, where: str, linenos, col: str, message: str, values=None) -> None:
+    """Raise naming the first row where ``bad``; ``message`` may hold ``{value}`` (of ``values``)."""
     idx = np.flatnonzero(bad)
     if idx.size:
+        if values is not None:
+            message = message.format(value=values[idx[0]])
         raise InputError(f"{where}, line {linenos[idx[0]]}, column '{col}': {message}")
 
 
@@ -582,19 +800,25 @@ def _check_duplicates(omega, linenos, where: str, col: str) -> None:
 
 
 def _average_series(omega, response, sigma, series, linenos, where, col):
-    """Average replicate series per frequency; check each series has distinct frequencies."""
+    """Average replicate series per frequency; check each series has distinct frequencies.
+
+    Returns the frequencies, mean responses, their σ (or None), the number of series and, per
+    frequency, the first line of the file that holds it.
+    """
     for s in np.unique(series):
         sel = series == s
         _check_duplicates(omega[sel], linenos[sel], where, col)
-    # Group frequencies that agree to FREQUENCY_RTOL across series.
+    # Group frequencies that agree to FREQUENCY_RTOL across series: each with the previous
+    # one, so that the means of neighbouring groups differ by more than FREQUENCY_RTOL too.
     order = np.argsort(omega, kind="stable")
     groups: list[list[int]] = []
     for i in order:
-        if groups and math.isclose(omega[i], omega[groups[-1][0]], rel_tol=FREQUENCY_RTOL):
+        if groups and math.isclose(omega[i], omega[groups[-1][-1]], rel_tol=FREQUENCY_RTOL):
             groups[-1].append(i)
         else:
             groups.append([i])
     w = np.array([np.mean(omega[g]) for g in groups])
+    lines = np.array([min(linenos[g]) for g in groups])
     if sigma is not None:
         # Known σ per replicate: inverse-variance weighted mean and its standard error.
         mean = np.empty(len(groups), dtype=complex)
@@ -603,7 +827,7 @@ def _average_series(omega, response, sigma, series, linenos, where, col):
             wts = 1.0 / sigma[g] ** 2
             mean[k] = np.sum(wts * response[g]) / np.sum(wts)
             se[k] = 1.0 / math.sqrt(np.sum(wts))
-        return w, mean, se, len(np.unique(series))
+        return w, mean, se, len(np.unique(series)), lines
     mean, se = _mean_and_standard_error([response[g] for g in groups])
     if se is None:
         warnings.warn(
@@ -611,4 +835,4 @@ def _average_series(omega, response, sigma, series, linenos, where, col):
             UserWarning,
             stacklevel=3,
         )
-    return w, mean, se, len(np.unique(series))
+    return w, mean, se, len(np.unique(series)), lines

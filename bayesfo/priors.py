@@ -13,6 +13,7 @@ Priors are declared in the structure cards (``models/*.toml``) as tables such as
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,6 +79,11 @@ class LogUniform(Prior):
         _check_interval(self.low, self.high, "log-uniform")
         if self.low <= 0:
             raise StructureError(f"log-uniform prior needs low > 0, got low = {self.low:g}")
+        if not math.isfinite(self.high / self.low):
+            raise StructureError(
+                f"log-uniform prior needs a ratio high/low that is a finite double, got "
+                f"low = {self.low:g}, high = {self.high:g}"
+            )
 
     @property
     def bounds(self) -> tuple[float, float]:
@@ -127,9 +133,20 @@ class Normal(Prior):
 def _check_interval(low, high, what):
     if not (math.isfinite(low) and math.isfinite(high) and low < high):
         raise StructureError(f"{what} prior needs finite low < high, got low = {low}, high = {high}")
+    if not math.isfinite(high - low) or not high - low > 0:
+        raise StructureError(
+            f"{what} prior needs a width high - low that is a finite double, got low = {low:g}, "
+            f"high = {high:g}"
+        )
 
 
 PRIOR_TYPES = {"uniform": Uniform, "log-uniform": LogUniform, "normal": Normal}
+
+
+def _short(value, limit: int = 60) -> str:
+    """``repr(value)`` shortened for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[:limit]}..."
 
 
 def prior_from_dict(spec: dict, where: str) -> Prior:
@@ -142,12 +159,12 @@ def prior_from_dict(spec: dict, where: str) -> Prior:
         arguments.
     """
     if not isinstance(spec, dict) or "prior" not in spec:
-        raise StructureError(f"{where}: expected a table with a 'prior' key, got {spec!r}")
+        raise StructureError(f"{where}: expected a table with a 'prior' key, got {_short(spec)}")
     kind = spec["prior"]
-    cls = PRIOR_TYPES.get(kind)
+    cls = PRIOR_TYPES.get(kind) if isinstance(kind, str) else None
     if cls is None:
         raise StructureError(
-            f"{where}: unknown prior '{kind}'; known priors are {', '.join(PRIOR_TYPES)}"
+            f"{where}: unknown prior {_short(kind)}; known priors are {', '.join(PRIOR_TYPES)}"
         )
     args = {k: v for k, v in spec.items() if k != "prior"}
     needed = [f for f in cls.__dataclass_fields__]
@@ -157,12 +174,14 @@ def prior_from_dict(spec: dict, where: str) -> Prior:
         raise StructureError(
             f"{where}: a {kind} prior takes {', '.join(needed)}"
             + (f"; missing {', '.join(missing)}" if missing else "")
-            + (f"; unknown {', '.join(extra)}" if extra else "")
+            + (f"; unknown {', '.join(_short(k) for k in extra)}" if extra else "")
         )
-    try:
-        values = {k: float(v) for k, v in args.items()}
-    except (TypeError, ValueError):
-        raise StructureError(f"{where}: prior arguments must be numbers, got {args!r}") from None
+    bad = [k for k, v in args.items() if isinstance(v, bool) or not isinstance(v, numbers.Real)]
+    if bad:
+        raise StructureError(
+            f"{where}: prior arguments must be numbers, got {bad[0]} = {_short(args[bad[0]])}"
+        )
+    values = {k: float(v) for k, v in args.items()}
     try:
         return cls(**values)
     except StructureError as exc:

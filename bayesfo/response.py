@@ -201,6 +201,13 @@ def matignon_stable(a, q, *, allow_integrator: bool = False) -> np.ndarray:
     ok &= ~zero_const  # identically zero, or an integrator that is not allowed
     if a.shape[1] > 1 and ok.any():
         rows = np.flatnonzero(ok)
+        # Non-finite coefficients (an overflowed fit) or q have no roots to test: unstable.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            finite = np.all(np.isfinite(a[rows, 1:] / a[rows, :1]), axis=1) & np.isfinite(q[rows])
+        ok[rows[~finite]] = False
+        rows = rows[finite]
+    if a.shape[1] > 1 and ok.any():
+        rows = np.flatnonzero(ok)
         mu = _monic_reversed_roots(a[rows])
         absmu = np.abs(mu)
         scale = np.maximum(1.0, absmu.max(axis=1, keepdims=True))

@@ -68,7 +68,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import StructureError
+from ._io import read_text_file, show
+from .errors import InputError, StructureError
 from .priors import Prior, prior_from_dict
 from .response import (
     commensurate_response,
@@ -81,6 +82,26 @@ from .response import (
 N_MAX_DEFAULT = 3
 MODEL_PATH_ENV = "BAYESFO_MODEL_PATH"
 
+#: Highest degree of a pseudo-polynomial in s^q: the largest ``n_max`` of a max-order family and
+#: the largest multiplier k of an exponent ``k*q`` (and the largest |exponent| given as a number).
+#: The thesis goes to n = 3; at degree 6 a max-order member already has up to 14 parameters,
+#: more than frequency responses of tens of points determine, the library of the family holds
+#: 100 structures, and the powers (ω/ω_ref)^(6q) of data within the reader's 30 decades stay
+#: finite. Larger multipliers would only make the polynomial arrays huge (``99999999999*q``
+#: asked for a polynomial of 10^11 coefficients).
+MAX_DEGREE = 6
+
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _number(text: str) -> float | None:
+    """The finite number written in plain decimal notation in ``text``, else None."""
+    if not _NUMBER.fullmatch(text):
+        return None
+    value = float(text)
+    return value if math.isfinite(value) else None
+
 
 # ---------------------------------------------------------------------- terms
 @dataclass(frozen=True)
@@ -92,21 +113,39 @@ class Exponent:
 
     @classmethod
     def parse(cls, spec, where: str) -> Exponent:
-        if isinstance(spec, bool):
+        """Read ``0``, ``0.5``, ``"q"`` or ``"2*q"``; numbers and multipliers are bounded by
+        ±:data:`MAX_DEGREE`."""
+        if isinstance(spec, bool) or not isinstance(spec, (int, float, str)):
             raise StructureError(f"{where}: exponent must be a number or text like '2*q', got {spec!r}")
-        if isinstance(spec, (int, float)):
-            return cls(float(spec))
-        if not isinstance(spec, str):
-            raise StructureError(f"{where}: exponent must be a number or text like '2*q', got {spec!r}")
-        text = spec.replace(" ", "")
-        try:
-            return cls(float(text))
-        except ValueError:
-            pass
-        m = re.fullmatch(r"(?:([0-9.]+)\*)?([A-Za-z_][A-Za-z0-9_]*)", text)
-        if not m:
-            raise StructureError(f"{where}: cannot read exponent {spec!r}; write e.g. 'q', '2*q', 0.5")
-        return cls(float(m.group(1)) if m.group(1) else 1.0, m.group(2))
+        if isinstance(spec, str):
+            text = spec.replace(" ", "")
+            value = _number(text)
+            if value is None:
+                if text.lower().lstrip("+-") in ("inf", "infinity", "nan"):
+                    raise StructureError(f"{where}: exponent must be a finite number, got {spec!r}")
+                m = re.fullmatch(r"(?:([^*]+)\*)?([A-Za-z_][A-Za-z0-9_]*)", text)
+                k = None if m is None else 1.0 if m.group(1) is None else _number(m.group(1))
+                if k is None or k < 0:
+                    raise StructureError(
+                        f"{where}: cannot read exponent {spec!r}; write a finite number or a "
+                        "parameter with an optional non-negative multiplier, e.g. 0.5, 'q', '2*q'"
+                    )
+                return cls._checked(k, m.group(2), spec, where)
+        else:
+            value = float(spec)
+        if not math.isfinite(value):
+            raise StructureError(f"{where}: exponent must be a finite number, got {spec!r}")
+        return cls._checked(value, None, spec, where)
+
+    @classmethod
+    def _checked(cls, multiple: float, param: str | None, spec, where: str) -> Exponent:
+        if abs(multiple) > MAX_DEGREE:
+            what = "the multiplier of an exponent" if param else "a constant exponent"
+            raise StructureError(
+                f"{where}: exponent {spec!r}: {what} must be within ±{MAX_DEGREE} (a "
+                f"pseudo-polynomial of degree at most {MAX_DEGREE}), got {multiple:g}"
+            )
+        return cls(float(multiple), param)
 
     def __str__(self) -> str:
         if self.param is None:
@@ -156,7 +195,8 @@ class Inequality:
                 f"{where}: unknown constraint {text!r}; use 'stable', 'passive' or an "
                 "inequality such as 'alpha <= beta'"
             )
-        return cls(_product(m.group(1), where), m.group(2), _product(m.group(3), where), text.strip())
+        return cls(_product(m.group(1), where, text), m.group(2), _product(m.group(3), where, text),
+                   text.strip())
 
     @property
     def names(self) -> set[str]:
@@ -170,16 +210,20 @@ class Inequality:
         ](lhs, rhs)
 
 
-def _product(text: str, where: str) -> tuple:
+def _product(text: str, where: str, constraint: str = "") -> tuple:
     factors = []
     for tok in text.split("*"):
         tok = tok.strip()
-        try:
-            factors.append(float(tok))
-        except ValueError:
-            if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", tok):
-                raise StructureError(f"{where}: cannot read {tok!r} in a constraint") from None
+        value = _number(tok)
+        if value is not None:
+            factors.append(value)
+        elif _NAME.fullmatch(tok) and tok.lower() not in ("nan", "inf", "infinity"):
             factors.append(tok)
+        else:
+            raise StructureError(
+                f"{where}: cannot read {tok!r} in the constraint {(constraint or text).strip()!r}; write "
+                "parameter names and finite numbers joined by '*', e.g. 'b1 <= a1*b0'"
+            )
     return tuple(factors)
 
 
@@ -333,7 +377,7 @@ class Structure:
         unknown = [k for k in priors if k not in self.param_names]
         if unknown:
             raise StructureError(
-                f"structure '{self.name}' has no parameter '{unknown[0]}'; "
+                f"structure '{self.name}' has no parameter {show(str(unknown[0]))}; "
                 f"its parameters are {', '.join(self.param_names)}"
             )
         params = tuple(
@@ -602,7 +646,7 @@ class Structure:
             raise StructureError(f"{where}: parameter '{sorted(missing)[0]}' has no prior")
         unused = set(self.param_names) - used
         if unused:
-            raise StructureError(f"{where}: parameter '{sorted(unused)[0]}' does not appear in the formula")
+            raise StructureError(f"{where}: parameter {show(sorted(unused)[0])} does not appear in the formula")
         for t in self.numerator + self.denominator:
             if not t.is_free and (t.exponent.param or t.exponent.multiple != 0):
                 raise StructureError(
@@ -681,7 +725,7 @@ def fix_parameters(s: Structure, values: dict[str, float]) -> Structure:
     unknown = [k for k in values if k not in s.param_names]
     if unknown:
         raise StructureError(
-            f"structure '{s.name}' has no free parameter '{unknown[0]}'; "
+            f"structure '{s.name}' has no free parameter {show(str(unknown[0]))}; "
             f"its free parameters are {', '.join(s.param_names)}"
         )
     # Coefficients change with the internal scaling of ω and G; only exponents are unit-free.
@@ -689,7 +733,7 @@ def fix_parameters(s: Structure, values: dict[str, float]) -> Structure:
     if coef:
         raise StructureError(
             f"only exponent parameters ({', '.join(s.exponent_params) or 'none'}) can be fixed "
-            f"in structure '{s.name}', not '{coef[0]}'"
+            f"in structure '{s.name}', not {show(str(coef[0]))}"
         )
     for k, v in values.items():
         if not s.priors[k].contains(v):
@@ -726,13 +770,19 @@ def _parse_terms(spec, where: str) -> tuple[Term, ...]:
         if isinstance(coef, bool) or not isinstance(coef, (str, int, float)):
             raise StructureError(f"{where}, term {i + 1}: coefficient must be a name or a number")
         if isinstance(coef, str):
-            try:
-                coef = float(coef)
-            except ValueError:
-                if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", coef):
-                    raise StructureError(f"{where}, term {i + 1}: bad coefficient name {coef!r}") from None
+            value = _number(coef.strip())
+            if value is not None:
+                coef = value
+            elif not _NAME.fullmatch(coef) or coef.lower() in ("nan", "inf", "infinity"):
+                raise StructureError(
+                    f"{where}, term {i + 1}: bad coefficient {coef!r}; write a parameter name "
+                    "(letters, digits, '_') or a finite number"
+                )
         else:
             coef = float(coef)
+            if not math.isfinite(coef):
+                raise StructureError(f"{where}, term {i + 1}: a constant coefficient must be a "
+                                     f"finite number, got {item[0]!r}")
         terms.append(Term(coef, Exponent.parse(expo, f"{where}, term {i + 1}")))
     return tuple(terms)
 
@@ -749,13 +799,19 @@ def _parameters(names, table: dict, where: str, exponent_names) -> tuple[Paramet
         if spec is None:
             raise StructureError(f"{where}: no prior for parameter '{name}'")
         role = "exponent" if name in exponent_names else "coefficient"
-        params.append(Parameter(name, role, prior_from_dict(spec, f"{where}, parameter '{name}'")))
+        params.append(Parameter(name, role, prior_from_dict(spec, f"{where}, parameter {show(name)}")))
     return tuple(params)
 
 
 def _common(card: dict, where: str) -> dict:
     constraints = []
-    for c in card.get("constraints", []):
+    raw = card.get("constraints", [])
+    if not isinstance(raw, list):
+        raise StructureError(
+            f"{where}: 'constraints' must be a list of text, e.g. [\"stable\", \"passive\"], "
+            f"got {raw!r}"
+        )
+    for c in raw:
         if not isinstance(c, str):
             raise StructureError(f"{where}: constraints must be text, got {c!r}")
         constraints.append(c if c in ("stable", "passive") else Inequality.parse(c, where))
@@ -779,13 +835,15 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
     StructureError
         Naming the card and the entry that cannot be used.
     """
+    if not isinstance(card, dict):
+        raise StructureError(f"card '{source}': expected a table of keys, got {type(card).__name__}")
     name = card.get("name")
     where = f"card '{source or name}'"
     if not isinstance(name, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise StructureError(f"{where}: 'name' must be lower-case letters, digits or '_', got {name!r}")
     unknown = set(card) - CARD_KEYS
     if unknown:
-        raise StructureError(f"{where}: unknown key '{sorted(unknown)[0]}'")
+        raise StructureError(f"{where}: unknown key {show(sorted(unknown)[0])}")
     table = card.get("parameters", {})
     if not isinstance(table, dict):
         raise StructureError(f"{where}: 'parameters' must be a table")
@@ -801,9 +859,10 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
         base = Structure(name, num, den, params, family=name, card=source, **common)
         bases = [(base, True, True)]
     elif family == "max-order":
-        nmax = int(n_max if n_max is not None else card.get("n_max", N_MAX_DEFAULT))
-        if nmax < 1:
-            raise StructureError(f"{where}: n_max must be at least 1, got {nmax}")
+        if n_max is not None:
+            nmax = _check_n_max(n_max, "argument 'n_max'")
+        else:
+            nmax = _check_n_max(card.get("n_max", N_MAX_DEFAULT), f"{where}: 'n_max'")
         bases = []
         pairs = {(n, m) for n in range(1, nmax + 1) for m in range(n + 1)}
         inv_pairs = {(n, m) for m in range(1, nmax + 1) for n in range(m + 1)}
@@ -834,6 +893,20 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
     return out
 
 
+def _check_n_max(value, what: str) -> int:
+    """``value`` as the highest degree of a max-order family: an integer 1..MAX_DEGREE."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise StructureError(
+            f"{what} must be a whole number from 1 to {MAX_DEGREE}, got {value!r}"
+        )
+    if not 1 <= value <= MAX_DEGREE:
+        raise StructureError(
+            f"{what} must be from 1 to {MAX_DEGREE} (the highest degree of a max-order member; "
+            f"the thesis uses 3), got {value}"
+        )
+    return int(value)
+
+
 def card_paths(extra=()) -> list[Path]:
     """The card files: the packaged ``models/``, then ``$BAYESFO_MODEL_PATH``, then ``extra``.
 
@@ -849,9 +922,15 @@ def card_paths(extra=()) -> list[Path]:
             paths.extend(sorted(entry.glob("*.toml")))
         elif entry.is_file():
             paths.append(entry)
+        elif entry.exists():
+            raise StructureError(f"model card path '{entry}' is not a regular file or a directory")
         else:
             raise StructureError(f"model card path '{entry}' does not exist")
     return paths
+
+
+#: Largest card file (bytes): a card is a few dozen lines.
+MAX_CARD_BYTES = 1024 * 1024
 
 
 def load_library(extra=(), n_max: int | None = None) -> dict[str, Structure]:
@@ -869,18 +948,25 @@ def load_library(extra=(), n_max: int | None = None) -> dict[str, Structure]:
     StructureError
         For an unreadable card, or two cards declaring the same structure name.
     """
+    if n_max is not None:
+        _check_n_max(n_max, "argument 'n_max'")
     library: dict[str, Structure] = {}
     cards = []
     for i, path in enumerate(card_paths(extra)):
         try:
-            card = tomllib.loads(path.read_text(encoding="utf-8"))
+            text = read_text_file(path, "card", max_bytes=MAX_CARD_BYTES)
+        except InputError as exc:
+            raise StructureError(str(exc)) from None
+        try:
+            card = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise StructureError(f"card '{path}' is not valid TOML: {exc}") from None
-        except OSError as exc:
-            raise StructureError(f"card '{path}' cannot be read: {exc.strerror}") from None
+        except RecursionError:
+            raise StructureError(f"card '{path}' is not valid TOML: arrays or tables nested "
+                                 "too deeply") from None
         order = card.get("order", 1000)
-        if isinstance(order, bool) or not isinstance(order, (int, float)):
-            raise StructureError(f"card '{path}': 'order' must be a number, got {order!r}")
+        if isinstance(order, bool) or not isinstance(order, (int, float)) or not math.isfinite(order):
+            raise StructureError(f"card '{path}': 'order' must be a finite number, got {order!r}")
         cards.append((order, i, path, card))
     for _, _, path, card in sorted(cards, key=lambda c: c[:2]):
         for s in structures_from_card(card, source=str(path), n_max=n_max):
@@ -911,7 +997,8 @@ def get_structure(name: str, library: dict[str, Structure] | None = None) -> Str
         return library[name]
     except KeyError:
         raise StructureError(
-            f"unknown structure '{name}'; known structures: {', '.join(_short_list(library))}"
+            f"unknown structure {show(str(name))}; known structures: "
+            f"{', '.join(_short_list(library))}"
         ) from None
 
 
@@ -927,24 +1014,40 @@ def resolve_structures(spec: str | list[str], library: dict[str, Structure] | No
     m ≤ N); ``all`` is every structure of the library with all its variants.
     """
     library = default_library() if library is None else library
-    names = spec.split(",") if isinstance(spec, str) else list(spec)
+    if isinstance(spec, str):
+        names = spec.split(",")
+    elif isinstance(spec, (list, tuple)) and all(isinstance(n, str) for n in spec):
+        names = list(spec)
+    else:
+        raise StructureError(f"structures must be given as a comma list of names, got {spec!r}")
     out: list[Structure] = []
     for raw in names:
         name = raw.strip()
         if not name:
             raise StructureError(f"empty structure name in {spec!r}")
-        m = re.fullmatch(r"max(\d+)(-inv)?(-int)?", name)
+        m = re.fullmatch(r"max([0-9]+)(-inv)?(-int)?", name)
         if name == "all":
             chosen = list(library.values())
         elif m:
             limit, inv, integer = int(m.group(1)), bool(m.group(2)), bool(m.group(3))
+            members = [s for s in library.values() if s.degrees is not None and s.family == "max"]
+            if not members:
+                raise StructureError(
+                    f"'{name}': the library has no max-order family (a card with "
+                    "name = \"max\" and family = \"max-order\")"
+                )
+            top = max(s.degrees[1] if s.inverted else s.degrees[0] for s in members)
+            if not 1 <= limit <= top:
+                raise StructureError(
+                    f"'{name}' asks for the max-order members up to degree {limit}, but the "
+                    f"library has them up to {top}: use max1 to max{top}, or raise n_max in "
+                    f"the card '{members[0].card}' (at most {MAX_DEGREE})"
+                )
             chosen = [
-                s for s in library.values()
-                if s.degrees is not None and s.family == "max" and s.inverted == inv
-                and s.integer == integer and (s.degrees[1] if inv else s.degrees[0]) <= limit
+                s for s in members
+                if s.inverted == inv and s.integer == integer
+                and (s.degrees[1] if inv else s.degrees[0]) <= limit
             ]
-            if not chosen:
-                raise StructureError(f"'{name}' selects no structure (n_max is smaller?)")
         else:
             chosen = [get_structure(name, library)]
         for s in chosen:

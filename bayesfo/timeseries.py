@@ -31,7 +31,6 @@ harmonics at 3 omega and 5 omega).
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 import re
@@ -42,7 +41,7 @@ from pathlib import Path
 import numpy as np
 from scipy import optimize
 
-from bayesfo._io import atomic_write_text, read_text_file
+from bayesfo._io import atomic_write_text, csv_cells, parse_number, read_text_file, split_lines
 from bayesfo.errors import InputError, NonlinearityWarning
 
 __all__ = [
@@ -518,6 +517,25 @@ _META = re.compile(r"^#\s*(omega|freq)\s*[:=]\s*(.*?)\s*$", re.IGNORECASE)
 _META_UNITS = {"omega": ("", "rad/s"), "freq": ("", "hz")}
 
 
+def _number(text: str) -> float:
+    """A number of a record file: plain ASCII decimal notation (not ``1_0``), or ``nan``/``inf``
+    returned as such for the caller to name as not finite.
+
+    Raises
+    ------
+    ValueError
+        With the reason, e.g. "'abc' is not a number".
+    """
+    try:
+        return parse_number(text)
+    except ValueError:
+        if re.fullmatch(r"[+-]?(?:nan|inf|infinity)", text.strip(), re.I):
+            value = float(text)
+            if not math.isfinite(value):
+                return value
+        raise
+
+
 def _parse_meta(path: Path, lineno: int, key: str, text: str) -> float:
     parts = text.split()
     units = _META_UNITS[key]
@@ -527,7 +545,7 @@ def _parse_meta(path: Path, lineno: int, key: str, text: str) -> float:
             f"{' and optionally rad/s' if key == 'omega' else ' and optionally Hz'}, got {text!r}"
         )
     try:
-        value = float(parts[0])
+        value = _number(parts[0])
     except ValueError:
         raise InputError(
             f"{path}, line {lineno}: '# {key}:' value {parts[0]!r} is not a number"
@@ -584,7 +602,7 @@ def read_sine_record(path):
     header_line = 0
     omega_meta: dict[str, tuple[float, int]] = {}
     rows: list[tuple[int, list[str]]] = []
-    for lineno, raw in enumerate(text.splitlines(), start=1):
+    for lineno, raw in enumerate(split_lines(text), start=1):
         line = raw.strip()
         if not line:
             continue
@@ -599,7 +617,7 @@ def read_sine_record(path):
                     )
                 omega_meta[key] = (_parse_meta(path, lineno, key, match.group(2)), lineno)
             continue
-        cells = next(csv.reader([line]))
+        cells = csv_cells(line, str(path), lineno)
         if header is None:
             header, header_line = [c.strip().lower() for c in cells], lineno
             continue
@@ -635,18 +653,16 @@ def read_sine_record(path):
             if not text:
                 raise InputError(f"{path}, line {lineno}, column {name!r}: empty cell")
             try:
-                v = float(text)
-            except ValueError:
-                raise InputError(
-                    f"{path}, line {lineno}, column {name!r}: {text!r} is not a number"
-                ) from None
+                v = _number(text)
+            except ValueError as exc:
+                raise InputError(f"{path}, line {lineno}, column {name!r}: {exc}") from None
             if not math.isfinite(v):
                 raise InputError(f"{path}, line {lineno}, column {name!r}: {text!r} is not finite")
             values[r, c] = v
         if "series" in col:
             text = cells[col["series"]].strip()
             try:
-                sid = float(text)
+                sid = _number(text)
             except ValueError:
                 sid = math.nan
             if not math.isfinite(sid) or sid != round(sid):

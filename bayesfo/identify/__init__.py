@@ -8,15 +8,41 @@ least squares of the complex residual on scaled data for every structure (§3.3,
 
 from __future__ import annotations
 
+import math
+import numbers
+
 from ..errors import InputError
 from ..structures import Structure, fix_parameters
 from .optimize import FitResult, fit_structure, linear_seeds, thesis_degrees
 from .scan import LinearFit, QScan, fit_linear, max_order_scan, q_grid_scan
 
 __all__ = [
-    "FitResult", "LinearFit", "QScan", "fit_linear", "fit_structure", "identify", "linear_seeds",
-    "max_order_scan", "q_grid_scan", "thesis_degrees",
+    "FitResult", "LinearFit", "QScan", "check_q", "fit_linear", "fit_structure", "identify",
+    "linear_seeds", "max_order_scan", "q_grid_scan", "thesis_degrees",
 ]
+
+
+def check_q(q, structure: Structure) -> float:
+    """``q`` as a float, checked to be finite and within the support of the prior of q of
+    ``structure`` (structures without a free q are left to :func:`identify`).
+
+    Raises
+    ------
+    InputError
+        Naming ``q``, the prior and the range to choose from.
+    """
+    if isinstance(q, bool) or not isinstance(q, numbers.Real) or not math.isfinite(q):
+        raise InputError(f"argument 'q' must be a finite number, got {q!r}")
+    q = float(q)
+    prior = structure.priors.get("q")
+    if prior is not None:
+        lo, hi = prior.bounds
+        if not lo <= q <= hi:
+            raise InputError(
+                f"argument 'q' = {q:g} is outside the prior {prior.describe()} of q in "
+                f"structure '{structure.name}': give a q from {lo:g} to {hi:g}"
+            )
+    return q
 
 
 def identify(data, structure: Structure, *, method="opt", q: float | None = None,
@@ -33,6 +59,8 @@ def identify(data, structure: Structure, *, method="opt", q: float | None = None
     """
     structure.check_data(data)
     method = str(method)
+    if q is not None:
+        q = check_q(q, structure)
     degrees = thesis_degrees(structure)
     out = {"structure": structure.name, "method": method, "inverted": structure.inverted}
     if method in ("1", "2", "3", "4", "5"):

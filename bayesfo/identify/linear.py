@@ -93,8 +93,31 @@ def weighted_solve(S, y, weights) -> np.ndarray:
     d = np.sqrt(np.abs(np.diagonal(A, axis1=-2, axis2=-1)))
     d = np.where(d > 0, d, 1.0)
     As = A / d[..., :, None] / d[..., None, :]
-    x = np.linalg.solve(As, (b / d)[..., None])[..., 0]
+    x = _solve_batch(As, b / d)
     return x / d
+
+
+def _solve_batch(A, b) -> np.ndarray:
+    """Solve A x = b for a batch of square systems; NaN for a system that is singular or holds
+    a non-finite number (e.g. powers of λ that overflowed for an extreme q), instead of an
+    exception that would discard the whole batch (a q grid)."""
+    finite = np.all(np.isfinite(A), axis=(-2, -1)) & np.all(np.isfinite(b), axis=-1)
+    P = A.shape[-1]
+    A_ok = np.where(finite[..., None, None], A, np.eye(P))
+    b_ok = np.where(finite[..., None], b, 0.0)
+    try:
+        x = np.linalg.solve(A_ok, b_ok[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        flat_A = A_ok.reshape(-1, P, P)
+        flat_b = b_ok.reshape(-1, P)
+        x = np.empty_like(flat_b)
+        for i in range(flat_A.shape[0]):
+            try:
+                x[i] = np.linalg.solve(flat_A[i], flat_b[i])
+            except np.linalg.LinAlgError:
+                x[i] = np.nan
+        x = x.reshape(b_ok.shape)
+    return np.where(finite[..., None], x, np.nan)
 
 
 def lawrence_rogers(S, y, weights, *, epsilon: float = LR_EPSILON, passes: int = LR_PASSES,
@@ -173,24 +196,27 @@ def identify_linear(omega, G, q, n: int, m: int, method: int, *,
             f"{omega.size} frequencies give {2 * omega.size} real equations, fewer than the "
             f"{n + m + 1} coefficients"
         )
-    S, y, powers = regressors(omega, G, q, n, m)
-    if method in (1, 2, 4):
-        wv = vinagre_weights(omega)
-        if method == 1:
-            p = weighted_solve(S, y, wv**2)
-        elif method == 2:
-            p = weighted_solve(S, y, wv)
-        else:
-            p = lawrence_rogers(S, y, wv, epsilon=lr_epsilon, passes=lr_passes)
-    else:
-        w = np.ones(S.shape[:-1])
-        p = None
-        for _ in range(sk_iterations):
-            if method == 3:
-                p = weighted_solve(S, y, w)
+    # Powers of λ may overflow for extreme q over many decades: the solve then marks that
+    # system NaN (see _solve_batch) instead of warning or raising.
+    with np.errstate(all="ignore"):
+        S, y, powers = regressors(omega, G, q, n, m)
+        if method in (1, 2, 4):
+            wv = vinagre_weights(omega)
+            if method == 1:
+                p = weighted_solve(S, y, wv**2)
+            elif method == 2:
+                p = weighted_solve(S, y, wv)
             else:
-                p = lawrence_rogers(S, y, np.sqrt(w), epsilon=lr_epsilon, passes=lr_passes)
-            A = 1.0 + sum(p[..., k - 1 : k] * powers[k] for k in range(1, n + 1))
-            w = 1.0 / np.abs(A) ** 2
+                p = lawrence_rogers(S, y, wv, epsilon=lr_epsilon, passes=lr_passes)
+        else:
+            w = np.ones(S.shape[:-1])
+            p = None
+            for _ in range(sk_iterations):
+                if method == 3:
+                    p = weighted_solve(S, y, w)
+                else:
+                    p = lawrence_rogers(S, y, np.sqrt(w), epsilon=lr_epsilon, passes=lr_passes)
+                A = 1.0 + sum(p[..., k - 1 : k] * powers[k] for k in range(1, n + 1))
+                w = 1.0 / np.abs(A) ** 2
     a = np.concatenate([np.ones(p.shape[:-1] + (1,)), p[..., :n]], axis=-1)
     return a, p[..., n:]

@@ -121,20 +121,22 @@ def fit_linear(data: FrequencyResponse, n: int, m: int, method: int, q, *,
     target = data.reciprocal() if reciprocal else data
     w_ref, g_ref = target.omega_ref, target.g_ref
     w = target.omega / w_ref
-    a_s, b_s = identify_linear(w, target.response / g_ref, q, n, m, method)
-    k_a = np.arange(n + 1)
-    k_b = np.arange(m + 1)
-    a = a_s * w_ref ** (-k_a[None, :] * q[:, None])
-    b = b_s * g_ref * w_ref ** (-k_b[None, :] * q[:, None])
-    fitted = commensurate_response(data.omega, a, b, q)
-    if reciprocal:
-        with np.errstate(divide="ignore", invalid="ignore"):
+    # Overflow for extreme q (powers of λ over many decades) gives non-finite coefficients:
+    # that q gets an infinite RMSE and counts as unstable, as the scan expects; no warnings.
+    with np.errstate(all="ignore"):
+        a_s, b_s = identify_linear(w, target.response / g_ref, q, n, m, method)
+        k_a = np.arange(n + 1)
+        k_b = np.arange(m + 1)
+        a = a_s * w_ref ** (-k_a[None, :] * q[:, None])
+        b = b_s * g_ref * w_ref ** (-k_b[None, :] * q[:, None])
+        fitted = commensurate_response(data.omega, a, b, q)
+        if reciprocal:
             fitted = 1.0 / fitted
-    stable = matignon_stable(b if inverted else a, q, allow_integrator=True)
-    if data.kind in ("compliance", "modulus"):
-        stable &= matignon_stable(a if inverted else b, q, allow_integrator=True)
-    err = np.abs(fitted - data.response[None, :]) ** 2
-    rmse = np.sqrt(np.sum(err, axis=-1)) / data.n_frequencies
+        stable = matignon_stable(b if inverted else a, q, allow_integrator=True)
+        if data.kind in ("compliance", "modulus"):
+            stable &= matignon_stable(a if inverted else b, q, allow_integrator=True)
+        err = np.abs(fitted - data.response[None, :]) ** 2
+        rmse = np.sqrt(np.sum(err, axis=-1)) / data.n_frequencies
     rmse = np.where(np.isfinite(rmse), rmse, np.inf)
     return [
         LinearFit(n, m, method, inverted, float(q[i]), a[i], b[i], float(rmse[i]), bool(stable[i]))

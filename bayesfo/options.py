@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._io import parse_number, show
 from .errors import InputError
 
 DEFAULT_STRUCTURES = "voigt,zener,maxwell,voigt-int,zener-int,maxwell-int"
@@ -20,9 +21,10 @@ DEFAULT_STRUCTURES = "voigt,zener,maxwell,voigt-int,zener-int,maxwell-int"
 
 def parse_floats(text: str, option: str) -> list[float]:
     try:
-        return [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise InputError(f"{option} takes comma-separated numbers, got {text!r}") from None
+        return [parse_number(v) for v in text.split(",") if v.strip()]
+    except ValueError as exc:
+        raise InputError(f"{option} takes comma-separated numbers, got {show(text)}: "
+                         f"{exc}") from None
 
 
 def parse_priors(specs) -> dict:
@@ -37,9 +39,10 @@ def parse_priors(specs) -> dict:
         kind, a, b = parts
         keys = ("mu", "sd") if kind == "normal" else ("low", "high")
         try:
-            values = {keys[0]: float(a), keys[1]: float(b)}
-        except ValueError:
-            raise InputError(f"--prior {spec!r}: the bounds must be numbers") from None
+            values = {keys[0]: parse_number(a), keys[1]: parse_number(b)}
+        except ValueError as exc:
+            raise InputError(f"--prior {show(spec)}: the bounds must be numbers ({exc})") \
+                from None
         if name.strip() in out:
             raise InputError(f"--prior {spec!r}: a prior for '{name.strip()}' is already given; "
                              "give one --prior per parameter")

@@ -401,3 +401,44 @@ def test_a_hopeless_misfit_gives_reasons_not_nan(tmp_path, run_cli):
     assert " and 19" in err and "more rad/s; PSIS-LOO is unreliable there" in err
     assert "nan" not in (tmp_path / "out" / "ranking.csv").read_text().lower()
     assert "nan" not in out.lower()
+
+
+# ---------------------------------------------------------------------- bad input in the shared layers
+def test_a_manifest_cell_too_long_is_named(tmp_path, run_cli):
+    manifest = tmp_path / "m.csv"
+    manifest.write_text("path,id\n" + "x" * 200_000 + ",a\n")
+    status, _, err = run_cli("batch", "--manifest", manifest, "--out", tmp_path / "out")
+    assert status == 2 and err.count("\n") == 1
+    assert err.startswith(f"bayesfo: error: manifest '{manifest}', line 2: a cell has more than")
+
+
+def test_identify_loop_names_a_bad_q_once(run_cli):
+    status, _, err = run_cli("identify", ADHESIVE / "Tp020C.csv", "--structure", "max3",
+                             "--q", "1.7")
+    assert status == 2 and err.count("\n") == 1
+    assert "argument 'q' = 1.7 is outside the prior" in err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--holdout", "1_0"], "--holdout takes comma-separated numbers"),
+    (["--prior", "q=uniform:0:1_0"], "the bounds must be numbers"),
+])
+def test_numbers_in_options_are_plain_decimals(run_cli, argv, message):
+    status, _, err = run_cli("compare", ADHESIVE / "Tp020C.csv", *argv)
+    assert status == 2 and message in err and err.count("\n") == 1
+
+
+def test_the_api_refuses_what_the_samplers_cannot_handle():
+    from bayesfo.data import MAX_FREQUENCIES
+    from bayesfo.errors import InputError
+
+    w = np.logspace(-2, 2, 25)
+    g = get_structure("voigt").response([1.0, 1e-3, 0.5], w, "compliance")
+    g[3] = 0
+    with pytest.raises(InputError, match=r"the response is exactly 0 at omega = 0.03162 rad/s, where relative noise"):
+        compare(FrequencyResponse(w, g, kind="compliance"), "voigt", workers=1, progress=False)
+    many = np.logspace(-3, 3, MAX_FREQUENCIES + 1)
+    g = get_structure("voigt").response([1.0, 1e-3, 0.5], many, "compliance")
+    with pytest.raises(InputError, match=f"{MAX_FREQUENCIES + 1} frequencies, more than"):
+        compare(FrequencyResponse(many, g, kind="compliance"), "voigt", workers=1,
+                progress=False)

@@ -3,7 +3,6 @@ expanded into :class:`DataSet` objects with unique ids and checked options."""
 
 from __future__ import annotations
 
-import csv
 import glob
 import hashlib
 import json
@@ -13,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import __version__
-from .._io import read_text_file
+from .._io import csv_cells, read_text_file, split_lines
 from ..errors import InputError
 from ..options import DEFAULT_OPTIONS, EVIDENCE_ROUTES, KINDS, check_options, check_seed
 from .temperature import parse_temperature, temperature_of_file
@@ -110,10 +109,13 @@ def _looks_like_manifest(path: Path) -> bool:
         text = read_text_file(path)
     except InputError:
         return False
-    for line in text.splitlines():
+    for lineno, line in enumerate(split_lines(text), start=1):
         stripped = line.strip()
         if stripped and not stripped.startswith("#"):
-            cells = next(csv.reader([line]))
+            try:
+                cells = csv_cells(line, f"file '{path}'", lineno)
+            except InputError:  # not a manifest; reading it as data names the problem
+                return False
             return "path" in {c.strip().lower() for c in cells}
     return False
 
@@ -191,11 +193,11 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
     base = dict(DEFAULT_OPTIONS, **(defaults or {}))
     header, header_line = None, 0
     entries = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
+    for lineno, line in enumerate(split_lines(text), start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        cells = [c.strip() for c in next(csv.reader([line]))]
+        cells = [c.strip() for c in csv_cells(line, where, lineno)]
         if header is None:
             header, header_line = [c.lower() for c in cells], lineno
             for col in header:

@@ -52,8 +52,11 @@ def run(args) -> int:
 
 def _identify_loop(args, data, structures) -> int:
     """The max-order loop of thesis §4.3.2: every member, and the one with the lowest RMSE."""
-    from ..identify import identify
+    from ..identify import check_q, identify
 
+    if args.q is not None:  # one message for a q outside the prior, not one per member
+        for s in structures:
+            check_q(args.q, s)
     results, skipped = [], {}
     for s in structures:
         try:

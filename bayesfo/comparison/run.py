@@ -23,7 +23,9 @@ from __future__ import annotations
 import sys
 import warnings
 
-from ..data import FrequencyResponse
+import numpy as np
+
+from ..data import MAX_FREQUENCIES, FrequencyResponse
 from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputError
 from ..identify.optimize import fit_structure
 from ..inference import Likelihood, run_posterior
@@ -104,6 +106,15 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         raise InputError(f"evidence must be 'auto', 'bridge' or 'ladder', got {evidence!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
         raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    if data.n_frequencies > MAX_FREQUENCIES:
+        raise InputError(f"{data.where()}: {data.n_frequencies} frequencies, more than the "
+                         f"{MAX_FREQUENCIES} the samplers handle in reasonable time; thin to "
+                         "10-50 log-spaced points per decade or average neighbours")
+    if noise in ("auto", "proportional") and data.sigma is None and np.any(data.response == 0):
+        # sigma_rel * |G| would be zero there: the likelihood has no scale at that point.
+        raise InputError(f"{data.where()}: the response is exactly 0 at omega = "
+                         f"{data.omega[data.response == 0][0]:.4g} rad/s, where relative noise "
+                         "has no scale; remove the point or give sigma")
     test = None
     if holdout is not None and len(holdout):
         data, test = data.split(holdout)

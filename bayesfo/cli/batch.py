@@ -6,14 +6,10 @@ import sys
 
 from ..batch import OK, BatchResult, expand_inputs, run_batch
 from ..options import (
-    DEFAULT_STRUCTURES,
-    EVIDENCE_ROUTES,
     KINDS,
-    NOISE_MODELS,
-    SAMPLERS,
     parse_floats,
-    seed_argument,
 )
+from ._common import add_comparison_options
 
 
 def add_parser(subparsers):
@@ -40,32 +36,14 @@ def add_parser(subparsers):
                         "'path' column and per-file options)")
     p.add_argument("--manifest", action="append", default=[], metavar="FILE",
                    help="manifest CSV: path[,id,kind,reciprocal|invert,structures,noise,prior,"
-                        "seed,holdout,evidence,evidence_check,temperature]; repeatable")
+                        "seed,holdout,evidence,evidence_check,temperature,sampler]; repeatable")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--kind", choices=KINDS,
                    help="what the responses are (default: each file's '# kind:' line, "
                         "else generic)")
     p.add_argument("--reciprocal", action="store_true",
                    help="use 1/G of the data (sigma propagated)")
-    p.add_argument("--structures", default=DEFAULT_STRUCTURES,
-                   help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
-    p.add_argument("--noise", default="auto", choices=NOISE_MODELS,
-                   help="noise model (default: known if the data give sigma, else relative "
-                        "or constant)")
-    p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
-                   help="override a prior, e.g. q=uniform:0.2:1; repeatable")
-    p.add_argument("--seed", type=seed_argument, default=0,
-                   help="seed of every data set (the same numbers whatever the workers)")
-    p.add_argument("--holdout", default=None, metavar="W1,W2",
-                   help="angular frequencies [rad/s] left out of every fit for validation")
-    p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
-                   help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
-                        "ladder (ladder); auto: the ladder where the posterior did not converge")
-    p.add_argument("--sampler", default="auto", choices=SAMPLERS,
-                   help="posterior by importance sampling from the optima where its weights "
-                        "certify it, else emcee (auto), or emcee first (emcee)")
-    p.add_argument("--evidence-check", action="store_true",
-                   help="also compute ln Z by dynesty nested sampling and flag disagreements")
+    add_comparison_options(p, each="every fit")
     p.add_argument("--no-figures", action="store_true",
                    help="skip each data set's figures and report.html (the combined figures "
                         "are still drawn)")

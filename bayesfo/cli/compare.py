@@ -9,39 +9,19 @@ import numpy as np
 
 from ..errors import InputError
 from ..options import (
-    DEFAULT_STRUCTURES,
-    EVIDENCE_ROUTES,
-    SAMPLERS,
     parse_floats,
     parse_priors,
-    seed_argument,
 )
-from ._common import add_data_options, library, read_data
+from ._common import add_comparison_options, add_data_options, library, read_data
 
 
 def add_parser(subparsers):
     """Register ``bayesfo compare``: compare structures on one data set."""
     p = subparsers.add_parser("compare", help="posteriors and criteria of several structures on one data set")
     add_data_options(p)
-    p.add_argument("--structures", default=DEFAULT_STRUCTURES,
-                   help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default: bayesfo-<data name>)")
-    p.add_argument("--noise", default="auto", choices=("auto", "known", "constant", "proportional"),
-                   help="noise model (default: known if the data give sigma, else relative or constant)")
-    p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
-                   help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1")
-    p.add_argument("--seed", type=seed_argument, default=0)
-    p.add_argument("--holdout", default=None, metavar="W1,W2",
-                   help="angular frequencies [rad/s] left out of the fit for validation")
-    p.add_argument("--evidence", default="auto", choices=EVIDENCE_ROUTES,
-                   help="ln Z by bridge sampling from the emcee draws (bridge) or from a tempered "
-                        "ladder (ladder); auto: the ladder where the posterior did not converge")
-    p.add_argument("--sampler", default="auto", choices=SAMPLERS,
-                   help="posterior by importance sampling from the optima where its weights "
-                        "certify it, else emcee (auto), or emcee first (emcee)")
-    p.add_argument("--evidence-check", action="store_true",
-                   help="also compute ln Z by dynesty nested sampling and flag disagreements")
+    add_comparison_options(p)
     p.add_argument("--workers", type=int, default=0, metavar="N",
                    help="processes running structures side by side and then drawing the figures "
                         "(default 0: one per CPU); the numbers do not depend on it")

@@ -470,7 +470,8 @@ def read_csv(
     path : path-like
         The CSV file (see the module docstring for the columns).
     kind : {"compliance", "modulus", "generic"}, optional
-        Overrides a ``# kind:`` comment in the file; the default is ``"generic"``.
+        Overrides a ``# kind:`` comment in the file; without either, ``storage``/``loss``
+        columns mean a modulus (stated in ``notes``) and other columns ``"generic"``.
     units, name : str, optional
         Override the ``# units:`` and ``# name:`` comments.
 
@@ -565,6 +566,14 @@ def read_csv(
         values[col] = out
     linenos = np.array([ln for ln, _ in rows])
 
+    notes: list[str] = []
+    if kind is None and "kind" not in meta and "storage" in values:
+        # G' and G'' (storage and loss) are by definition the parts of a modulus; fitting them
+        # as a generic transfer function loses the sign convention and the dissipation check.
+        kind = "modulus"
+        notes.append("kind modulus: storage and loss columns are the parts of a modulus "
+                     "(G', G''); for a compliance J', J'' give '# kind: compliance' or "
+                     "--kind compliance")
     kind = kind if kind is not None else meta.get("kind", "generic")
     if kind not in KINDS:
         raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {show(str(kind))}")
@@ -600,7 +609,6 @@ def read_csv(
         _check_rows(sigma <= 0, where, linenos, "sigma", "sigma must be positive")
         _check_sigma(sigma, magnitude, where, linenos)
 
-    notes: list[str] = []
     if "series" in values:
         omega, response, sigma, n_rep, linenos = _average_series(
             omega, response, sigma, values["series"], linenos, where, fcol

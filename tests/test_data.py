@@ -255,3 +255,16 @@ def test_cli_inspect_reports_negative_loss_of_bundled_glassy_isotherm(run_cli):
     info = json.loads(out)
     assert status == 0 and info["n_frequencies"] == 17 and info["kind"] == "modulus"
     assert len(info["dissipation_violations"]) == 1
+
+
+def test_storage_and_loss_mean_a_modulus_unless_told_otherwise(write_csv):
+    text = "omega,storage,loss\n1,100,30\n2,150,40\n3,180,45\n"
+    fr = read_csv(write_csv(text))
+    assert fr.kind == "modulus" and fr.response[0] == 100 + 30j
+    assert fr.notes[0].startswith("kind modulus: storage and loss columns are the parts of a")
+    j = read_csv(write_csv("# kind: compliance\n" + text, name="j.csv"))
+    assert j.kind == "compliance" and j.response[0] == 100 - 30j and not j.notes
+    g = read_csv(write_csv(text, name="g.csv"), kind="generic")
+    assert g.kind == "generic" and not g.notes
+    # Other forms stay generic unless told.
+    assert read_csv(write_csv("omega,real,imag\n1,1,-1\n2,2,-1\n", name="r.csv")).kind == "generic"

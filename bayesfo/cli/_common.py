@@ -15,7 +15,8 @@ from ..options import (
 def add_data_options(p):
     p.add_argument("data", metavar="DATA", help="CSV file with omega|freq and the response columns")
     p.add_argument("--kind", choices=KINDS,
-                   help="what the response is (default: the file's '# kind:' line, else generic)")
+                   help="what the response is (default: the file's '# kind:' line, else modulus "
+                        "for storage/loss columns, else generic)")
     p.add_argument("--reciprocal", action="store_true",
                    help="use 1/G of the data (sigma propagated)")
 

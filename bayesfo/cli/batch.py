@@ -39,8 +39,8 @@ def add_parser(subparsers):
                         "seed,holdout,evidence,evidence_check,temperature,sampler]; repeatable")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--kind", choices=KINDS,
-                   help="what the responses are (default: each file's '# kind:' line, "
-                        "else generic)")
+                   help="what the responses are (default: each file's '# kind:' line, else "
+                        "modulus for storage/loss columns, else generic)")
     p.add_argument("--reciprocal", action="store_true",
                    help="use 1/G of the data (sigma propagated)")
     add_comparison_options(p, each="every fit")

@@ -217,7 +217,7 @@ class Comparison:
                      "n_frequencies": self.data.n_frequencies, "kind": self.data.kind,
                      "units": self.data.units, "omega_min": float(self.data.omega.min()),
                      "omega_max": float(self.data.omega.max()),
-                     "warnings": self.data_warnings,
+                     "warnings": self.data_warnings, "notes": list(self.data.notes),
                      "dissipation_violations_omega":
                          self.data.omega[self.data.dissipation_violations()].tolist()},
             "seed": self.seed,

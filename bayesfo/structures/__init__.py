@@ -1,0 +1,76 @@
+"""Model structures, declared as cards in ``models/*.toml`` and evaluated vectorised.
+
+A :class:`Structure` is a transfer function written as a ratio of power terms,
+``Σ c_i s^{e_i} / Σ d_j s^{f_j}``, whose coefficients and exponents are parameters or constants,
+together with the priors of its free parameters and its constraints. It is something you
+evaluate: ``structure.response(theta, omega, kind)`` returns complex values of shape
+``(n_sets, n_freq)`` for ``theta`` of shape ``(n_sets, n_params)``, and the same function serves
+least squares, MCMC and plotting.
+
+Cards
+-----
+A card describes one structure (or a family of them) as the **compliance** of a material, as the
+thesis does (§2.4.2); for modulus data the same material is compared through the reciprocal. A
+single-structure card::
+
+    name = "voigt"
+    title = "Fractional Voigt model"
+    numerator = [["b0", "0"]]                  # [coefficient, exponent] pairs
+    denominator = [[1, "0"], ["a1", "q"]]      # exponents: "0", "q", "2*q", "alpha", 1, ...
+    constraints = ["stable", "passive"]        # and inequalities such as "alpha <= beta"
+    [parameters]                               # priors on the scaled data, in this order
+    a1 = { prior = "log-uniform", low = 1e-4, high = 1e4 }
+    b0 = { prior = "log-uniform", low = 1e-4, high = 1e4 }
+    q  = { prior = "uniform", low = 0, high = 1 }
+
+A family card has ``family = "max-order"`` and ``n_max``; its members are the commensurate
+structures ``B(λ)/A(λ)`` with ``A = 1 + a1 λ + … + an λ^n`` and ``B = b0 + … + bm λ^m`` for
+n = 1..n_max, m = 0..n, and parameter tables may use the patterns ``"a*"`` and ``"b*"``.
+
+Variants are generated, never written by hand: ``NAME-int`` fixes every exponent parameter to 1
+(the integer-order baseline) and ``NAME-inv`` is the reciprocal transfer function (for
+integrator-like data such as a hydraulic dashpot, thesis §4.3.4). Inverted max-order members
+run over m = 1..n_max, n = 0..m.
+
+Constraints
+-----------
+``stable``
+    Matignon's theorem (thesis Theorem 3) on the denominator, which must be a polynomial in
+    λ = s^p for one exponent parameter p, and for compliance and modulus data also on the
+    numerator (the reciprocal of a passive material response is a stable response too). A root
+    at λ = 0 is an integrator (Maxwell compliance, dashpot), not an instability, and is accepted.
+``passive``
+    Dissipation ≥ 0 of the response compared with the data (Im J ≤ 0 for a compliance,
+    Im G ≥ 0 for a modulus; nothing for generic data), on a dense grid reaching decades beyond
+    the data.
+inequalities
+    ``lhs <= rhs`` (or ``<``, ``>=``, ``>``), each side a product of parameter names and numbers.
+    They must be invariant under the internal scaling (compare exponents with exponents, or
+    products with the same units); inverted variants keep only those between exponent
+    parameters, because coefficient orderings are statements about the parent material.
+
+Scaling
+-------
+Parameters are sampled and optimised on scaled data, ω̃ = ω/ω_ref and G̃ = G/g_ref (see
+:class:`Scaling`), and reported in physical units through :meth:`Structure.to_physical`.
+"""
+
+from .cards import (
+                    CARD_KEYS,
+                    MODEL_PATH_ENV,
+                    N_MAX_DEFAULT,
+                    card_paths,
+                    default_library,
+                    get_structure,
+                    load_library,
+                    resolve_structures,
+                    structures_from_card,
+)
+from .structure import Parameter, Scaling, Structure
+from .terms import MAX_DEGREE, Exponent, Inequality, Term
+from .variants import fix_parameters, integer_variant, inverted_variant
+
+__all__ = ["CARD_KEYS", "MAX_DEGREE", "MODEL_PATH_ENV", "N_MAX_DEFAULT", "Exponent", "Inequality",
+           "Parameter", "Scaling", "Structure", "Term", "card_paths", "default_library",
+           "fix_parameters", "get_structure", "integer_variant", "inverted_variant",
+           "load_library", "resolve_structures", "structures_from_card"]

@@ -1,0 +1,323 @@
+"""Structure cards (``models/*.toml``) and the library they make: reading and checking cards,
+expanding max-order families and variants, and resolving names and shortcuts."""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from .._io import read_text_file, show
+from ..errors import InputError, StructureError
+from ..priors import prior_from_dict
+from .structure import Parameter, Structure
+from .terms import _NAME, MAX_DEGREE, Exponent, Inequality, Term, _number
+from .variants import integer_variant, inverted_variant
+
+N_MAX_DEFAULT = 3
+
+
+MODEL_PATH_ENV = "BAYESFO_MODEL_PATH"
+
+
+def _parse_terms(spec, where: str) -> tuple[Term, ...]:
+    if not isinstance(spec, list) or not spec:
+        raise StructureError(f"{where}: expected a list of [coefficient, exponent] pairs")
+    terms = []
+    for i, item in enumerate(spec):
+        if not isinstance(item, list) or len(item) != 2:
+            raise StructureError(f"{where}, term {i + 1}: expected [coefficient, exponent], got {item!r}")
+        coef, expo = item
+        if isinstance(coef, bool) or not isinstance(coef, (str, int, float)):
+            raise StructureError(f"{where}, term {i + 1}: coefficient must be a name or a number")
+        if isinstance(coef, str):
+            value = _number(coef.strip())
+            if value is not None:
+                coef = value
+            elif not _NAME.fullmatch(coef) or coef.lower() in ("nan", "inf", "infinity"):
+                raise StructureError(
+                    f"{where}, term {i + 1}: bad coefficient {coef!r}; write a parameter name "
+                    "(letters, digits, '_') or a finite number"
+                )
+        else:
+            coef = float(coef)
+            if not math.isfinite(coef):
+                raise StructureError(f"{where}, term {i + 1}: a constant coefficient must be a "
+                                     f"finite number, got {item[0]!r}")
+        terms.append(Term(coef, Exponent.parse(expo, f"{where}, term {i + 1}")))
+    return tuple(terms)
+
+
+def _parameters(names, table: dict, where: str, exponent_names) -> tuple[Parameter, ...]:
+    params = []
+    for name in names:
+        spec = table.get(name)
+        if spec is None:
+            for pattern, s in table.items():
+                if pattern.endswith("*") and name.startswith(pattern[:-1]) and name[len(pattern) - 1:].isdigit():
+                    spec = s
+                    break
+        if spec is None:
+            raise StructureError(f"{where}: no prior for parameter '{name}'")
+        role = "exponent" if name in exponent_names else "coefficient"
+        params.append(Parameter(name, role, prior_from_dict(spec, f"{where}, parameter {show(name)}")))
+    return tuple(params)
+
+
+def _common(card: dict, where: str) -> dict:
+    constraints = []
+    raw = card.get("constraints", [])
+    if not isinstance(raw, list):
+        raise StructureError(
+            f"{where}: 'constraints' must be a list of text, e.g. [\"stable\", \"passive\"], "
+            f"got {raw!r}"
+        )
+    for c in raw:
+        if not isinstance(c, str):
+            raise StructureError(f"{where}: constraints must be text, got {c!r}")
+        constraints.append(c if c in ("stable", "passive") else Inequality.parse(c, where))
+    return {
+        "title": str(card.get("title", "")),
+        "description": str(card.get("description", "")),
+        "reference": str(card.get("reference", "")),
+        "constraints": tuple(constraints),
+    }
+
+
+CARD_KEYS = {"name", "title", "description", "reference", "numerator", "denominator",
+             "constraints", "parameters", "family", "n_max", "order"}
+
+
+def structures_from_card(card: dict, source: str = "", n_max: int | None = None) -> list[Structure]:
+    """All structures a card declares, including the generated ``-int`` and ``-inv`` variants.
+
+    Raises
+    ------
+    StructureError
+        Naming the card and the entry that cannot be used.
+    """
+    if not isinstance(card, dict):
+        raise StructureError(f"card '{source}': expected a table of keys, got {type(card).__name__}")
+    name = card.get("name")
+    where = f"card '{source or name}'"
+    if not isinstance(name, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", name):
+        raise StructureError(f"{where}: 'name' must be lower-case letters, digits or '_', got {name!r}")
+    unknown = set(card) - CARD_KEYS
+    if unknown:
+        raise StructureError(f"{where}: unknown key {show(sorted(unknown)[0])}")
+    table = card.get("parameters", {})
+    if not isinstance(table, dict):
+        raise StructureError(f"{where}: 'parameters' must be a table")
+    common = _common(card, where)
+    family = card.get("family")
+    out: list[Structure] = []
+    if family is None:
+        num = _parse_terms(card.get("numerator"), f"{where}, numerator")
+        den = _parse_terms(card.get("denominator"), f"{where}, denominator")
+        expo = {t.exponent.param for t in num + den if t.exponent.param}
+        used = [n for n in table if not n.endswith("*")]
+        params = _parameters(used, table, where, expo)
+        base = Structure(name, num, den, params, family=name, card=source, **common)
+        bases = [(base, True, True)]
+    elif family == "max-order":
+        if n_max is not None:
+            nmax = _check_n_max(n_max, "argument 'n_max'")
+        else:
+            nmax = _check_n_max(card.get("n_max", N_MAX_DEFAULT), f"{where}: 'n_max'")
+        bases = []
+        pairs = {(n, m) for n in range(1, nmax + 1) for m in range(n + 1)}
+        inv_pairs = {(n, m) for m in range(1, nmax + 1) for n in range(m + 1)}
+        for n, m in sorted(pairs | inv_pairs, key=lambda p: (max(p), p[0], p[1])):
+            num = tuple(Term(f"b{k}", Exponent(float(k), "q") if k else Exponent(0.0)) for k in range(m + 1))
+            den = (Term(1.0, Exponent(0.0)),) + tuple(
+                Term(f"a{k}", Exponent(float(k), "q")) for k in range(1, n + 1)
+            )
+            names = [f"a{k}" for k in range(1, n + 1)] + [f"b{k}" for k in range(m + 1)] + ["q"]
+            params = _parameters(names, table, where, {"q"})
+            s = Structure(
+                f"{name}-n{n}m{m}", num, den, params, family=name, degrees=(n, m), card=source,
+                **common,
+            )
+            bases.append((s, (n, m) in pairs, (n, m) in inv_pairs))
+    else:
+        raise StructureError(f"{where}: unknown family {family!r}; known: 'max-order'")
+    for base, plain, inverse in bases:
+        variants = []
+        if plain:
+            variants.append(base)
+        if inverse:
+            variants.append(inverted_variant(base))
+        for v in variants:
+            out.append(v)
+            if v.exponent_params:
+                out.append(integer_variant(v))
+    return out
+
+
+def _check_n_max(value, what: str) -> int:
+    """``value`` as the highest degree of a max-order family: an integer 1..MAX_DEGREE."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise StructureError(
+            f"{what} must be a whole number from 1 to {MAX_DEGREE}, got {value!r}"
+        )
+    if not 1 <= value <= MAX_DEGREE:
+        raise StructureError(
+            f"{what} must be from 1 to {MAX_DEGREE} (the highest degree of a max-order member; "
+            f"the thesis uses 3), got {value}"
+        )
+    return int(value)
+
+
+def card_paths(extra=()) -> list[Path]:
+    """The card files: the packaged ``models/``, then ``$BAYESFO_MODEL_PATH``, then ``extra``.
+
+    ``extra`` entries may be card files or directories of cards.
+    """
+    paths = sorted(
+        Path(str(p)) for p in resources.files("bayesfo.models").iterdir() if p.name.endswith(".toml")
+    )
+    dirs = [d for d in os.environ.get(MODEL_PATH_ENV, "").split(os.pathsep) if d]
+    for entry in [*dirs, *extra]:
+        entry = Path(entry)
+        if entry.is_dir():
+            paths.extend(sorted(entry.glob("*.toml")))
+        elif entry.is_file():
+            paths.append(entry)
+        elif entry.exists():
+            raise StructureError(f"model card path '{entry}' is not a regular file or a directory")
+        else:
+            raise StructureError(f"model card path '{entry}' does not exist")
+    return paths
+
+
+#: Largest card file (bytes): a card is a few dozen lines.
+MAX_CARD_BYTES = 1024 * 1024
+
+
+def load_library(extra=(), n_max: int | None = None) -> dict[str, Structure]:
+    """Every structure of every card, by name.
+
+    Parameters
+    ----------
+    extra : sequence of path-like
+        Additional card files or directories (a user's own structures).
+    n_max : int, optional
+        Highest order of the max-order family (default: the card's ``n_max``, 3).
+
+    Raises
+    ------
+    StructureError
+        For an unreadable card, or two cards declaring the same structure name.
+    """
+    if n_max is not None:
+        _check_n_max(n_max, "argument 'n_max'")
+    library: dict[str, Structure] = {}
+    cards = []
+    for i, path in enumerate(card_paths(extra)):
+        try:
+            text = read_text_file(path, "card", max_bytes=MAX_CARD_BYTES)
+        except InputError as exc:
+            raise StructureError(str(exc)) from None
+        try:
+            card = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise StructureError(f"card '{path}' is not valid TOML: {exc}") from None
+        except RecursionError:
+            raise StructureError(f"card '{path}' is not valid TOML: arrays or tables nested "
+                                 "too deeply") from None
+        order = card.get("order", 1000)
+        if isinstance(order, bool) or not isinstance(order, (int, float)) or not math.isfinite(order):
+            raise StructureError(f"card '{path}': 'order' must be a finite number, got {order!r}")
+        cards.append((order, i, path, card))
+    for _, _, path, card in sorted(cards, key=lambda c: c[:2]):
+        for s in structures_from_card(card, source=str(path), n_max=n_max):
+            if s.name in library:
+                raise StructureError(
+                    f"card '{path}' declares structure '{s.name}', already declared by "
+                    f"card '{library[s.name].card}'"
+                )
+            library[s.name] = s
+    return library
+
+
+_DEFAULT_LIBRARY: dict[str, Structure] | None = None
+
+
+def default_library() -> dict[str, Structure]:
+    """The packaged structures (cached)."""
+    global _DEFAULT_LIBRARY
+    if _DEFAULT_LIBRARY is None:
+        _DEFAULT_LIBRARY = load_library()
+    return _DEFAULT_LIBRARY
+
+
+def get_structure(name: str, library: dict[str, Structure] | None = None) -> Structure:
+    """The structure called ``name`` (e.g. ``"zener"``, ``"max-n2m1"``, ``"zener-inv-int"``)."""
+    library = default_library() if library is None else library
+    try:
+        return library[name]
+    except KeyError:
+        raise StructureError(
+            f"unknown structure {show(str(name))}; known structures: "
+            f"{', '.join(_short_list(library))}"
+        ) from None
+
+
+def _short_list(library) -> list[str]:
+    bases = [n for n, s in library.items() if not (s.inverted or s.integer)]
+    return bases + ["NAME-int", "NAME-inv", "maxN", "all"]
+
+
+def resolve_structures(spec: str | list[str], library: dict[str, Structure] | None = None) -> list[Structure]:
+    """Structures named by a comma list with the shortcuts ``maxN`` and ``all``.
+
+    ``maxN`` is every max-order member with n ≤ N (``maxN-inv``: the inverted members with
+    m ≤ N); ``all`` is every structure of the library with all its variants.
+    """
+    library = default_library() if library is None else library
+    if isinstance(spec, str):
+        names = spec.split(",")
+    elif isinstance(spec, (list, tuple)) and all(isinstance(n, str) for n in spec):
+        names = list(spec)
+    else:
+        raise StructureError(f"structures must be given as a comma list of names, got {spec!r}")
+    out: list[Structure] = []
+    for raw in names:
+        name = raw.strip()
+        if not name:
+            raise StructureError(f"empty structure name in {spec!r}")
+        m = re.fullmatch(r"max([0-9]+)(-inv)?(-int)?", name)
+        if name == "all":
+            chosen = list(library.values())
+        elif m:
+            limit, inv, integer = int(m.group(1)), bool(m.group(2)), bool(m.group(3))
+            members = [s for s in library.values() if s.degrees is not None and s.family == "max"]
+            if not members:
+                raise StructureError(
+                    f"'{name}': the library has no max-order family (a card with "
+                    "name = \"max\" and family = \"max-order\")"
+                )
+            top = max(s.degrees[1] if s.inverted else s.degrees[0] for s in members)
+            if not 1 <= limit <= top:
+                raise StructureError(
+                    f"'{name}' asks for the max-order members up to degree {limit}, but the "
+                    f"library has them up to {top}: use max1 to max{top}, or raise n_max in "
+                    f"the card '{members[0].card}' (at most {MAX_DEGREE})"
+                )
+            chosen = [
+                s for s in members
+                if s.inverted == inv and s.integer == integer
+                and (s.degrees[1] if inv else s.degrees[0]) <= limit
+            ]
+        else:
+            chosen = [get_structure(name, library)]
+        for s in chosen:
+            if s not in out:
+                out.append(s)
+    return out
+

@@ -350,6 +350,7 @@ def test_trace_shows_every_walker(comparison):
     # whose draws are drawn as one histogram per parameter instead).
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PredictiveWarning)
+        warnings.simplefilter("ignore", DataWarning)  # as in the fixture
         r = compare(comparison.data, [get_structure("voigt")], seed=0, progress=False,
                     sampler="emcee")["voigt"]
     assert r.posterior.sampler == "emcee"

@@ -16,9 +16,14 @@ before step 1 leaves the earlier output as it was (its staging directory is remo
 run); a run killed during steps 2-4 is completed by the next run into the same directory
 (:func:`recover`), as the journal says.
 
-The earlier run's entries are the fixed names a run writes and one NetCDF per structure named in
-its ``summary.json``; a name read from there is only used if it is a single name of the kinds
-bayesfo writes (:func:`is_output_name`). Other files in the output directory are never touched.
+Which entries belong to the earlier run is read from the manifest that every run moves in with
+its outputs, ``.bayesfo-run.json``; a name is only taken from there if it is a single name of the
+kinds bayesfo writes (:func:`is_output_name`). Without a manifest (a directory no run of this
+version wrote into), nothing is taken as the earlier run's: only files of the names the new run
+writes are replaced, and a directory of such a name that no run recorded (a ``figures/`` of your
+own) is refused rather than replaced. Other files in the output directory are never touched.
+Runs into the same directory take turns: a lock (``.bayesfo-lock``) is held while a run swaps
+its outputs in.
 """
 
 from __future__ import annotations
@@ -31,12 +36,15 @@ import re
 import secrets
 import shutil
 import signal
+import time
 from pathlib import Path, PurePosixPath
 
 from ._io import atomic_write_text
 from .errors import InputError, OutputError
 
 JOURNAL = ".bayesfo-swap.json"
+MANIFEST = ".bayesfo-run.json"
+LOCK = ".bayesfo-lock"
 STAGING_PREFIX = ".bayesfo-staging-"
 _FORMAT = 1
 
@@ -44,8 +52,6 @@ _FORMAT = 1
 _OUTPUT_NAME = re.compile(
     r"^(?:summary\.json|ranking\.csv|report\.html|figures|batch\.json|error\.txt"
     r"|[A-Za-z0-9][A-Za-z0-9_.+\-]*\.nc)$")
-#: Entries every kind of run may write besides its NetCDF files.
-FIXED_NAMES = ("summary.json", "ranking.csv", "report.html", "figures", "batch.json", "error.txt")
 #: The names of a run's entries, in the order they are moved out (and, reversed, in).
 _FIRST_OUT = ("summary.json", "batch.json")
 
@@ -75,17 +81,60 @@ def _read_json(path: Path):
 
 
 def owned_entries(out_dir) -> list[str]:
-    """The entries of ``out_dir`` that an earlier bayesfo run wrote and that exist now: the
-    fixed names and one NetCDF per structure of its ``summary.json``, each checked with
-    :func:`is_output_name`."""
+    """The entries of ``out_dir`` that the earlier run recorded in its manifest and that exist
+    now, each checked with :func:`is_output_name` (none without a manifest)."""
     out_dir = Path(out_dir)
-    names = list(FIXED_NAMES)
-    summary = _read_json(out_dir / "summary.json")
-    structures = summary.get("structures") if isinstance(summary, dict) else None
-    if isinstance(structures, list):
-        names += [f"{s.get('name')}.nc" for s in structures if isinstance(s, dict)]
-    return [name for name in dict.fromkeys(names)
+    record = _read_json(out_dir / MANIFEST)
+    names = record.get("entries") if isinstance(record, dict) else None
+    if not isinstance(names, list):
+        return []
+    return [name for name in dict.fromkeys(n for n in names if isinstance(n, str))
             if is_output_name(name) and os.path.lexists(out_dir / name)]
+
+
+def _real_directory(path: Path) -> bool:
+    return path.is_dir() and not path.is_symlink()
+
+
+_OWNER = ".owner"
+
+
+def _claim(staging: Path):
+    """Lock the staging directory's owner file for the life of the run (closed at its end);
+    None where the platform has no file locks."""
+    try:
+        import fcntl
+    except ImportError:
+        return None
+    fd = os.open(staging / _OWNER, os.O_RDWR | os.O_CREAT, 0o644)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    return fd
+
+
+def _abandoned(staging: Path) -> bool:
+    """Whether no live run owns ``staging`` (its owner file is not locked by another process;
+    a staging directory without one is taken as abandoned once it is a minute old)."""
+    owner = staging / _OWNER
+    if not owner.is_file() or owner.is_symlink():
+        try:
+            return time.time() - staging.lstat().st_mtime > 60
+        except OSError:
+            return False
+    try:
+        import fcntl
+    except ImportError:
+        return True
+    try:
+        fd = os.open(owner, os.O_RDWR)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:  # held by a running process
+        return False
+    finally:
+        os.close(fd)
+    return True
 
 
 def _order(names, first) -> list[str]:
@@ -96,6 +145,8 @@ def _swap(out_dir: Path, staging: Path, old: list[str], new: list[str]) -> None:
     """Steps 2-4 of the module docstring; safe to repeat after an interruption."""
     src, trash = staging / "new", staging / "old"
     trash.mkdir(exist_ok=True)
+    if not (_real_directory(src) and _real_directory(trash)):  # never renamed through a link
+        raise OutputError(f"the staging directory '{staging}' is not bayesfo's; remove it")
     for name in _order(old, _FIRST_OUT):
         # An entry that is also new and has already been moved in is the new one: keep it.
         if name in new and not os.path.lexists(src / name):
@@ -117,25 +168,36 @@ def _swap(out_dir: Path, staging: Path, old: list[str], new: list[str]) -> None:
 def recover(out_dir) -> None:
     """Complete a swap that an interrupted run left in ``out_dir`` (its journal), and delete the
     staging directories of runs that never reached the swap. Does nothing in a directory that
-    does not exist or holds no such leftovers."""
+    does not exist or holds no such leftovers; waits for a run that is swapping its outputs in."""
     out_dir = Path(out_dir)
-    if not out_dir.is_dir():
+    if not _real_directory(out_dir) or not any(out_dir.glob(".bayesfo-s*")):
         return
+    with _locked(out_dir):
+        _recover_unlocked(out_dir)
+
+
+def _recover_unlocked(out_dir: Path, keep: str | None = None) -> None:
     record = _read_json(out_dir / JOURNAL)
     if isinstance(record, dict):
         staging_name = record.get("staging")
         old, new = record.get("old"), record.get("new")
-        if (isinstance(staging_name, str) and staging_name.startswith(STAGING_PREFIX)
+        staging = out_dir / staging_name if isinstance(staging_name, str) else None
+        if (staging is not None and staging_name.startswith(STAGING_PREFIX)
                 and "/" not in staging_name and isinstance(old, list) and isinstance(new, list)
-                and all(is_output_name(n) for n in old + new)
-                and (out_dir / staging_name).is_dir()
-                and not (out_dir / staging_name).is_symlink()):
-            _swap(out_dir, out_dir / staging_name, old, new)
+                and all(isinstance(n, str) and (is_output_name(n) or n == MANIFEST)
+                        for n in old + new)
+                and _real_directory(staging) and _real_directory(staging / "new")
+                and (not os.path.lexists(staging / "old") or _real_directory(staging / "old"))):
+            _swap(out_dir, staging, old, new)
     (out_dir / JOURNAL).unlink(missing_ok=True)
+    # A staging directory without a journal belongs to a run that died before its swap, or to
+    # one still writing in another process (which holds the lock on its owner file).
     for leftover in out_dir.glob(STAGING_PREFIX + "*"):
+        if leftover.name == keep:
+            continue
         if leftover.is_symlink() or not leftover.is_dir():
             leftover.unlink(missing_ok=True)
-        else:
+        elif _abandoned(leftover):
             shutil.rmtree(leftover, ignore_errors=True)
 
 
@@ -147,18 +209,31 @@ def _describe_os_error(exc: OSError, out_dir: Path) -> str:
     return f"cannot write into '{out_dir}': {exc.strerror or exc}"
 
 
-def check_output_directory(out_dir, option: str = "--out") -> Path:
+def check_output_directory(out_dir, option: str = "--out", directories=()) -> Path:
     """Create ``out_dir`` if missing and make sure files can be written into it, before any
     work starts.
+
+    Parameters
+    ----------
+    directories : sequence of str
+        Directory entries the run will write (``figures``): one that exists in ``out_dir``
+        without an earlier run having recorded it is refused now, not after the work.
 
     Raises
     ------
     InputError
-        If it is a file, lies below a file, or cannot be created or written to.
+        If it is a file, lies below a file, cannot be created or written to, or holds one of
+        ``directories`` that no bayesfo run recorded.
     """
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"{option} '{out_dir}' is a file, not a directory; give a directory")
+    foreign = [n for n in directories
+               if _real_directory(out_dir / n) and n not in owned_entries(out_dir)]
+    if foreign:
+        raise InputError(f"{option} '{out_dir}' holds a directory '{foreign[0]}' that no "
+                         "bayesfo run recorded; bayesfo would replace it: move it away or "
+                         "choose another output directory")
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         probe = out_dir / f"{STAGING_PREFIX}probe-{secrets.token_hex(4)}"
@@ -176,28 +251,59 @@ def check_output_directory(out_dir, option: str = "--out") -> Path:
 
 
 @contextlib.contextmanager
+def _locked(out_dir: Path):
+    """Hold the output directory's lock (waiting for another run's swap to finish)."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: runs into one directory must not overlap
+        yield
+        return
+    fd = os.open(out_dir / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """Ctrl-C and SIGTERM wait until the block is done (where the platform allows it)."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+@contextlib.contextmanager
 def staged_run(out_dir):
     """Write one run's outputs into ``out_dir`` as one unit.
 
     Yields the staging directory to write every output into (top-level names as in the output
     directory). When the block ends without an exception, the earlier run's entries are replaced
-    by the new ones (see the module docstring); when it raises
-    (``KeyboardInterrupt`` included), the staging directory is deleted and the earlier output
-    stays as it was.
+    by the new ones (see the module docstring); when it raises (``KeyboardInterrupt``
+    included), the staging directory is deleted and the earlier output stays as it was.
 
     Raises
     ------
     OutputError
-        If the outputs cannot be written (no space left, permissions); the earlier outputs stay.
+        If the outputs cannot be written (no space left, permissions), or a new entry would
+        replace a directory that no bayesfo run recorded; the earlier outputs stay.
     """
     out_dir = Path(out_dir)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
-        recover(out_dir)
         staging = out_dir / f"{STAGING_PREFIX}{secrets.token_hex(6)}"
-        (staging / "new").mkdir(parents=True)
+        staging.mkdir()
+        owner = _claim(staging)
+        (staging / "new").mkdir()
     except OSError as exc:
         raise OutputError(_describe_os_error(exc, out_dir)) from None
+    swapping = False  # from the journal on, the staging directory holds both runs' files
     try:
         yield staging / "new"
         new = sorted(p.name for p in (staging / "new").iterdir()
@@ -205,25 +311,40 @@ def staged_run(out_dir):
         bad = [n for n in new if not is_output_name(n)]
         if bad:
             raise ValueError(f"output entry {bad[0]!r} is not a name a run may write")
-        old = owned_entries(out_dir)
-        atomic_write_text(out_dir / JOURNAL, json.dumps(
-            {"format": _FORMAT, "staging": staging.name, "old": old, "new": new}))
-    except OSError as exc:
+        atomic_write_text(staging / "new" / MANIFEST,
+                          json.dumps({"format": _FORMAT, "entries": new}, indent=2) + "\n")
+        with _locked(out_dir):
+            _recover_unlocked(out_dir, keep=staging.name)
+            old = owned_entries(out_dir)
+            foreign = [n for n in new if n not in old and _real_directory(out_dir / n)]
+            if foreign:
+                raise OutputError(
+                    f"'{out_dir / foreign[0]}' is a directory that no bayesfo run recorded; "
+                    "bayesfo would replace it: move it away or choose another output directory")
+            if os.path.lexists(out_dir / MANIFEST):
+                old.append(MANIFEST)
+            # From the journal on, the swap only renames (milliseconds): Ctrl-C and SIGTERM
+            # wait until it is done, and a SIGKILL in between is completed by the next run.
+            with _signals_held():
+                atomic_write_text(out_dir / JOURNAL, json.dumps(
+                    {"format": _FORMAT, "staging": staging.name, "old": old,
+                     "new": new + [MANIFEST]}))
+                swapping = True
+                _swap(out_dir, staging, old, new + [MANIFEST])
+    except BaseException as exc:
+        if swapping:  # never delete: the journal lets the next run complete the swap
+            if isinstance(exc, OSError):
+                raise OutputError(f"the outputs were not all moved into '{out_dir}' "
+                                  f"({exc.strerror or exc}); the next run into it completes "
+                                  "the move") from None
+            raise
         shutil.rmtree(staging, ignore_errors=True)
-        (out_dir / JOURNAL).unlink(missing_ok=True)
-        raise OutputError(_describe_os_error(exc, out_dir)) from None
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        (out_dir / JOURNAL).unlink(missing_ok=True)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise OutputError(_describe_os_error(exc, out_dir)) from None
         raise
-    # From here on the swap only renames (milliseconds): Ctrl-C and SIGTERM wait until it is
-    # done, and a SIGKILL in between is completed by the next run's recover().
-    held = {signal.SIGINT, signal.SIGTERM}
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    try:
-        _swap(out_dir, staging, old, new)
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        if owner is not None:
+            os.close(owner)
 
 
 def final_path(path, staging, out_dir) -> Path:

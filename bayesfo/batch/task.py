@@ -93,8 +93,11 @@ def run_task(task: dict) -> dict:
             out["compare_cpu_seconds"] = time.process_time() - c1
             with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
                 write_outputs(comparison, tmp, figures=opts["figures"])
+                # The outputs, without the bookkeeping of the run's own output directory
+                # (manifest, lock), which the store writes for the data set's directory.
                 out["files"] = {f.relative_to(tmp).as_posix(): f.read_bytes()
-                                for f in sorted(Path(tmp).rglob("*")) if f.is_file()}
+                                for f in sorted(Path(tmp).rglob("*"))
+                                if f.is_file() and not f.name.startswith(".bayesfo-")}
     except InputError as exc:
         out.update(status=INPUT_ERROR, error=str(exc), files={})
     except Exception as exc:  # recorded per data set: one failure never stops the batch

@@ -50,7 +50,8 @@ def run(args) -> int:
     unknown = [k for k in priors if k not in known]
     if unknown:
         raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
-    out = check_output_directory(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
+    out = check_output_directory(args.out if args.out else f"bayesfo-{Path(args.data).stem}",
+                                 directories=() if args.no_figures else ("figures",))
     progress = not args.quiet and sys.stderr.isatty()
     holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,

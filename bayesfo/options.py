@@ -108,6 +108,9 @@ def check_options(options: dict, where: str) -> dict:
     opts = {**DEFAULT_OPTIONS, **options}
     if opts["kind"] is not None and opts["kind"] not in KINDS:
         raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {opts['kind']!r}")
+    if opts["evidence"] not in EVIDENCE_ROUTES:
+        raise InputError(f"{where}: evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
+                         f"got {opts['evidence']!r}")
     if opts["sampler"] not in SAMPLERS:
         raise InputError(f"{where}: sampler must be one of {', '.join(SAMPLERS)}, "
                          f"got {opts['sampler']!r}")

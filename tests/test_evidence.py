@@ -192,3 +192,22 @@ def test_importance_sampling_matches_closed_form(linear_case):
         # Monte Carlo error of a mean from the resampled draws: about sd / sqrt(n_draws).
         assert abs(got.mean - mean[i]) < 4 * sd[i] / np.sqrt(post.samples.shape[0]), name
         assert got.sd == pytest.approx(sd[i], rel=0.08), name
+
+
+def test_importance_proposal_of_an_ill_conditioned_peak():
+    """A sharp and a flat direction (condition 1e20, as a Maxwell on data of 1e-8 relative
+    noise gives): the proposal draws and its density stay finite, where a Cholesky factor of
+    the covariance fails; the density matches scipy's multivariate t."""
+    from scipy import stats
+
+    from bayesfo.inference.importance import DF, _mvt
+
+    w = np.array([1e20, 1.0])  # precision eigenvalues
+    v = np.array([[np.cos(0.3), -np.sin(0.3)], [np.sin(0.3), np.cos(0.3)]])
+    x, log_pdf = _mvt([(w, v)], np.zeros((1, 2)), np.zeros(1), 500, np.random.default_rng(0))
+    assert np.all(np.isfinite(x)) and np.all(np.isfinite(log_pdf(x)))
+    cov = (v / np.array([1e4, 1.0])) @ v.T  # a well-conditioned case, against scipy
+    w2, v2 = np.linalg.eigh(np.linalg.inv(cov))
+    y, log_pdf2 = _mvt([(w2, v2)], np.ones((1, 2)), np.zeros(1), 50, np.random.default_rng(1))
+    ref = stats.multivariate_t(loc=np.ones(2), shape=cov, df=DF).logpdf(y)
+    np.testing.assert_allclose(log_pdf2(y), ref, rtol=1e-10)

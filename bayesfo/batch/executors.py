@@ -17,24 +17,6 @@ from .task import INPUT_ERROR, OK, run_task
 SCHEDULER_TIMEOUT = 15.0
 
 
-# BLAS/OpenMP thread pools of the worker processes: one thread each, as the workers already use
-# the cores (set before the worker imports numpy, unless the user set them).
-
-
-
-
-# ---------------------------------------------------------------------- temperatures
-
-
-# ---------------------------------------------------------------------- inputs and manifests
-
-
-
-
-
-
-
-
 def _run_in_process(todo, on_result):
     for ds in todo:
         on_result(ds, run_task(ds.task()))

@@ -115,7 +115,10 @@ def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
     # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
     # from the prior instead (ladder_evidence), proposing from the draws as well so that it
     # keeps the narrow modes the walkers found.
-    ladder = route == "ladder" or (route == "auto" and not post.converged)
+    # Importance draws are a resample (duplicates): without the weights' own ln Z (k̂ ≥ 0.5)
+    # they go to the ladder, not to bridge sampling.
+    ladder = route == "ladder" or (route == "auto" and (
+        not post.converged or getattr(post, "sampler", "emcee") == "importance"))
     try:
         if importance is not None and route == "auto":
             # The certified importance weights that gave the posterior give ln Z too.

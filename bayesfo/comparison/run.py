@@ -1,21 +1,23 @@
 """Run structures on one data set and rank them: the engine behind ``bayesfo compare``.
 
 For every structure: the global least-squares optimisation (modes and a maximum-likelihood
-start), the emcee posterior, and the criteria that follow from them: maximum log-likelihood,
-AIC, AICc, BIC (from the higher of the optimiser's and the sampler's maximum), WAIC and PSIS-LOO
-(arviz, pointwise per frequency), RMSE at the posterior mode (thesis eq. (3.23)), and the
-log-evidence ln Z by bridge sampling from the posterior draws, or from the particles of a
-tempered ladder where the posterior did not converge (optionally checked by dynesty nested
-sampling, with a flag when the two disagree by more than twice their combined error).
-Structures are ranked by ln Z; posterior model probabilities assume equal prior odds unless
-given.
+start); a certified posterior, by importance sampling from the optima where its weights certify
+it (:mod:`bayesfo.inference.importance`), else emcee, and where the walkers do not converge the
+particles of the tempered ladder if its independent runs agree; the criteria that follow:
+maximum log-likelihood, AIC, AICc, BIC (from the higher of the optimiser's and the sampler's
+maximum), WAIC and PSIS-LOO (arviz, pointwise per frequency), RMSE at the posterior mode (thesis
+eq. (3.23)); the log-evidence ln Z from the route that gave the posterior (optionally checked by
+dynesty nested sampling, flagged when the two disagree by more than twice their combined error);
+and the posterior predictive adequacy checks (:mod:`bayesfo.inference.adequacy`). Structures are
+ranked by ln Z; posterior model probabilities assume equal prior odds unless given.
 
 Structures run one after the other or side by side in worker processes (``workers``); each runs
 with the same seed, so the numbers do not depend on how many.
 
-Outputs (:func:`write_outputs`, each file written atomically): one ``<structure>.nc`` (arviz
-InferenceData) per structure, ``figures/`` and ``report.html`` (:mod:`bayesfo.plotting`,
-:mod:`bayesfo.report`), ``ranking.csv`` and ``summary.json`` (the contract of DESIGN.md), last.
+Outputs (:func:`~bayesfo.comparison.output.write_outputs`, staged and swapped in as one run by
+:mod:`bayesfo.outdir`): one ``<structure>.nc`` (arviz InferenceData) per structure,
+``figures/`` and ``report.html`` (:mod:`bayesfo.plotting`, :mod:`bayesfo.report`),
+``ranking.csv`` and ``summary.json`` (the contract of DESIGN.md).
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from ..inference import Likelihood, run_posterior
 from ..inference.adequacy import check_adequacy
 from ..inference.importance import importance_posterior
 from ..inference.posterior import posterior_from_particles
-from ..options import SAMPLERS
+from ..options import EVIDENCE_ROUTES, SAMPLERS
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
 from .criteria import _criteria, _evidence, _holdout, _model_probabilities
@@ -60,14 +62,15 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     evidence : {"auto", "bridge", "ladder"}
         How ln Z is computed: bridge sampling from the emcee draws (``"bridge"``), or from the
         particles of a tempered ladder (``"ladder"``, sequential Monte Carlo from the prior,
-        seconds per structure); ``"auto"`` takes the draws where the posterior converged and
-        the ladder where it did not.
+        seconds per structure); ``"auto"`` takes the certified importance weights where they
+        gave the posterior (k̂ < 0.5), the emcee draws where the walkers converged, and the
+        ladder otherwise.
     sampler : {"auto", "emcee"}
         How each posterior is computed. ``"auto"``: importance sampling from the optima where
         its weights certify it (Pareto k̂ < 0.7, ESS ≥ 1000; well-posed structures, a fraction
         of a second), else emcee, and where the walkers do not converge the tempered ladder's
-        particles (see :mod:`bayesfo.inference.importance`). ``"emcee"``: emcee first, as
-        before 0.2.
+        particles (see :mod:`bayesfo.inference.importance`). ``"emcee"``: emcee first.
+        ``evidence="bridge"`` implies emcee (bridge sampling uses its draws).
     evidence_check : bool
         Also compute ln Z by dynesty nested sampling and flag disagreements with the default
         estimate larger than twice the combined error (slower: seconds to minutes each).
@@ -102,8 +105,9 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         raise InputError("no structure to compare")
     if sampler not in SAMPLERS:
         raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}")
-    if evidence not in ("auto", "bridge", "ladder"):
-        raise InputError(f"evidence must be 'auto', 'bridge' or 'ladder', got {evidence!r}")
+    if evidence not in EVIDENCE_ROUTES:
+        raise InputError(f"evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
+                         f"got {evidence!r}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
         raise InputError(f"workers must be a non-negative integer, got {workers!r}")
     if data.n_frequencies > MAX_FREQUENCIES:
@@ -220,10 +224,15 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
             lik = Likelihood(s, data, noise=noise, priors=own)
             fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
             post = ev = None
-            if options["sampler"] == "auto" and fit.optima.size:
+            # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
+            if (options["sampler"] == "auto" and options["evidence"] != "bridge"
+                    and fit.optima.size):
                 modes = lik.structure.to_scaled(
                     lik.structure.to_physical(fit.optima, fit.scaling), lik.scaling)
-                post, ev, info = importance_posterior(lik, modes, seed=seed)
+                try:
+                    post, ev, info = importance_posterior(lik, modes, seed=seed)
+                except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
+                    post = ev = None
             if post is None:
                 post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
                                         fit=fit, progress=False, **options["sampler_kwargs"])

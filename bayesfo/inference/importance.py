@@ -8,7 +8,7 @@ Laplace covariance, each mode weighted by its Laplace mass) is the proposal. One
 call of the likelihood on 20 000 proposal draws gives the importance weights, and from them
 
 * the evidence, ln Z' = ln mean(w), with the standard error of that mean (the prior normalised
-  on its support as elsewhere: ln Z = ln Z' − ln P(S));
+  on its support as elsewhere: ln Z = ln Z' − ln P(S)), where k̂ < 0.5;
 * the posterior, as draws resampled from the Pareto-smoothed weights.
 
 The certificate is the weights themselves (Vehtari et al. 2024, Pareto smoothed importance
@@ -39,6 +39,8 @@ from .likelihood import Likelihood
 #: reliable estimates) and at least this many effective draws.
 K_HAT_MAX = 0.7
 ESS_MIN_IMPORTANCE = 1000
+#: ln Z from the raw weights needs their variance finite: k̂ below 0.5.
+K_HAT_EVIDENCE = 0.5
 
 DF = 5.0        # Student-t degrees of freedom: heavier tails than the Laplace approximation
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
@@ -74,8 +76,10 @@ def _hessian(f, u0: np.ndarray, h: np.ndarray):
 
 
 def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: int = 4):
-    """The mode near ``u0`` (a few Newton steps on the log posterior) and the covariance of
-    the Laplace approximation there; None where the curvature is not that of a peak."""
+    """The mode near ``u0`` (a few Newton steps on the log posterior) and the Laplace
+    approximation there, as the eigenvalues and eigenvectors ``(w, v)`` of its precision
+    (directions without curvature floored, see below); None where the difference stencil
+    leaves the support or the Hessian is singular or not finite."""
     span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u0))
     h = 1e-4 * span
     # An optimum on a bound of the prior box (a coefficient at its smallest value) is moved just
@@ -108,29 +112,31 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
     # the weights decides whether that describes the posterior.
     broad = (np.max(span[np.isfinite(span)]) / 4.0) ** 2
     w = np.where(w > 1.0 / broad, w, 1.0 / broad)
-    cov = (v / w) @ v.T
-    # The approximation must fit inside the prior box: a mode whose 3-sd ellipse crosses a
-    # bound sits on a boundary, where the curvature does not describe the posterior.
-    return f0, u, cov
+    return f0, u, (w, v)
 
 
-def _mvt(chols, means, log_weights, n: int, rng: np.random.Generator):
-    """Draws from a mixture of multivariate t (``DF``) and the log density of any points."""
+def _mvt(factors, means, log_weights, n: int, rng: np.random.Generator):
+    """Draws from a mixture of multivariate t (``DF``) and the log density of any points.
+
+    Each component is given by its mean and a factor A with covariance A Aᵀ: ``(w, v)`` of the
+    eigendecomposition, A = v·diag(1/sqrt(w)) (no Cholesky: the Laplace covariances of
+    structures with a sharp and a flat direction have condition numbers near 1e20)."""
     k, d = means.shape
     p = np.exp(log_weights - logsumexp(log_weights))
     which = rng.choice(k, size=n, p=p)
     z = rng.standard_normal((n, d))
     g = rng.chisquare(DF, size=n) / DF
-    x = means[which] + np.einsum("nij,nj->ni", chols[which], z) / np.sqrt(g)[:, None]
+    a = np.array([v / np.sqrt(w) for w, v in factors])
+    x = means[which] + np.einsum("nij,nj->ni", a[which], z) / np.sqrt(g)[:, None]
 
     def log_pdf(y):
         terms = []
         const = gammaln((DF + d) / 2) - gammaln(DF / 2) - 0.5 * d * math.log(DF * math.pi)
-        for lw, mean, chol in zip(log_weights - logsumexp(log_weights), means, chols,
-                                  strict=True):
-            sol = np.linalg.solve(chol, (y - mean).T)
-            maha = np.sum(sol * sol, axis=0)
-            log_det = np.sum(np.log(np.diag(chol)))
+        for lw, mean, (w, v) in zip(log_weights - logsumexp(log_weights), means, factors,
+                                    strict=True):
+            proj = (y - mean) @ v  # coordinates along the eigenvectors
+            maha = np.sum(proj * proj * w, axis=1)
+            log_det = -0.5 * np.sum(np.log(w))  # log sqrt(det covariance)
             terms.append(lw + const - log_det - 0.5 * (DF + d) * np.log1p(maha / DF))
         return logsumexp(np.array(terms), axis=0)
 
@@ -158,9 +164,11 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
 
     Returns
     -------
-    (PosteriorResult, Evidence, dict) or (None, None, dict)
-        The dict states the certificate (``k_hat``, ``ess``, ``n_modes``, ``seconds``) or, when
-        the route does not apply, ``reason``.
+    (PosteriorResult, Evidence or None, dict) or (None, None, dict)
+        The dict states the certificate (``k_hat``, ``ess`` of the weights, ``n_modes``,
+        ``seconds``) or, when the route does not apply, ``reason``. The evidence is None when
+        0.5 ≤ k̂ < 0.7 (see :data:`K_HAT_EVIDENCE`). The posterior's ESS is that of the
+        resampled draws, 1/(1/ESS_weights + 1/n_draws).
     """
     from .evidence import Evidence, log_support_fraction
     from .posterior import _log_prob_fn, _Transform, result_from_draws
@@ -181,16 +189,17 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
             continue
         peak = _laplace(log_prob, u0, tr.lo_u, tr.hi_u)
         if peak is None:
-            return None, None, {"reason": "a mode is not a regular peak (boundary or ridge)"}
+            return None, None, {"reason": "no curvature at an optimum (the support ends or "
+                                          "the Hessian is singular there)"}
         if not any(np.allclose(peak[1], p[1], rtol=1e-6, atol=1e-8) for p in peaks):
             peaks.append(peak)
     if not peaks:
         return None, None, {"reason": "no optimum lies in the support"}
     means = np.array([p[1] for p in peaks])
-    chols = np.array([np.linalg.cholesky(SCALE**2 * p[2]) for p in peaks])
+    factors = [(w / SCALE**2, v) for _, _, (w, v) in peaks]
     # Each mode weighted by its Laplace mass: height × sqrt(det covariance).
-    log_weights = np.array([p[0] + 0.5 * np.linalg.slogdet(p[2])[1] for p in peaks])
-    x, log_q = _mvt(chols, means, log_weights, n_proposals, rng)
+    log_weights = np.array([p[0] - 0.5 * np.sum(np.log(p[2][0])) for p in peaks])
+    x, log_q = _mvt(factors, means, log_weights, n_proposals, rng)
     lp = log_prob(x)
     log_w = np.where(np.isfinite(lp), lp - log_q(x), -np.inf)
     finite = np.isfinite(log_w)
@@ -207,7 +216,9 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
                           f"{ess:.0f})")
         return None, None, info
     # Evidence: the mean of the raw weights over every proposal draw (zero outside the
-    # support), with the standard error of a mean.
+    # support), with the standard error of a mean. That error needs weights of finite
+    # variance, k̂ < 0.5; between 0.5 and 0.7 the smoothed weights still give the posterior,
+    # but ln Z is left to the tempered ladder.
     lw_all = np.where(finite, log_w, -np.inf)
     log_z_support = float(logsumexp(lw_all) - math.log(n_proposals))
     rel = np.exp(lw_all - log_z_support)
@@ -222,12 +233,17 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     draws_u = x[finite][idx][rng.permutation(n_draws)]
     per_chain = n_draws // chains
     chain_u = draws_u[: per_chain * chains].reshape(chains, per_chain, -1)
+    # The reported draws are a resample: their effective size is that of the weights and of
+    # the resampling together.
+    ess_draws = 1.0 / (1.0 / ess + 1.0 / (per_chain * chains))
     post = result_from_draws(lik, chain_u, sampler="importance", rhat=math.nan,
-                             ess_bulk=ess, ess_tail=ess, messages=(), converged=True,
-                             seed=seed, predictive=predictive)
+                             ess_bulk=ess_draws, ess_tail=ess_draws, messages=(),
+                             converged=True, seed=seed, predictive=predictive)
     info["seconds"] = time.perf_counter() - t0
-    evidence = Evidence(log_z=log_z_support - log_s,
-                        log_z_err=math.sqrt(min(rel_err, 1.0) ** 2 + log_s_err**2),
-                        method="importance", log_support=log_s,
-                        n_likelihood=int(n_proposals), seconds=info["seconds"])
+    evidence = None
+    if k_hat < K_HAT_EVIDENCE:
+        evidence = Evidence(log_z=log_z_support - log_s,
+                            log_z_err=math.sqrt(min(rel_err, 1.0) ** 2 + log_s_err**2),
+                            method="importance", log_support=log_s,
+                            n_likelihood=int(n_proposals), seconds=info["seconds"])
     return post, evidence, info

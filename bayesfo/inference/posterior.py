@@ -463,8 +463,9 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
     reported. The certificate is the agreement of the runs: each run is one chain of the
     rank-normalised split R-hat, and the bulk and tail ESS are computed over the runs (the
     particles of a run are put in random order first: their order after resampling follows
-    their ancestors, not a chain). The ESS is capped by the number of distinct particles, since
-    resampling duplicates some.
+    their ancestors, not a chain). That ESS is an upper bound (particles of a run that share
+    ancestors count as independent), capped by the number of distinct particles: the
+    certificate rests on R-hat, the agreement of runs that share nothing but the guide.
 
     Parameters
     ----------

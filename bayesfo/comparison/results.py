@@ -81,6 +81,10 @@ class StructureResult:
             ess_tail_min=post.ess_tail_min, converged=post.converged, tau_max=float(np.max(post.tau)),
             n_steps=post.n_steps, n_draws=int(post.samples.shape[0]), messages=list(post.messages),
             sampler=getattr(post, "sampler", "emcee"),
+            # The certificate of an importance-sampled posterior: Pareto k of its weights, their
+            # ESS and the optima the proposal covered.
+            importance=None if self.criteria.get("importance") is None else {
+                k: v for k, v in self.criteria["importance"].items() if k != "seconds"},
             adequacy=None if self.adequacy is None else self.adequacy.to_dict(),
             warnings=self.criteria["warnings"],
             optimum={"parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),

@@ -310,3 +310,17 @@ def test_adequacy_of_every_structure(voigt_comparison):
     alone = dataclasses.replace(result, results=(result["voigt-int"],))
     text, flagged = next((t, f) for t, f in verdict(alone) if t.startswith("None of"))
     assert flagged and "voigt-int: residuals are correlated along frequency" in text
+
+
+def test_ranking_figure_names_the_structures_that_misfit(voigt_comparison):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bayesfo.plotting import plot_ranking
+
+    result, _ = voigt_comparison
+    drawn = plot_ranking(result)
+    labels = {t.get_text().split("\n")[0]: t.get_text() for t in drawn.axes[1].get_yticklabels()}
+    assert labels["voigt-int"].endswith("misfits the data")
+    assert labels["voigt"] == "voigt" and labels["zener"] == "zener"
+    assert list(drawn.values["fits"]) == [result[n].fits for n in result.ranking]

@@ -51,6 +51,14 @@ def _set_delta_scale(ax, values) -> None:
     ax.xaxis.set_minor_locator(NullLocator())
 
 
+def _label(name: str, converged: bool, fits: str) -> str:
+    """A structure's tick label, with what the reader must know about it: a posterior that is
+    not certified, and a structure that does not describe the data (adequacy checks)."""
+    notes = [] if converged else ["not converged"]
+    notes += {"no": ["misfits the data"], "small": ["small misfit"]}.get(fits, [])
+    return "\n".join([name, *notes])
+
+
 def plot_ranking(comparison, fig=None) -> Drawn:
     """The structures' log-evidence and information criteria relative to the best.
 
@@ -77,7 +85,9 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         ``axes`` = (evidence, criteria). ``values`` (one entry per ranked structure, top to
         bottom): ``"structures"``, ``"y"``, ``"delta_log_evidence"``, ``"log_evidence_err"``,
         ``"posterior_probability"``, ``"delta_loo"``, ``"delta_loo_se"``, ``"delta_aic_half"``,
-        ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing). ``artists``:
+        ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing), ``"fits"``
+        (``"yes"``, ``"small"``, ``"no"`` from the adequacy checks; labels say "misfits the
+        data" or "small misfit"). ``artists``:
         ``"<name>/log_evidence"`` (``ErrorbarContainer``) and one ``ErrorbarContainer`` per
         criterion under its value key.
 
@@ -105,6 +115,7 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         "delta_aic_half": np.array([-(r["aic"] - best_aic) / 2 for r in rows], float),
         "delta_bic_half": np.array([-(r["bic"] - best_bic) / 2 for r in rows], float),
         "converged": np.array([bool(r["converged"]) for r in rows]),
+        "fits": np.array([r.get("fits") or "" for r in rows]),
     }
     colors = colors_for(comparison.ranking)
     artists = {}
@@ -143,8 +154,8 @@ def plot_ranking(comparison, fig=None) -> Drawn:
                     handletextpad=0.3, columnspacing=0.8)
         for ax in (ax_z, ax_c):
             ax.set_ylim(-0.6, n - 0.4)
-            ax.set_yticks(y, [nm if ok else f"{nm}\nnot converged"
-                              for nm, ok in zip(names, values["converged"])])
+            ax.set_yticks(y, [_label(nm, ok, fit) for nm, ok, fit
+                              in zip(names, values["converged"], values["fits"])])
             ax.grid(axis="y", visible=False)
             for tick, ok in zip(ax.get_yticklabels(), values["converged"]):
                 if not ok:

@@ -59,7 +59,9 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     ``out_dir`` and swapped in at the end (:mod:`bayesfo.outdir`), so ``out_dir`` always holds the
     complete output of one run: an interrupted run leaves the earlier output as it was, and the
     outputs of an earlier run that this one does not write (a structure left out) are removed.
-    Files of the user's own in ``out_dir`` are never touched.
+    Other files in ``out_dir`` are left alone, except files of the very names this run writes
+    (replaced); a directory of such a name that no run recorded (a ``figures/`` of your own)
+    raises :class:`~bayesfo.errors.OutputError` instead of being replaced.
 
     Parameters
     ----------

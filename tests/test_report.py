@@ -141,7 +141,9 @@ def test_ranking_table_numbers_match_the_comparison(comparison):
                 continue
             assert float(value) == row[key], key
             if key in ("log_evidence", "loo", "bic"):
-                assert text == f"{row[key]:.2f}"
+                # A ln Z from the tempered ladder is marked L (as in the terminal table).
+                mark = " L" if key == "log_evidence" and row["evidence_method"] == "ladder" else ""
+                assert text == f"{row[key]:.2f}{mark}"
         assert cells[-1][0] == ("yes" if row["converged"] else "NO")
 
 

@@ -10,8 +10,8 @@ import threading
 import numpy as np
 import pytest
 
-from bayesfo import data as data_module
 from bayesfo.data import FrequencyResponse, read_csv
+from bayesfo.data import csv_reader as data_module  # where the reader reads its limits
 from bayesfo.errors import InputError, StructureError
 from bayesfo.identify import identify
 from bayesfo.identify.linear import _solve_batch

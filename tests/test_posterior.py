@@ -165,7 +165,7 @@ def test_walkers_move_between_the_q_modes_of_a_max_order_member():
 
 
 def test_count_modes_on_known_mixtures():
-    from bayesfo.inference.posterior import _count_modes
+    from bayesfo.inference.results import _count_modes
 
     rng = np.random.default_rng(0)
     assert _count_modes(rng.normal(0.5, 0.02, 4000), 0, 1) == 1
@@ -180,7 +180,8 @@ def test_count_modes_on_known_mixtures():
 
 
 def test_poorly_determined_flag_follows_the_prior_width():
-    from bayesfo.inference.posterior import _summaries, _Transform
+    from bayesfo.inference.results import _summaries
+    from bayesfo.inference.transform import _Transform
 
     s = get_structure("voigt")
     data = _noisy(s, [1.0, 1.0, 0.5], 0.02, seed=9)

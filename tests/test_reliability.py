@@ -91,7 +91,7 @@ def test_a_later_run_leaves_nothing_of_the_earlier_one(comparison, earlier):
 
 
 def test_full_disk_keeps_the_earlier_output(comparison, earlier, monkeypatch):
-    import bayesfo.inference.posterior as posterior
+    import bayesfo.inference.results as posterior  # where save_netcdf checks the space
 
     out, before = earlier
     monkeypatch.setattr(posterior.shutil, "disk_usage", lambda p: shutil._ntuple_diskusage(

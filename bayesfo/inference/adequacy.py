@@ -96,7 +96,7 @@ import numpy as np
 
 from ..errors import InputError
 from .likelihood import Likelihood
-from .posterior import PosteriorResult
+from .results import PosteriorResult
 
 #: Family-wise level of the checks (see the module docstring).
 LEVEL = 0.01

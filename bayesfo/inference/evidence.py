@@ -37,8 +37,9 @@ from scipy.special import logsumexp
 from ..errors import InputError
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
-from .posterior import PosteriorResult, _log_prob_fn, _Transform
+from .results import PosteriorResult
 from .smc import ladder_run
+from .transform import _log_prob_fn, _Transform
 
 
 @dataclass(frozen=True)

@@ -171,7 +171,8 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
         resampled draws, 1/(1/ESS_weights + 1/n_draws).
     """
     from .evidence import Evidence, log_support_fraction
-    from .posterior import _log_prob_fn, _Transform, result_from_draws
+    from .results import result_from_draws
+    from .transform import _log_prob_fn, _Transform
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)

@@ -12,207 +12,35 @@ The run length is set by the integrated autocorrelation time τ (emcee): it cont
 at least ``tau_factor``·τ steps long and τ has settled, up to ``max_steps``. Burn-in is 2·τ_max,
 thinning τ_min/2. Convergence is judged with arviz' rank-normalised split R-hat across four groups
 of walkers and bulk and tail effective sample sizes over walkers; a run that misses them issues a :class:`ConvergenceWarning`
-and has ``converged = False``.
+and has ``converged = False``. The result (:class:`~bayesfo.inference.results.PosteriorResult`)
+and the sampling coordinates (:mod:`bayesfo.inference.transform`) live in their own modules.
 """
 
 from __future__ import annotations
 
-import errno
 import math
-import os
-import shutil
 import sys
-import tempfile
 import warnings
-from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-from .._io import publish
 from ..errors import ConvergenceWarning, InputError
-from ..priors import LogUniform, Uniform
 from ._arviz import arviz
 from .likelihood import Likelihood
+from .results import (
+    ESS_MIN,
+    RHAT_MAX,
+    PosteriorResult,
+    _inference_data,
+    _summaries,
+    posterior_from_particles,
+    result_from_draws,
+    save_netcdf,
+)
+from .transform import _log_prob_fn, _Transform
 
-HDI_PROB = 0.94
-RHAT_MAX = 1.01
-ESS_MIN = 400
-
-
-@dataclass(frozen=True)
-class ParameterSummary:
-    """Posterior summary of one parameter, in physical units.
-
-    ``poorly_determined``: the 94 % HDI covers more than half of the prior range (in the sampling
-    coordinate, i.e. in log for log-uniform priors). ``multimodal``: the marginal density has more
-    than one clearly separated peak.
-    """
-
-    mean: float
-    sd: float
-    hdi_low: float
-    hdi_high: float
-    map: float
-    median: float
-    poorly_determined: bool
-    multimodal: bool
-
-    def to_dict(self) -> dict:
-        return {k: (bool(v) if isinstance(v, (bool, np.bool_)) else float(v))
-                for k, v in self.__dict__.items()}
-
-
-@dataclass(frozen=True, eq=False)
-class PosteriorResult:
-    """Posterior draws of one structure on one data set, with diagnostics.
-
-    Attributes
-    ----------
-    structure : str
-    param_names : tuple of str
-        Structure parameters, then ``sigma``/``sigma_rel`` when the noise is sampled.
-    noise, noise_reason : str
-        The noise model and why it was chosen.
-    samples : ndarray, shape (n_draws, ndim)
-        Thinned post-burn-in draws in physical units (walkers × kept steps).
-    samples_scaled : ndarray
-        The same draws on the scaled problem.
-    log_likelihood : ndarray, shape (n_draws,)
-        Total log-likelihood of each draw (physical units).
-    summary : dict
-        ``{name: ParameterSummary}``.
-    map_theta : ndarray
-        The draw with the highest posterior density (physical units).
-    max_log_likelihood : float
-        Highest log-likelihood among the draws.
-    tau : ndarray
-        Integrated autocorrelation time of each parameter [steps].
-    n_steps, burn, thin, n_walkers : int
-    acceptance : float
-        Mean acceptance fraction.
-    rhat_max, ess_bulk_min, ess_tail_min : float
-    converged : bool
-    messages : tuple of str
-        Warnings raised during the run.
-    sampler : str
-        ``"emcee"``; ``"ladder"`` for the final particles of independent tempered-ladder runs
-        (:func:`posterior_from_particles`; each run is one chain of the diagnostics);
-        ``"importance"`` for draws resampled from certified importance weights
-        (:func:`bayesfo.inference.importance.importance_posterior`; R-hat does not apply, the
-        ESS is that of the weights).
-    idata : arviz.InferenceData
-        Posterior, log_likelihood (per frequency), posterior_predictive, observed_data and
-        sample_stats, coordinates named by frequency.
-    """
-
-    structure: str
-    param_names: tuple[str, ...]
-    noise: str
-    noise_reason: str
-    samples: np.ndarray
-    samples_scaled: np.ndarray
-    log_likelihood: np.ndarray
-    summary: dict
-    map_theta: np.ndarray
-    max_log_likelihood: float
-    tau: np.ndarray
-    n_steps: int
-    burn: int
-    thin: int
-    n_walkers: int
-    acceptance: float
-    rhat_max: float
-    ess_bulk_min: float
-    ess_tail_min: float
-    converged: bool
-    messages: tuple[str, ...] = ()
-    idata: object = field(default=None, repr=False)
-    sampler: str = "emcee"
-
-    @property
-    def ess_min(self) -> float:
-        return min(self.ess_bulk_min, self.ess_tail_min)
-
-    def to_dict(self) -> dict:
-        return {
-            "structure": self.structure,
-            "noise": self.noise,
-            "noise_reason": self.noise_reason,
-            "parameters": {k: v.to_dict() for k, v in self.summary.items()},
-            "max_log_likelihood": self.max_log_likelihood,
-            "tau": dict(zip(self.param_names, map(float, self.tau))),
-            "n_steps": self.n_steps, "burn": self.burn, "thin": self.thin,
-            "n_walkers": self.n_walkers, "n_draws": int(self.samples.shape[0]),
-            "acceptance": self.acceptance,
-            "rhat_max": self.rhat_max, "ess_bulk_min": self.ess_bulk_min,
-            "ess_tail_min": self.ess_tail_min, "ess_min": self.ess_min,
-            "converged": self.converged, "messages": list(self.messages),
-            "sampler": self.sampler,
-        }
-
-
-class _Transform:
-    """θ ↔ u (log for log-uniform priors) and the log-Jacobian.
-
-    In u, uniform and log-uniform priors are flat: their log density is the constant
-    ``flat_const`` inside the box [lo_u, hi_u]; other priors (normal) are evaluated as such.
-    """
-
-    def __init__(self, lik: Likelihood):
-        priors = lik.prior_list
-        self.log = np.array([isinstance(p, LogUniform) for p in priors])
-        flat = np.array([isinstance(p, (LogUniform, Uniform)) for p in priors])
-        lo, hi = np.array([p.bounds for p in priors], dtype=float).T
-        self.lo_u = np.where(self.log, np.log(np.where(self.log, lo, 1.0)), lo)
-        self.hi_u = np.where(self.log, np.log(np.where(self.log, hi, 1.0)), hi)
-        self.flat_const = float(-np.sum(np.log(self.hi_u - self.lo_u)[flat]))
-        self.other = [(i, p) for i, p in enumerate(priors) if not flat[i]]
-
-    def to_theta(self, u):
-        return np.where(self.log, np.exp(np.clip(u, -700, 700)), u)
-
-    def to_u(self, theta):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.log, np.log(np.abs(theta)), theta)
-
-
-def _log_parts_fn(lik: Likelihood, tr: _Transform):
-    """(log prior density in u, log-likelihood) of a batch of points in u, both −inf outside
-    the support; the tempered ladder weighs the two parts differently."""
-    k = lik.structure.n_params
-    kind, grid = lik.data.kind, lik.grid
-
-    def log_parts(u):
-        u = np.atleast_2d(u)
-        log_prior = np.full(u.shape[0], -np.inf)
-        log_lik = np.full(u.shape[0], -np.inf)
-        rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
-        if not rows.size:
-            return log_prior, log_lik
-        theta = tr.to_theta(u[rows])
-        ok = lik.structure.constraints_hold(theta[:, :k], kind, grid)
-        rows, theta = rows[ok], theta[ok]
-        if rows.size:
-            lp = np.full(rows.size, tr.flat_const)
-            for i, prior in tr.other:
-                lp = lp + prior.log_prob(theta[:, i])
-            log_prior[rows] = lp
-            log_lik[rows] = lik(theta)
-        return log_prior, log_lik
-
-    return log_parts
-
-
-def _log_prob_fn(lik: Likelihood, tr: _Transform):
-    """Log posterior density in u (the hot path: one vectorised call per half-ensemble)."""
-    log_parts = _log_parts_fn(lik, tr)
-
-    def log_prob(u):
-        log_prior, log_lik = log_parts(u)
-        return log_prior + log_lik
-
-    return log_prob
+__all__ = ["ConvergenceWarning", "PosteriorResult", "initial_walkers", "posterior_from_particles",
+           "result_from_draws", "sample_posterior", "save_netcdf"]
 
 
 def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.random.Generator,
@@ -452,102 +280,6 @@ def sample_posterior(
     )
 
 
-def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
-                             predictive: bool = True) -> PosteriorResult:
-    """The posterior as the final particles of independent tempered-ladder runs.
-
-    Each run (a :class:`~bayesfo.inference.smc.LadderRun`, or its particles in the sampling
-    coordinates) carries prior draws to the posterior through resampling and Metropolis moves,
-    so its particles are posterior draws that no walker had to reach by a long chain; where
-    the emcee walkers did not converge (ridges, several modes) they are the posterior that is
-    reported. The certificate is the agreement of the runs: each run is one chain of the
-    rank-normalised split R-hat, and the bulk and tail ESS are computed over the runs (the
-    particles of a run are put in random order first: their order after resampling follows
-    their ancestors, not a chain). That ESS is an upper bound (particles of a run that share
-    ancestors count as independent), capped by the number of distinct particles: the
-    certificate rests on R-hat, the agreement of runs that share nothing but the guide.
-
-    Parameters
-    ----------
-    lik : Likelihood
-    runs : sequence of LadderRun or of ndarray, shape (n_particles, ndim)
-        At least two runs, the same number of particles each.
-    seed : int
-        Seed of the shuffle and of the posterior predictive draws.
-    predictive : bool
-        Store the posterior predictive and the model response in the InferenceData.
-
-    Returns
-    -------
-    PosteriorResult
-        With ``sampler="ladder"``; ``n_walkers`` is the number of runs, ``n_steps`` 0 and
-        ``tau`` NaN (no chain); ``converged`` when R-hat < 1.01 and the ESS ≥ 400.
-    """
-    az = arviz()
-    rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
-    chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
-    n_runs, n_kept, _ = chain_u.shape
-    if n_runs < 2:
-        raise ValueError("at least two runs are needed to certify the posterior")
-    chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
-    chains = az.convert_to_dataset({name: tr.to_theta(chain_u)[:, :, i]
-                                    for i, name in enumerate(lik.param_names)})
-    rhat_max = max(float(v) for v in az.rhat(chains).data_vars.values())
-    distinct = float(len(np.unique(chain_u.reshape(-1, chain_u.shape[2]), axis=0)))
-    ess_bulk = min(distinct, min(float(v) for v in az.ess(chains, method="bulk").data_vars.values()))
-    ess_tail = min(distinct, min(float(v) for v in az.ess(chains, method="tail").data_vars.values()))
-    messages = []
-    if not rhat_max < RHAT_MAX:
-        messages.append(f"{lik.structure.name}: the tempered-ladder runs disagree (R-hat "
-                        f"{rhat_max:.3f} is not below {RHAT_MAX})")
-    if not min(ess_bulk, ess_tail) >= ESS_MIN:
-        messages.append(f"{lik.structure.name}: the tempered-ladder particles give an effective "
-                        f"sample size of {min(ess_bulk, ess_tail):.0f}, below {ESS_MIN}")
-    acceptance = [float(np.mean(r.acceptance[-1:])) for r in runs if hasattr(r, "acceptance")]
-    post = result_from_draws(lik, chain_u, sampler="ladder", rhat=rhat_max, ess_bulk=ess_bulk,
-                             ess_tail=ess_tail, messages=tuple(messages),
-                             converged=not messages, seed=seed, predictive=predictive,
-                             acceptance=float(np.mean(acceptance)) if acceptance else np.nan)
-    post.idata.posterior.attrs.update(sampler="tempered ladder", runs=n_runs)
-    return post
-
-
-def result_from_draws(lik: Likelihood, chain_u, *, sampler: str, rhat: float, ess_bulk: float,
-                      ess_tail: float, messages: tuple, converged: bool, seed: int = 0,
-                      predictive: bool = True, acceptance: float = np.nan) -> PosteriorResult:
-    """A :class:`PosteriorResult` from posterior draws that another route than emcee produced
-    (``chain_u``: chains × draws × parameters in the sampling coordinates), with that route's
-    diagnostics. ``n_walkers`` is the number of chains, ``n_steps`` 0 and ``tau`` NaN."""
-    rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
-    chain_u = np.asarray(chain_u, dtype=float)
-    n_chains, n_kept, ndim = chain_u.shape
-    flat_u = chain_u.reshape(-1, ndim)  # chain-major
-    flat_scaled = tr.to_theta(flat_u)
-    pointwise = lik.pointwise(flat_scaled)
-    loglik = pointwise.sum(axis=1)
-    flat_phys = lik.to_physical(flat_scaled)
-    lp_flat = _log_prob_fn(lik, tr)(flat_u)
-    post = {name: flat_phys[:, i].reshape(n_chains, n_kept)
-            for i, name in enumerate(lik.param_names)}
-    best = int(np.argmax(lp_flat))
-    map_theta = flat_phys[best]
-    summary = _summaries(lik, tr, flat_phys, flat_u, map_theta)
-    idata = _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_chains, n_kept,
-                            rng if predictive else None)
-    idata.posterior.attrs.update(sampler=sampler)
-    return PosteriorResult(
-        structure=lik.structure.name, param_names=lik.param_names, noise=lik.noise,
-        noise_reason=lik.noise_reason, samples=flat_phys, samples_scaled=flat_scaled,
-        log_likelihood=loglik, summary=summary, map_theta=map_theta,
-        max_log_likelihood=float(loglik.max()), tau=np.full(ndim, np.nan), n_steps=0, burn=0,
-        thin=1, n_walkers=n_chains, acceptance=acceptance, rhat_max=rhat, ess_bulk_min=ess_bulk,
-        ess_tail_min=ess_tail, converged=converged, messages=tuple(messages), idata=idata,
-        sampler=sampler,
-    )
-
-
 WALKER_GROUPS = 4
 
 
@@ -587,117 +319,3 @@ def _diagnostics(sampler, tau, tr, names):
     return rhat, bulk, tail, bool(rhat < RHAT_MAX and min(bulk, tail) >= ESS_MIN)
 
 
-def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:
-    """Peaks of a kernel density of ``u`` with a prominence of at least 5 % of the highest and
-    half their own height.
-
-    The bandwidth is Silverman's robust rule, 0.9·min(sd, IQR/1.34)·n^(-1/5): the standard
-    deviation of draws from two separated modes is that of their distance, and a bandwidth set
-    by it smooths a minor mode away.
-    """
-    from scipy import signal, stats
-
-    if np.ptp(u) <= 0 or u.size < 20:
-        return 1
-    sd = float(np.std(u))
-    spread = min(sd, float(np.subtract(*np.percentile(u, [75, 25]))) / 1.34) or sd
-    grid = np.linspace(max(lo, u.min()), min(hi, u.max()), 512)
-    dens = stats.gaussian_kde(u, bw_method=0.9 * spread * u.size ** -0.2 / sd)(grid)
-    padded = np.r_[0.0, dens, 0.0]
-    peaks, props = signal.find_peaks(padded, prominence=0.05 * dens.max())
-    # A mode stands out: the valley to its higher neighbour is below half its own height (a
-    # flat or noisy density has bumps of small relative prominence).
-    real = props["prominences"] >= 0.5 * padded[peaks]
-    return max(1, int(np.sum(real)))
-
-
-def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:
-    az = arviz()
-
-    out = {}
-    for i, (name, prior) in enumerate(zip(lik.param_names, lik.prior_list)):
-        x = flat_phys[:, i]
-        lo, hi = az.hdi(x, hdi_prob=HDI_PROB)
-        plo, phi = prior.bounds
-        if tr.log[i]:
-            plo, phi = math.log(plo), math.log(phi)
-        u = flat_u[:, i]
-        ulo, uhi = az.hdi(u, hdi_prob=HDI_PROB)
-        wide = bool(np.isfinite(phi - plo) and (uhi - ulo) > 0.5 * (phi - plo))
-        out[name] = ParameterSummary(
-            mean=float(x.mean()), sd=float(x.std(ddof=1)), hdi_low=float(lo), hdi_high=float(hi),
-            map=float(map_theta[i]), median=float(np.median(x)), poorly_determined=wide,
-            multimodal=_count_modes(u, plo, phi) > 1,
-        )
-    return out
-
-
-def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kept, rng):
-    az = arviz()
-
-    omega = lik.data.omega
-    shape = (n_walkers, n_kept, omega.size)
-    g = lik.data.response
-    groups = dict(
-        posterior=post,
-        log_likelihood={"G": pointwise.reshape(shape)},
-        observed_data={"G_real": g.real, "G_imag": g.imag},
-        sample_stats={"lp": lp_flat.reshape(n_walkers, n_kept)},
-    )
-    if rng is not None:
-        model = lik.model(flat_scaled) * lik.scaling.g_ref
-        if lik.noise == "known":
-            sd = np.broadcast_to(lik.data.sigma, model.shape)
-        else:
-            s = flat_scaled[:, -1:] * lik.scaling.g_ref
-            sd = s * np.ones(model.shape) if lik.noise == "constant" else flat_scaled[:, -1:] * np.abs(g)
-        noise = sd / math.sqrt(2.0) * (rng.normal(size=model.shape) + 1j * rng.normal(size=model.shape))
-        rep = model + noise
-        groups["posterior_predictive"] = {"G_real": rep.real.reshape(shape), "G_imag": rep.imag.reshape(shape)}
-        groups["posterior"] = dict(post, model_real=model.real.reshape(shape), model_imag=model.imag.reshape(shape))
-    dims = {k: ["omega"] for k in ("G", "G_real", "G_imag", "model_real", "model_imag")}
-    idata = az.from_dict(**groups, coords={"omega": omega}, dims=dims)
-    idata.posterior.attrs.update(
-        structure=lik.structure.name, noise=lik.noise, kind=lik.data.kind,
-        omega_units="rad/s", data=lik.data.label,
-    )
-    return idata
-
-
-def _netcdf_bytes_needed(idata) -> int:
-    """An upper bound of the size of ``idata`` as NetCDF: its arrays uncompressed, plus the
-    HDF5 headers of every variable and group."""
-    total = 0
-    for group in idata.groups():
-        ds = idata[group]
-        total += ds.nbytes + 16_384 * (len(ds.variables) + 1)
-    return total + 65_536
-
-
-def save_netcdf(idata, path) -> Path:
-    """Write InferenceData to NetCDF through a temporary file and an atomic rename.
-
-    Raises
-    ------
-    OSError
-        ``ENOSPC`` before anything is written when the file system has less free space than the
-        file may need: HDF5 fails on a full disk with errors it cannot recover from (the
-        process crashes at exit), so the space is checked first.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    needed = _netcdf_bytes_needed(idata)
-    free = shutil.disk_usage(path.parent).free
-    if free < needed:
-        raise OSError(errno.ENOSPC, f"{needed} bytes may be needed for {path.name}, "
-                                    f"{free} are free", str(path.parent))
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".nc", dir=path.parent)
-    os.close(fd)
-    try:
-        idata.to_netcdf(tmp)
-        publish(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path

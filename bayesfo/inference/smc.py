@@ -48,7 +48,7 @@ from scipy.special import logsumexp
 from ..errors import InputError
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
-from .posterior import _log_parts_fn, _Transform
+from .transform import _log_parts_fn, _Transform
 
 
 @dataclass(frozen=True)

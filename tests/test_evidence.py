@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy import stats
@@ -138,9 +140,16 @@ def test_ladder_evidence_of_unconverged_posteriors_on_the_thesis_set_up():
                          progress=False, workers=2)
     for r in result.results:
         ev = r.criteria["evidence"]
-        ref, _, _ = NESTED_REFERENCE[r.name]
-        assert ev.method == ("bridge" if r.posterior.converged else "ladder"), r.name
-        assert abs(ev.log_z - ref) < 0.3, (r.name, ev.log_z, ref)
+        ref, ref_err, _ = NESTED_REFERENCE[r.name]
+        # The route follows the posterior's: importance weights (their own ln Z, or the ladder
+        # where k >= 0.5), the ladder where it certified the posterior or emcee did not
+        # converge, bridge sampling from converged emcee draws.
+        expected = {"importance": ("importance", "ladder"), "ladder": ("ladder",),
+                    "emcee": ("bridge",) if r.posterior.converged else ("ladder",)}
+        assert ev.method in expected[r.posterior.sampler], (r.name, ev.method)
+        # Within three combined standard errors (the nested references carry 0.14-0.29).
+        tol = 3 * math.hypot(ref_err, ev.log_z_err)
+        assert abs(ev.log_z - ref) < tol, (r.name, ev.log_z, ref, tol)
 
 
 def test_bridge_proposal_finds_the_components_of_a_mixture():

@@ -33,7 +33,7 @@ from scipy import signal
 from scipy.linalg import lapack
 
 from bayesfo.errors import InputError
-from bayesfo.timeseries import check_time_grid
+from bayesfo.sine import check_time_grid
 
 __all__ = [
     "oustaloup",

@@ -9,9 +9,9 @@ evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optim
 criteria, results, output files) → ``report`` and ``plotting``. ``options`` checks the options
 of a comparison before any work; ``outdir`` keeps each output directory the output of one run;
 ``parallel`` runs worker processes; ``batch`` runs comparisons over many data sets; ``cli`` is
-the command line, one module per command. ``timeseries`` turns raw sine records into frequency
-responses; ``timedomain`` simulates fitted models in the time domain for validation;
-``studies`` reruns the thesis' Monte Carlo studies.
+the command line, one module per command. ``sine`` analyses one sine record and ``records``
+turns many record files into a frequency response; ``timedomain`` simulates fitted models in
+the time domain for validation; ``studies`` reruns the thesis' Monte Carlo studies.
 
 Example
 -------
@@ -30,12 +30,9 @@ try:
 except PackageNotFoundError:  # run from a source tree that is not installed
     __version__ = "0+unknown"
 
-from .data import FrequencyResponse, read_csv  # noqa: E402
+from .data import FrequencyResponse, read, read_csv  # noqa: E402
 from .errors import BayesfoError, InputError, NonlinearityWarning, OutputError, StructureError  # noqa: E402
 from .structures import get_structure, resolve_structures  # noqa: E402
-
-#: Read a data file (see :func:`bayesfo.data.read_csv`).
-read = read_csv
 
 #: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
 #: ``import bayesfo`` and ``bayesfo --help`` stay fast.

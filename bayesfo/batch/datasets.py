@@ -13,6 +13,7 @@ from pathlib import Path
 
 from .. import __version__
 from .._io import csv_cells, read_text_file, split_lines
+from ..data import is_contract_csv
 from ..errors import InputError
 from ..options import DEFAULT_OPTIONS, EVIDENCE_ROUTES, KINDS, check_options, check_seed
 from .temperature import parse_temperature, temperature_of_file
@@ -47,7 +48,18 @@ class DataSet:
         Where the data set was named (an argument, or a manifest line), for messages.
     error : str or None
         Bad input found while the inputs were read (a ``# temperature:`` line that is not a
-        temperature): the data set is recorded as an input error and not run; the others run.
+        temperature, a lab file that cannot be read): the data set is recorded as an input error
+        and not run; the others run.
+    block : str or None
+        For a lab file of several data sets (steps, intervals, isotherms; see
+        :func:`bayesfo.data.read_isotherms`), the label of this one.
+    content : bytes or None
+        For a lab file (any file that is not a CSV of the bayesfo contract), this data set as a
+        contract CSV, read when the inputs were expanded (see :func:`_lab_entries`); the
+        worker reads it as it reads any contract file.
+    notes : tuple of str
+        For a lab file, how it was read (:meth:`bayesfo.data.Reading.notes`), carried in the
+        task for the worker to add to the notes of the data.
     """
 
     id: str
@@ -57,22 +69,36 @@ class DataSet:
     temperature: float | None = None
     origin: str = ""
     error: str | None = None
+    block: str | None = None
+    content: bytes | None = None
+    notes: tuple[str, ...] = ()
 
     def task(self) -> dict:
-        """The picklable task of :func:`run_task`, carrying the data file's bytes (a few kB)
-        so that a worker on another machine needs no access to the file."""
-        try:
-            content = Path(self.path).read_bytes()
-        except OSError:
-            content = None  # the worker reports the problem
-        return {"id": self.id, "path": str(Path(self.path).resolve()), "content": content,
+        """The picklable task of :func:`run_task`, carrying the data file's bytes (a few kB),
+        or for a lab file this data set as a contract CSV, so that a worker on another machine
+        needs no access to the file."""
+        content = self.content
+        if content is None:
+            try:
+                content = Path(self.path).read_bytes()
+            except OSError:
+                content = None  # the worker reports the problem
+        task = {"id": self.id, "path": str(Path(self.path).resolve()), "content": content,
                 "options": dict(self.options), "seed": self.seed}
+        if self.block is not None:
+            task["block"] = self.block
+        if self.notes:
+            task["notes"] = list(self.notes)
+        return task
 
     def fingerprint(self) -> dict:
         """What makes a stored result valid for this data set: the data file's content, the
-        options, the seed and the bayesfo version."""
-        return {"sha256": _sha256(self.path), "options": _jsonable(self.options),
-                "seed": self.seed, "bayesfo": __version__}
+        options, the seed and the bayesfo version (and the data set of a lab file)."""
+        fp = {"sha256": _sha256(self.path), "options": _jsonable(self.options),
+              "seed": self.seed, "bayesfo": __version__}
+        if self.block is not None:
+            fp["block"] = self.block
+        return fp
 
 
 def _jsonable(obj):
@@ -154,6 +180,47 @@ class _Entry:
     origin: str
     id: str | None = None  # given in a manifest
     error: str | None = None  # see DataSet.error
+    block: str | None = None  # see DataSet.block
+    content: bytes | None = None  # see DataSet.content
+    suffix: str = ""  # appended to the file stem of an automatic id (the data set of a lab file)
+    notes: tuple[str, ...] = ()  # see DataSet.notes
+
+
+def _lab_entries(file: Path, opts: dict, seed: int, temperature: float | None, origin: str,
+                 entry_id: str | None = None) -> list[_Entry]:
+    """The entries of a file that is not a contract CSV (a lab export): one per data set of
+    :func:`bayesfo.data.read_isotherms`, each carrying its data as a contract CSV; a file that
+    cannot be read is one entry with its error."""
+    from ..data import contract_text, read_isotherms
+
+    try:
+        sets = read_isotherms(file, kind=opts.get("kind"))
+    except InputError as exc:
+        return [_Entry(file, opts, seed, temperature, origin, entry_id, str(exc))]
+    if len(sets) == 1:
+        iso = sets[0]
+        error = None
+        t = temperature if temperature is not None else iso.temperature
+        if t is None:
+            t, error = _temperature_or_error(file)
+        return [_Entry(file, opts, seed, t, origin, entry_id, error,
+                       content=contract_text(iso.data, t).encode("utf-8"), notes=iso.data.notes)]
+    out = []
+    for k, iso in enumerate(sets, start=1):
+        suffix = _temperature_tag(iso.temperature) if iso.temperature is not None else f"{k:02d}"
+        out.append(_Entry(file, opts, seed, iso.temperature, f"{origin}, data set {k} "
+                          f"({iso.label})", f"{entry_id}-{suffix}" if entry_id else None,
+                          block=iso.label, content=contract_text(iso.data, iso.temperature)
+                          .encode("utf-8"), suffix=f"-{suffix}", notes=iso.data.notes))
+    return out
+
+
+def _temperature_tag(t: float) -> str:
+    """``Tp150C``, ``Tm040C``, ``Tp020p5C``: the temperature in an id, as the bundled isotherms
+    are named (read back by :func:`temperature_from_stem`)."""
+    sign = "m" if t < 0 else "p"
+    whole, _, frac = f"{abs(t):.2f}".rstrip("0").rstrip(".").partition(".")
+    return f"T{sign}{int(whole):03d}" + (f"p{frac}" if frac else "") + "C"
 
 
 def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list[_Entry]:
@@ -275,6 +342,9 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
                        "device or socket)" if file.exists() else "does not exist")
             raise InputError(f"{at}, column 'path': file '{file}' {problem}")
         opts = check_options(opts, at)
+        if not is_contract_csv(file):
+            entries.extend(_lab_entries(file, opts, row_seed, temperature, at, entry_id))
+            continue
         error = None
         if temperature is None:
             temperature, error = _temperature_or_error(file)
@@ -295,7 +365,10 @@ def expand_inputs(inputs=(), *, manifests=(), options: dict | None = None, seed:
     inputs : sequence of str
         Each a CSV file, a manifest (a CSV whose header has a ``path`` column, see
         :func:`_read_manifest`), a directory (its ``*.csv`` files, not recursive, manifests
-        excepted) or a glob pattern (``*``, ``?``, ``[...]``; ``**`` recurses).
+        excepted) or a glob pattern (``*``, ``?``, ``[...]``; ``**`` recurses). A file that is
+        not a CSV of the contract is read by :func:`bayesfo.data.read_isotherms` (a lab export)
+        and gives one data set per step, interval or isotherm, with its temperature: a file of
+        isotherms is a temperature series.
     manifests : sequence of path-like
         Manifests named explicitly (``--manifest``).
     options : dict, optional
@@ -310,7 +383,8 @@ def expand_inputs(inputs=(), *, manifests=(), options: dict | None = None, seed:
     -------
     list of DataSet
         In the order given; a file named twice with the same options counts once. The id is the
-        file stem, or, when stems clash (case-insensitively), the stem prefixed by as many parent
+        file stem (for a data set of a lab file of several, the stem and its temperature,
+        ``run-Tp150C``, or its number), or, when stems clash (case-insensitively), the stem prefixed by as many parent
         directory names as make the clashing ids distinct (``run1-T020C``), else numbered
         (``T020C-1``, ``T020C-2``); a manifest's ``id`` column wins.
 
@@ -327,6 +401,9 @@ def expand_inputs(inputs=(), *, manifests=(), options: dict | None = None, seed:
     entries: list[_Entry] = []
 
     def data_file(file: Path, origin: str):
+        if not is_contract_csv(file):
+            entries.extend(_lab_entries(file, opts, seed, None, origin))
+            return
         temperature, error = _temperature_or_error(file)
         entries.append(_Entry(file, opts, seed, temperature, origin, error=error))
 
@@ -379,7 +456,7 @@ def _unique(entries: list[_Entry]) -> list[_Entry]:
     seen, out = set(), []
     for e in entries:
         key = (str(e.path.resolve()), json.dumps(_jsonable(e.options), sort_keys=True), e.seed,
-               e.temperature, e.id)
+               e.temperature, e.id, e.block)
         if key not in seen:
             seen.add(key)
             out.append(e)
@@ -405,17 +482,18 @@ def _assign_ids(entries: list[_Entry]) -> list[DataSet]:
     auto = [e for e in entries if e.id is None]
     groups: dict[str, list[_Entry]] = {}
     for e in auto:
-        groups.setdefault(_safe_id(e.path.stem).lower(), []).append(e)
+        groups.setdefault(_safe_id(e.path.stem + e.suffix).lower(), []).append(e)
     ids: dict[int, str] = {}
     for key, group in groups.items():
-        base = _safe_id(group[0].path.stem)
+        base = _safe_id(group[0].path.stem + group[0].suffix)
         if len(group) == 1 and key not in taken:
             ids[id(group[0])] = base
             continue
         parents = [list(reversed(e.path.resolve().parent.parts)) for e in group]
         chosen = None
         for depth in range(1, max(len(p) for p in parents) + 1):
-            names = ["-".join([_safe_id(x) for x in reversed(p[:depth])] + [_safe_id(e.path.stem)])
+            names = ["-".join([_safe_id(x) for x in reversed(p[:depth])]
+                              + [_safe_id(e.path.stem + e.suffix)])
                      for p, e in zip(parents, group)]
             lowered = [n.lower() for n in names]
             if len(set(lowered)) == len(names) and not set(lowered) & set(taken):
@@ -433,5 +511,6 @@ def _assign_ids(entries: list[_Entry]) -> list[DataSet]:
     for e in auto:
         taken[ids[id(e)].lower()] = e.origin
     return [DataSet(e.id if e.id is not None else ids[id(e)], str(e.path), e.options, e.seed,
-                    e.temperature, e.origin, e.error) for e in entries]
+                    e.temperature, e.origin, e.error, e.block, e.content, e.notes)
+            for e in entries]
 

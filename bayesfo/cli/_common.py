@@ -13,18 +13,52 @@ from ..options import (
 
 
 def add_data_options(p):
-    p.add_argument("data", metavar="DATA", help="CSV file with omega|freq and the response columns")
+    p.add_argument("data", metavar="DATA",
+                   help="data file: a bayesfo CSV (omega|freq and the response columns) or a "
+                        "lab export (TRIOS, RheoCompass, ARES, RepTate, pyvisco, delimited text "
+                        "with recognisable headers; see docs/lab_files.md)")
     p.add_argument("--kind", choices=KINDS,
-                   help="what the response is (default: the file's '# kind:' line, else modulus "
+                   help="what the response is (default: what the columns say, e.g. G' a "
+                        "modulus, J' a compliance; else the file's '# kind:' line, else modulus "
                         "for storage/loss columns, else generic)")
     p.add_argument("--reciprocal", action="store_true",
                    help="use 1/G of the data (sigma propagated)")
+    p.add_argument("--columns", default=None, metavar="ROLE=COLUMN,...",
+                   help="which column is what, for columns not recognised or to choose, e.g. "
+                        "omega=\"Ang. Freq.\",storage=\"G'\",loss=\"G''\"; roles omega [rad/s], "
+                        "freq [Hz], storage, loss, real, imag, magnitude, phase, phase_deg, "
+                        "tan_delta, viscosity, eta_dyn, eta_out, sigma, series, temperature, "
+                        "block; a column is its header or its number from 1, a unit in "
+                        "brackets replaces the file's (E_stor=\"E_stor [Pa]\"), empty means none "
+                        "(temperature=)")
+    p.add_argument("--block", default=None, metavar="N|LABEL",
+                   help="for a file of several data sets (steps, intervals, isotherms): which "
+                        "one, by number from 1 or label (bayesfo inspect lists them)")
+    p.add_argument("--delimiter", default=None, choices=(",", ";", "tab", "space"),
+                   help="cell delimiter (default: sniffed)")
+    p.add_argument("--decimal", default=None, choices=(".", ","),
+                   help="decimal mark (default: sniffed)")
+    p.add_argument("--duplicates", default="error", choices=("error", "first", "mean"),
+                   help="rows that repeat a frequency: refuse (default), keep the first, or "
+                        "average them (overlapping isotherms of a master curve)")
 
 
-def read_data(args):
-    from ..data import read_csv
+def read_data(args, every: bool = False):
+    """The data set of ``args.data`` read with the data options (``--reciprocal`` applied); with
+    ``every``, every data set of the file as :class:`~bayesfo.data.Isotherm` objects (``--block``
+    selects one; ``--reciprocal`` is left to the caller)."""
+    from ..data import columns_from_text, read, read_isotherms, select
 
-    data = read_csv(args.data, kind=args.kind)
+    delimiter = getattr(args, "delimiter", None)
+    options = {"kind": args.kind, "columns": columns_from_text(getattr(args, "columns", None)),
+               "delimiter": {"tab": "\t", "space": " "}.get(delimiter, delimiter),
+               "decimal": getattr(args, "decimal", None),
+               "duplicates": getattr(args, "duplicates", "error")}
+    block = getattr(args, "block", None)
+    if every:
+        sets = read_isotherms(args.data, **options)
+        return sets if block is None else [select(sets, block, f"file '{args.data}'")]
+    data = read(args.data, block=block, **options)
     if args.reciprocal:
         data = data.reciprocal()
     return data
@@ -43,8 +77,8 @@ def add_comparison_options(p, each: str = "the fit"):
     p.add_argument("--structures", default=DEFAULT_STRUCTURES,
                    help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
     p.add_argument("--noise", default="auto", choices=NOISE_MODELS,
-                   help="noise model (default: known if the data give sigma, else relative "
-                        "or constant)")
+                   help="noise model (default: known if the data give sigma, else constant or "
+                        "proportional, whichever has the larger evidence for each structure)")
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1; "
                         "one per parameter")
@@ -59,5 +93,11 @@ def add_comparison_options(p, each: str = "the fit"):
                    help="ln Z from the route that gave the posterior (auto: the importance "
                         "weights, else bridge sampling from the emcee draws, or the tempered "
                         "ladder where the walkers did not converge), or forced: bridge, ladder")
+    p.add_argument("--max-steps", type=int, default=None, metavar="N",
+                   help="emcee's cap on steps per walker (default 10000): raise it when a "
+                        "posterior is flagged as not converged")
+    p.add_argument("--walkers", type=int, default=None, metavar="N",
+                   help="emcee walkers (default max(32, 4 x parameters)); more walkers help "
+                        "ridged and multimodal posteriors")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")

@@ -1,4 +1,4 @@
-"""``bayesfo inspect``: read and check a data file; show what it holds."""
+"""``bayesfo inspect``: read and check a data file; show what it holds and how it was read."""
 
 from __future__ import annotations
 
@@ -12,39 +12,71 @@ from ._common import add_data_options, library, read_data
 
 def add_parser(subparsers):
     """Register ``bayesfo inspect``: read and check a data file."""
-    p = subparsers.add_parser("inspect", help="read and check a data file; show what it holds")
+    p = subparsers.add_parser(
+        "inspect", help="read and check a data file; show what it holds and how it was read",
+        description="Read a data file and print every choice the reader made (format, "
+                    "delimiter, columns used, units converted to SI, kind and why, temperature, "
+                    "rows skipped, columns ignored) and what the data hold. A file of several "
+                    "data sets (steps, intervals, isotherms) prints each.")
     add_data_options(p)
     p.add_argument("--structures", default=None,
                    help="comma list of structures to check the data against (e.g. voigt,zener,max3)")
     p.add_argument("--holdout", default=None, metavar="W1,W2",
                    help="angular frequencies [rad/s] to hold out for validation")
-    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--json", action="store_true",
+                   help="print JSON: one object, or a list of objects for a file of several "
+                        "data sets")
     return p
 
 
-def run(args) -> int:
-    from ..structures import resolve_structures
-
-    data = read_data(args)
+def _info(iso, args, structures) -> dict:
+    data = iso.data.reciprocal() if args.reciprocal else iso.data
     info = data.to_dict()
     info.update(
         omega_ref=data.omega_ref,
         g_ref=data.g_ref,
         magnitude_min=float(data.magnitude.min()),
         magnitude_max=float(data.magnitude.max()),
+        block=iso.label,
+        temperature_C=iso.temperature,
+        reading=iso.reading.to_dict(),
     )
     if args.holdout:
         train, test = data.split(parse_floats(args.holdout, "--holdout"))
         info["holdout"] = test.omega.tolist()
         data = train
-    if args.structures:
-        structures = resolve_structures(args.structures, library(args))
+    if structures:
         for s in structures:
             s.check_data(data)
         info["structures"] = {s.name: s.n_params for s in structures}
+    return info
+
+
+def run(args) -> int:
+    from ..structures import resolve_structures
+
+    sets = read_data(args, every=True)
+    structures = resolve_structures(args.structures, library(args)) if args.structures else None
+    infos = [_info(iso, args, structures) for iso in sets]
     if args.json:
-        print(json.dumps(info, indent=2))
+        print(json.dumps(infos[0] if len(infos) == 1 else infos, indent=2))
         return 0
+    if len(infos) > 1:
+        first = infos[0]["reading"]
+        print(f"{args.data}: {len(infos)} data sets, read as {first['format']} "
+              f"({first['delimiter']}-separated, decimal '{first['decimal']}', "
+              f"{first['encoding']}); each one:")
+    for k, info in enumerate(infos, start=1):
+        if len(infos) > 1:
+            print(f"\n[{k}] {info['block'] or 'data set'}"
+                  + (f" ({info['temperature_C']:g} °C)" if info["temperature_C"] is not None
+                     else ""))
+        _print(info)
+    return 0
+
+
+def _print(info: dict) -> None:
+    reading = info["reading"]
     print(f"{info['name']}: {info['n_frequencies']} frequencies, "
           f"{info['omega_min']:.4g} to {info['omega_max']:.4g} rad/s, kind {info['kind']}"
           + (f", units {info['units']}" if info["units"] else ""))
@@ -55,6 +87,11 @@ def run(args) -> int:
     if bad:
         print(f"warning: {len(bad)} point(s) with negative loss, impossible for a passive "
               f"{info['kind']}: omega = " + ", ".join(f"{w:.4g}" for w in bad) + " rad/s")
+    if reading["format"] == "bayesfo CSV":
+        print(f"read as bayesfo CSV: columns {', '.join(reading['columns'])}; "
+              + (f"temperature {info['temperature_C']:g} °C ('# temperature:' line); "
+                 if info["temperature_C"] is not None else "")
+              + "no units converted (the '# units:' line is a label)")
     for note in info["notes"]:
         print(f"note: {note}")
     if "holdout" in info:
@@ -62,4 +99,3 @@ def run(args) -> int:
     if "structures" in info:
         print("structures (parameters): "
               + ", ".join(f"{k} ({v})" for k, v in info["structures"].items()))
-    return 0

@@ -1,4 +1,7 @@
-"""Measured frequency responses: the :class:`FrequencyResponse` container and its CSV reader.
+"""Measured frequency responses: the :class:`FrequencyResponse` container, the reader of the CSV
+contract (:func:`read_csv`) and the tolerant reader of lab files (:func:`read`,
+:func:`read_isotherms`: rheometer and DMA exports, units, delimiters, temperature columns; see
+``docs/lab_files.md``).
 
 A frequency response is a set of angular frequencies ω [rad/s] with the complex value G(jω) of a
 transfer function at each, and optionally the standard deviation σ of each complex value. The
@@ -43,8 +46,11 @@ from .csv_reader import (
                          read_csv,
 )
 from .frequency_response import FREQUENCY_RTOL, KINDS, SIGMA_MIN_RATIO, FrequencyResponse
+from .lab import DUPLICATES, columns_from_text, is_contract_csv, read, read_isotherms, select
+from .reading import Isotherm, Reading, contract_text
 
 __all__ = ["FREQUENCY_COLUMNS", "FREQUENCY_RTOL", "KINDS", "KNOWN_COLUMNS", "MAX_FILE_BYTES",
            "MAX_FREQUENCIES", "MAX_PHASE_DEG", "MAX_ROWS", "MAX_SPAN", "OPTIONAL_COLUMNS",
            "RESPONSE_FORMS", "SIGMA_MAX_RATIO", "SIGMA_MIN_RATIO", "VALUE_RANGE",
-           "FrequencyResponse", "read_csv"]
+           "DUPLICATES", "FrequencyResponse", "Isotherm", "Reading", "columns_from_text",
+           "contract_text", "is_contract_csv", "read", "read_csv", "read_isotherms", "select"]

@@ -178,7 +178,30 @@ def read_csv(
         values[col] = out
     linenos = np.array([ln for ln, _ in rows])
 
-    notes: list[str] = []
+    return _from_columns(values, linenos, where, kind=kind, meta=meta, units=units, name=name,
+                         source=str(path))
+
+
+def _from_columns(
+    values: dict[str, np.ndarray], linenos: np.ndarray, where: str, *, kind: str | None,
+    meta: dict[str, str], units: str | None, name: str | None, source: str,
+    notes: tuple[str, ...] = (), labels: dict[str, str] | None = None,
+) -> FrequencyResponse:
+    """The checked, sorted response from parsed columns named as in the contract.
+
+    ``values`` maps contract column names (``omega`` or ``freq``, one response form, optionally
+    ``sigma`` and ``series``) to numbers, one per data row, and ``linenos`` gives each row's line
+    in the file; every check of :func:`read_csv` after parsing the cells happens here, so that
+    other readers that normalise a file to these columns keep the same limits. ``labels`` maps a
+    contract name to the name shown in messages (a column of the original file); ``notes`` start
+    the notes of the response.
+    """
+    labels = labels or {}
+
+    def lab(col: str) -> str:
+        return labels.get(col, col)
+
+    notes = list(notes)
     if kind is None and "kind" not in meta and "storage" in values:
         # G' and G'' (storage and loss) are by definition the parts of a modulus; fitting them
         # as a generic transfer function loses the sign convention and the dissipation check.
@@ -196,17 +219,18 @@ def read_csv(
         fcol = "freq"
         with np.errstate(over="ignore"):
             omega = 2 * np.pi * values["freq"]
-    _check_rows(omega <= 0, where, linenos, fcol, "frequency must be positive")
-    _check_frequency_range(omega, values.get("freq"), where, linenos, fcol)
+    _check_rows(omega <= 0, where, linenos, lab(fcol), "frequency must be positive")
+    _check_frequency_range(omega, values.get("freq"), where, linenos, lab(fcol))
 
     if "real" in values:
         form = ("real", "imag")
         response = values["real"] + 1j * values["imag"]
     elif "magnitude" in values:
         form = ("magnitude",)
-        _check_rows(values["magnitude"] < 0, where, linenos, "magnitude", "magnitude is negative")
+        _check_rows(values["magnitude"] < 0, where, linenos, lab("magnitude"),
+                    "magnitude is negative")
         phase = values["phase_deg"]
-        _check_rows(np.abs(phase) > MAX_PHASE_DEG, where, linenos, "phase_deg",
+        _check_rows(np.abs(phase) > MAX_PHASE_DEG, where, linenos, lab("phase_deg"),
                     f"a phase of {{value:g}} degrees is outside ±{MAX_PHASE_DEG:g}; a phase is an "
                     "angle within one turn: wrap it into (-180, 180] by adding or subtracting "
                     "multiples of 360", phase)
@@ -215,15 +239,15 @@ def read_csv(
         form = ("storage", "loss")
         sign = -1.0 if kind == "compliance" else 1.0
         response = values["storage"] + sign * 1j * values["loss"]
-    magnitude = _check_magnitudes(values, form, where, linenos)
+    magnitude = _check_magnitudes(values, form, where, linenos, labels)
     sigma = values.get("sigma")
     if sigma is not None:
-        _check_rows(sigma <= 0, where, linenos, "sigma", "sigma must be positive")
-        _check_sigma(sigma, magnitude, where, linenos)
+        _check_rows(sigma <= 0, where, linenos, lab("sigma"), "sigma must be positive")
+        _check_sigma(sigma, magnitude, where, linenos, lab("sigma"))
 
     if "series" in values:
         omega, response, sigma, n_rep, linenos = _average_series(
-            omega, response, sigma, values["series"], linenos, where, fcol
+            omega, response, sigma, values["series"], linenos, where, lab(fcol)
         )
         notes.append(f"mean of {n_rep} replicate series")
         if sigma is None:
@@ -238,9 +262,9 @@ def read_csv(
         if omega.size > MAX_FREQUENCIES:
             _too_many(where, omega.size)
     else:
-        _check_duplicates(omega, linenos, where, fcol)
-    _check_span(omega, linenos, where, f"column '{fcol}'", "the frequencies span", "rad/s")
-    _check_span(np.abs(response), linenos, where, _columns(form), "|G| spans", "")
+        _check_duplicates(omega, linenos, where, lab(fcol))
+    _check_span(omega, linenos, where, f"column '{lab(fcol)}'", "the frequencies span", "rad/s")
+    _check_span(np.abs(response), linenos, where, _columns(form, labels), "|G| spans", "")
 
     fr = FrequencyResponse(
         omega,
@@ -249,7 +273,7 @@ def read_csv(
         kind=kind,
         units=units if units is not None else meta.get("units", ""),
         name=name if name is not None else meta.get("name", ""),
-        source=str(path),
+        source=source,
         notes=tuple(notes),
     )
     return fr.sorted()
@@ -268,10 +292,12 @@ def _too_many(where: str, n: int) -> None:
     )
 
 
-def _columns(form) -> str:
-    if len(form) == 1:
-        return f"column '{form[0]}'"
-    return f"columns '{form[0]}' and '{form[1]}'"
+def _columns(form, labels=None) -> str:
+    labels = labels or {}
+    names = [labels.get(c, c) for c in form]
+    if len(names) == 1:
+        return f"column '{names[0]}'"
+    return f"columns '{names[0]}' and '{names[1]}'"
 
 
 def _check_frequency_range(omega, freq, where, linenos, col) -> None:
@@ -289,13 +315,13 @@ def _check_frequency_range(omega, freq, where, linenos, col) -> None:
         )
 
 
-def _check_magnitudes(values, form, where, linenos) -> np.ndarray:
+def _check_magnitudes(values, form, where, linenos, labels=None) -> np.ndarray:
     """|G| per row, after checking it is nonzero and within :data:`VALUE_RANGE`."""
     if len(form) == 1:
         magnitude = values[form[0]]
     else:
         magnitude = np.hypot(values[form[0]], values[form[1]])
-    cols = _columns(form)
+    cols = _columns(form, labels)
     if np.all(magnitude == 0):
         raise InputError(
             f"{where}: the response is 0 at every frequency ({cols}): there is nothing to fit; "
@@ -315,7 +341,7 @@ def _check_magnitudes(values, form, where, linenos) -> np.ndarray:
         if len(form) == 2 and magnitude[k] > hi:
             # Name the cell that is too large.
             col = form[0] if abs(values[form[0]][k]) >= abs(values[form[1]][k]) else form[1]
-            cols = f"column '{col}'"
+            cols = _columns((col,), labels)
             what = f"{values[col][k]:g}"
         else:
             what = f"|G| = {magnitude[k]:g}"
@@ -327,13 +353,13 @@ def _check_magnitudes(values, form, where, linenos) -> np.ndarray:
     return magnitude
 
 
-def _check_sigma(sigma, magnitude, where, linenos) -> None:
+def _check_sigma(sigma, magnitude, where, linenos, col: str = "sigma") -> None:
     g_max = float(magnitude.max())
     big = np.flatnonzero(sigma > SIGMA_MAX_RATIO * g_max)
     if big.size:
         k = big[0]
         raise InputError(
-            f"{where}, line {linenos[k]}, column 'sigma': sigma = {sigma[k]:g} is more than "
+            f"{where}, line {linenos[k]}, column '{col}': sigma = {sigma[k]:g} is more than "
             f"{SIGMA_MAX_RATIO:g} times the largest |G| of the data ({g_max:g}); no measurement is "
             "that noisy: check that sigma is the standard deviation of G, in the units of G"
         )
@@ -341,7 +367,7 @@ def _check_sigma(sigma, magnitude, where, linenos) -> None:
     if small.size:
         k = small[0]
         raise InputError(
-            f"{where}, line {linenos[k]}, column 'sigma': sigma = {sigma[k]:g} is less than "
+            f"{where}, line {linenos[k]}, column '{col}': sigma = {sigma[k]:g} is less than "
             f"{SIGMA_MIN_RATIO:g} times |G| = {magnitude[k]:g} on this line, below the precision "
             "of a double; give the measurement's real standard deviation"
         )

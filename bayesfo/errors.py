@@ -52,3 +52,8 @@ class PredictiveWarning(UserWarning):
 class EvidenceWarning(UserWarning):
     """The two evidence estimates disagree, or the evidence could not be computed."""
 
+
+
+class NoiseWarning(UserWarning):
+    """A structure's exponents (q, α, β) have non-overlapping 94 % HDIs under the two noise
+    models between which the evidence chose: the conclusion depends on the noise model."""

@@ -62,6 +62,8 @@ DEFAULT_OPTIONS = {
     "evidence": "auto",      # ln Z from the emcee draws (bridge), a tempered ladder, or auto
     "sampler": "auto",       # importance sampling where certified, else emcee; or emcee
     "evidence_check": False,
+    "max_steps": None,       # emcee's cap on steps (None: 10 000)
+    "walkers": None,         # emcee walkers (None: max(32, 4 x parameters))
     "models": (),            # extra structure cards (paths)
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
 }
@@ -117,6 +119,7 @@ def check_options(options: dict, where: str) -> dict:
     if opts["noise"] not in NOISE_MODELS:
         raise InputError(f"{where}: noise must be one of {', '.join(NOISE_MODELS)}, "
                          f"got {opts['noise']!r}")
+    check_sampler_settings(opts, where)
     models = tuple(str(Path(m).resolve()) for m in opts["models"])
     try:
         library = load_library(extra=models) if models else default_library()
@@ -145,11 +148,34 @@ def check_options(options: dict, where: str) -> dict:
             "priors": priors, "holdout": holdout, "evidence": opts["evidence"],
             "sampler": opts["sampler"],
             "evidence_check": bool(opts["evidence_check"]),
+            "max_steps": opts["max_steps"], "walkers": opts["walkers"],
             "models": models, "figures": bool(opts["figures"])}
 
 
 #: Seeds are 32-bit: every random generator in the chain (numpy, scipy, emcee) accepts them.
 MAX_SEED = 2**32 - 1
+
+
+def check_sampler_settings(options: dict, where: str) -> None:
+    """``max_steps`` (at least 100) and ``walkers`` (at least 8) are integers or None."""
+    for key, least in (("max_steps", 100), ("walkers", 8)):
+        value = options.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int)
+                                  or value < least):
+            flag = "--" + key.replace("_", "-")
+            raise InputError(f"{where}: {key} ({flag}) must be an integer of at least {least}, "
+                             f"got {value!r}")
+
+
+def sampler_options(options: dict) -> dict:
+    """The emcee options of checked ``options`` (:func:`check_options`) as keyword arguments of
+    :func:`~bayesfo.comparison.compare`: only those the user set."""
+    out = {}
+    if options.get("max_steps") is not None:
+        out["max_steps"] = options["max_steps"]
+    if options.get("walkers") is not None:
+        out["n_walkers"] = options["walkers"]
+    return out
 
 
 def check_seed(seed, where: str) -> int:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..options import parse_priors
+from ..options import parse_priors, sampler_options
 
 #: Status of a data set: compared, bad input, or anything else that went wrong.
 OK, INPUT_ERROR, INTERNAL_ERROR = "ok", "input_error", "internal_error"
@@ -25,15 +25,19 @@ def _read_task_data(task: dict, read_csv):
     name), with the original path as its source and in error messages."""
     kind = task["options"]["kind"]
     if task.get("content") is None:
-        return read_csv(task["path"], kind=kind)
-    with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
-        copy = Path(tmp) / Path(task["path"]).name
-        copy.write_bytes(task["content"])
-        try:
-            data = read_csv(copy, kind=kind)
-        except InputError as exc:
-            raise InputError(str(exc).replace(str(copy), task["path"])) from None
-    return replace(data, source=task["path"])
+        data = read_csv(task["path"], kind=kind)
+    else:
+        with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
+            copy = Path(tmp) / Path(task["path"]).name
+            copy.write_bytes(task["content"])
+            try:
+                data = read_csv(copy, kind=kind)
+            except InputError as exc:
+                raise InputError(str(exc).replace(str(copy), task["path"])) from None
+        data = replace(data, source=task["path"])
+    if task.get("notes"):  # how a lab file was read (DataSet.notes)
+        data = replace(data, notes=tuple(task["notes"]) + tuple(data.notes))
+    return data
 
 
 def run_task(task: dict) -> dict:
@@ -88,7 +92,7 @@ def run_task(task: dict) -> dict:
                                  evidence=opts["evidence"], sampler=opts["sampler"],
                                  evidence_check=opts["evidence_check"],
                                  holdout=list(opts["holdout"]) if opts["holdout"] else None,
-                                 workers=1)
+                                 workers=1, **sampler_options(opts))
             out["compare_seconds"] = time.perf_counter() - t1
             out["compare_cpu_seconds"] = time.process_time() - c1
             with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:

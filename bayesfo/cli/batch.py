@@ -65,7 +65,7 @@ def run(args) -> int:
                "noise": args.noise, "priors": tuple(args.prior),
                "holdout": parse_floats(args.holdout, "--holdout") if args.holdout else None,
                "evidence": args.evidence, "evidence_check": args.evidence_check,
-               "sampler": args.sampler,
+               "sampler": args.sampler, "max_steps": args.max_steps, "walkers": args.walkers,
                "models": tuple(getattr(args, "models", None) or ()),
                "figures": not args.no_figures}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,

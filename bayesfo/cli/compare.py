@@ -8,10 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..options import (
-    parse_floats,
-    parse_priors,
-)
+from ..options import check_sampler_settings, parse_floats, parse_priors, sampler_options
 from ._common import add_comparison_options, add_data_options, library, read_data
 
 
@@ -50,6 +47,8 @@ def run(args) -> int:
     unknown = [k for k in priors if k not in known]
     if unknown:
         raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
+    settings = {"max_steps": args.max_steps, "walkers": args.walkers}
+    check_sampler_settings(settings, "compare")
     out = check_output_directory(args.out if args.out else f"bayesfo-{Path(args.data).stem}",
                                  directories=() if args.no_figures else ("figures",))
     progress = not args.quiet and sys.stderr.isatty()
@@ -57,6 +56,7 @@ def run(args) -> int:
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
                    evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,
                    sampler=args.sampler)
+    options.update(sampler_options(settings))
     if args.workers < 0:
         raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
     n_proc = min(args.workers or available_cpus(), len(structures))

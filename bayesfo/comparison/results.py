@@ -62,6 +62,11 @@ class StructureResult:
             parameters={k: v.to_dict() for k, v in post.summary.items()},
             priors=self.criteria["priors"],
             noise=post.noise, noise_reason=post.noise_reason,
+            # Under noise="auto" without σ: each candidate noise model's ln Z, probability and
+            # exponent HDIs; ``noise_sensitive`` when those HDIs do not overlap.
+            noise_models=self.criteria.get("noise_models"),
+            noise_sensitive=(None if self.criteria.get("noise_models") is None
+                             else self.criteria["noise_models"]["sensitive"]),
             log_evidence=None if ev is None else ev.log_z,
             log_evidence_err=None if ev is None else ev.log_z_err,
             evidence_method=None if ev is None else ev.method,

@@ -24,20 +24,22 @@ from __future__ import annotations
 
 import sys
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
 from ..data import MAX_FREQUENCIES, FrequencyResponse
-from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputError
+from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputError, NoiseWarning
 from ..identify.optimize import fit_structure
 from ..inference import Likelihood, run_posterior
 from ..inference.adequacy import check_adequacy
-from ..inference.importance import importance_posterior
+from ..inference.importance import K_HAT_MAX, importance_posterior, screen_noise
+from ..inference.likelihood import NOISE_PRIORS
 from ..inference.posterior import posterior_from_particles
 from ..options import EVIDENCE_ROUTES, SAMPLERS
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
-from .criteria import _criteria, _evidence, _holdout, _model_probabilities
+from .criteria import _criteria, _evidence, _evidence_check, _holdout, _model_probabilities
 from .results import Comparison, StructureResult, data_problems
 
 
@@ -189,6 +191,17 @@ def _run_in_pool(pool, structures, data, options, bar) -> list:
     return [futures[i].result() for i in range(len(structures))]
 
 
+def remedy(lik) -> str:
+    """What to try when a posterior is not certified: the options that address it."""
+    walkers = max(32, 4 * lik.ndim)
+    walkers += -walkers % 4
+    exponents = [p.name for p in lik.structure.parameters if p.role == "exponent"]
+    prior = (f", or a narrower prior where you know the physics (e.g. --prior "
+             f"{exponents[0]}=uniform:0.2:1)" if exponents else "")
+    return (f"Try a longer run (--max-steps 40000; API: max_steps=40000), more walkers "
+            f"(--walkers {2 * walkers}; API: n_walkers={2 * walkers}){prior}")
+
+
 def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
     """Where the emcee walkers did not converge, the final particles of the independent
     tempered-ladder runs (which gave ln Z) are the posterior, if the runs agree: summaries,
@@ -197,7 +210,7 @@ def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
     if not ladder.converged:
         note = (f"{lik.structure.name}: the tempered-ladder runs do not certify the posterior "
                 f"either ({'; '.join(m.split(': ', 1)[1] for m in ladder.messages)}); the "
-                "emcee draws are reported, flagged")
+                f"emcee draws are reported, flagged. {remedy(lik)}")
         warnings.warn(note, ConvergenceWarning, stacklevel=3)
         criteria["warnings"].append(note)
         return post, criteria
@@ -211,39 +224,210 @@ def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
     return ladder, criteria
 
 
+def _noise_candidates(data: FrequencyResponse, noise: str) -> tuple[str, ...]:
+    """The noise models a structure is run with: the one asked for; ``auto`` (which the
+    likelihood resolves to ``known``, saying why) when the data carry σ; else both
+    ``constant`` and ``proportional``, between which the evidence chooses. (:func:`compare`
+    refuses ``auto`` without σ where the response is exactly 0: relative noise has no scale
+    there.)"""
+    if noise != "auto" or data.sigma is not None:
+        return (noise,)
+    return NOISE_CANDIDATES
+
+
+#: The noise models between which ``noise="auto"`` chooses by evidence, when the data carry no σ.
+NOISE_CANDIDATES = ("constant", "proportional")
+
+
+def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dict) -> dict:
+    """Posterior, criteria and evidence of one structure under one noise model."""
+    seed = options["seed"]
+    own = {k: v for k, v in (options["priors"] or {}).items()
+           if k in s.param_names or k == NOISE_PRIORS.get(noise, ("",))[0]}
+    lik = Likelihood(s, data, noise=noise, priors=own)
+    post = ev = None
+    # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
+    if options["sampler"] == "auto" and options["evidence"] != "bridge" and fit.optima.size:
+        modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling),
+                                        lik.scaling)
+        try:
+            post, ev, info = importance_posterior(lik, modes, seed=seed)
+        except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
+            post = ev = None
+    if post is None:
+        post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
+                                fit=fit, progress=False,
+                                **{"give_up": True, **options["sampler_kwargs"]})
+    criteria = _criteria(lik, fit, post)
+    if post.sampler == "importance":
+        criteria["importance"] = info
+    extra = _evidence(lik, post, seed, False, options["evidence"],
+                      best_log_likelihood=criteria["max_log_likelihood"], importance=ev)
+    runs = extra.pop("ladder_runs")
+    if runs is not None and not post.converged:
+        post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
+    criteria["warnings"].extend(extra.pop("warnings"))
+    criteria.update(extra)
+    return {"lik": lik, "post": post, "criteria": criteria}
+
+
+def _exponent_intervals(run: dict) -> dict:
+    """94 % HDIs of the structure's exponents (q, α, β, ...) under one noise model."""
+    lik, post = run["lik"], run["post"]
+    return {p.name: (post.summary[p.name].hdi_low, post.summary[p.name].hdi_high)
+            for p in lik.structure.parameters if p.role == "exponent"}
+
+
+#: A noise model whose quick ln Z (:func:`~bayesfo.inference.importance.screen_noise`) trails
+#: the other's by this many nats (posterior odds above 150:1) is not sampled in full, provided
+#: its own estimate is reliable (Pareto k̂ < 0.7; a heavy-tailed estimate of the leader only
+#: understates its lead).
+SCREEN_MARGIN = 5.0
+
+
+def _screen(s, data, candidates, fit, options) -> dict | None:
+    """The quick ln Z of each candidate noise model, and the leader where it is decisive (see
+    :data:`SCREEN_MARGIN`); None when all candidates must be sampled."""
+    if len(candidates) < 2 or not fit.optima.size:
+        return None
+    quick = {}
+    for noise in candidates:
+        own = {k: v for k, v in (options["priors"] or {}).items()
+               if k in s.param_names or k == NOISE_PRIORS[noise][0]}
+        lik = Likelihood(s, data, noise=noise, priors=own)
+        modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling),
+                                        lik.scaling)
+        try:
+            quick[noise] = screen_noise(lik, modes, seed=options["seed"])
+        except (np.linalg.LinAlgError, FloatingPointError):
+            quick[noise] = None
+        if quick[noise] is None:
+            return None
+    order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
+    leader, other = order[0], order[1]
+    if (quick[leader]["log_z"] - quick[other]["log_z"] < SCREEN_MARGIN
+            or not quick[other]["k_hat"] < K_HAT_MAX):
+        return None
+    return {"leader": leader, "quick": quick}
+
+
+def _exponent_intervals(run: dict) -> dict:
+    """94 % HDIs of the structure's exponents (q, α, β, ...) under one noise model."""
+    lik, post = run["lik"], run["post"]
+    return {p.name: (post.summary[p.name].hdi_low, post.summary[p.name].hdi_high)
+            for p in lik.structure.parameters if p.role == "exponent"}
+
+
+def _choose_noise(name: str, runs: list[dict], screened: dict | None) -> tuple[dict, dict]:
+    """The run whose noise model has the larger evidence, and the record of the choice: each
+    noise model's ln Z (certified, or the quick estimate of a model left out by the screen),
+    its posterior probability (equal prior odds) and the exponents' intervals, and
+    ``sensitive`` when an exponent's intervals under the two models do not overlap."""
+    entries = []  # (noise, log_z, log_z_err, method, intervals, run or None)
+    for r in runs:
+        e = r["criteria"]["evidence"]
+        entries.append((r["lik"].noise, e.log_z if e is not None else -np.inf,
+                        None if e is None else float(e.log_z_err),
+                        None if e is None else e.method, _exponent_intervals(r), r))
+    if screened is not None:
+        for noise, q in screened["quick"].items():
+            if noise != screened["leader"]:
+                entries.append((noise, q["log_z"], None, q["method"], q["intervals"], None))
+    log_z = np.array([e[1] for e in entries])
+    sampled = [i for i, e in enumerate(entries) if e[5] is not None]
+    best = max(sampled, key=lambda i: log_z[i])
+    if np.isfinite(log_z[best]):
+        prob = np.exp(log_z - log_z[best])
+        prob /= prob.sum()
+    else:
+        prob = np.full(len(entries), np.nan)
+    chosen = entries[best][5]
+    record = {"chosen": entries[best][0], "models": {}}
+    for (noise, lz, err, method, hdi, _), p in zip(entries, prob, strict=True):
+        record["models"][noise] = {
+            "log_evidence": float(lz) if np.isfinite(lz) else None, "log_evidence_err": err,
+            "evidence_method": method,
+            "probability": float(p) if np.isfinite(p) else None,
+            "hdi": {k: [float(lo), float(hi)] for k, (lo, hi) in hdi.items()},
+        }
+    intervals = [e[4] for e in entries]
+    apart = []
+    for param in intervals[best]:
+        spans = [iv[param] for iv in intervals if param in iv]
+        if max(lo for lo, _ in spans) > min(hi for _, hi in spans):
+            apart.append(param)
+    record["sensitive"] = bool(apart)
+    record["sensitive_parameters"] = apart
+    other = next(i for i in range(len(entries)) if i != best)
+    delta = log_z[best] - log_z[other]
+    reason = (f"chosen by evidence over {' and '.join(e[0] for e in entries)} noise "
+              + (f"(ln Z higher by {delta:.1f}; probability {prob[best]:.3f})"
+                 if np.isfinite(delta) else "(the other has no evidence)"))
+    chosen["post"] = replace(chosen["post"], noise_reason=reason)
+    if apart:
+        ours, theirs = intervals[best], intervals[other]
+        shown = "; ".join(
+            f"{p} {ours[p][0]:.3g}…{ours[p][1]:.3g} under {entries[best][0]} noise, "
+            f"{theirs[p][0]:.3g}…{theirs[p][1]:.3g} under {entries[other][0]}"
+            for p in apart)
+        decided = np.isfinite(prob[best]) and prob[best] >= NOISE_DECISIVE
+        msg = (f"{name}: the exponents depend on the noise model: 94 % intervals do not overlap "
+               f"({shown}); the evidence favours {entries[best][0]} noise with probability "
+               f"{prob[best]:.3f}")
+        if not decided:
+            msg += (". Give sigma per point, or force a model with --noise, if you know how "
+                    "the instrument's error scales")
+        chosen["criteria"]["warnings"].append(msg)
+        if not decided:
+            warnings.warn(msg, NoiseWarning, stacklevel=3)
+    return chosen, record
+
+
+#: The evidence decides the noise model when it gives the chosen one at least this probability;
+#: below, non-overlapping exponent intervals raise a NoiseWarning (the conclusion then hangs on
+#: a choice the data do not make).
+NOISE_DECISIVE = 0.99
+
+
 def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
     """Optimisation, posterior, criteria and evidence of one structure (runs in a worker process
     when ``compare`` has several). Returns the result and the warnings raised on the way."""
     seed, test = options["seed"], options["test"]
-    noise = options["noise"]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            own = {k: v for k, v in (options["priors"] or {}).items()
-                   if k in s.param_names or k in ("sigma", "sigma_rel")}
-            lik = Likelihood(s, data, noise=noise, priors=own)
-            fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
-            post = ev = None
-            # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
-            if (options["sampler"] == "auto" and options["evidence"] != "bridge"
-                    and fit.optima.size):
-                modes = lik.structure.to_scaled(
-                    lik.structure.to_physical(fit.optima, fit.scaling), lik.scaling)
-                try:
-                    post, ev, info = importance_posterior(lik, modes, seed=seed)
-                except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
-                    post = ev = None
-            if post is None:
-                post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
-                                        fit=fit, progress=False, **options["sampler_kwargs"])
-            criteria = _criteria(lik, fit, post)
-            if post.sampler == "importance":
-                criteria["importance"] = info
-            extra = _evidence(lik, post, seed, options["evidence_check"], options["evidence"],
-                              best_log_likelihood=criteria["max_log_likelihood"], importance=ev)
-            runs = extra.pop("ladder_runs")
-            if runs is not None and not post.converged:
-                post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
+            candidates = _noise_candidates(data, options["noise"])
+            structure = Likelihood(s, data, noise=candidates[0], priors={
+                k: v for k, v in (options["priors"] or {}).items() if k in s.param_names
+            }).structure
+            fit = fit_structure(structure, data, rng=seed, seed_methods=True)
+            screened = _screen(s, data, candidates, fit, options)
+            runs = []
+            for noise in candidates:
+                if screened is not None and noise != screened["leader"]:
+                    continue
+                # Warnings of each noise model's run are held back: only the chosen one's
+                # reach the user (the other's are kept in its record).
+                with warnings.catch_warnings(record=True) as held:
+                    warnings.simplefilter("always")
+                    runs.append(_sample(s, data, noise, fit, options))
+                runs[-1]["caught"] = held
+            if len(candidates) > 1:
+                run, record = _choose_noise(s.name, runs, screened)
+            else:
+                run, record = runs[0], None
+            lik, post, criteria = run["lik"], run["post"], run["criteria"]
+            for w in run["caught"]:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            for other in runs:
+                if other is not run:
+                    record["models"][other["lik"].noise]["warnings"] = list(
+                        dict.fromkeys(str(w.message) for w in other["caught"]))
+            criteria["noise_models"] = record
+            if options["evidence_check"] and criteria["evidence"] is not None:
+                check = _evidence_check(lik, post, criteria["evidence"], seed)
+                criteria["warnings"].extend(check.pop("warnings"))
+                criteria.update(check)
             try:
                 criteria["adequacy"] = check_adequacy(lik, post, seed=seed)
             except InputError as exc:  # e.g. too few frequencies for the statistics
@@ -251,8 +435,6 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
                 criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
             if test is not None:
                 criteria.update(_holdout(lik, post, test))
-            criteria["warnings"].extend(extra.pop("warnings"))
-            criteria.update(extra)
             result = StructureResult(s, fit, post, criteria)
         except InputError as exc:
             result = StructureResult(s, error=str(exc))

@@ -1,8 +1,10 @@
 """Posterior and evidence by importance sampling from the optima: the fast, certified route for
 well-posed structures.
 
-The global optimisation already found the modes. Around each (in the sampling coordinates u,
-log for log-uniform priors), the curvature of the log posterior gives a Laplace approximation;
+The global optimisation already found the modes. Each is polished to the maximum of the log
+posterior under the noise model at hand (L-BFGS-B; the optimiser's least squares weight the
+residuals by the data's magnitude). Around each (in the sampling coordinates u, log for
+log-uniform priors), the curvature of the log posterior gives a Laplace approximation;
 a mixture of multivariate Student-t distributions (5 degrees of freedom, scale 1.5 × the
 Laplace covariance, each mode weighted by its Laplace mass) is the proposal. One vectorised
 call of the likelihood on 20 000 proposal draws gives the importance weights, and from them
@@ -14,7 +16,10 @@ call of the likelihood on 20 000 proposal draws gives the importance weights, an
 The certificate is the weights themselves (Vehtari et al. 2024, Pareto smoothed importance
 sampling): the Pareto shape k̂ of their upper tail below 0.7 says that the proposal's tails
 cover the posterior's and the estimates converge at the usual rate, and their effective sample
-size says how many independent draws they are worth. Where either fails (a ridge, a boundary,
+size says how many independent draws they are worth. Where the first round's weights do not
+certify, a second round adds to the proposal a Student-t matched to their weighted mean and
+covariance (one step of population Monte Carlo), which reaches skewed and bounded directions.
+Where either still fails (a ridge, a boundary,
 a mode the optimiser did not find, an unidentified parameter), the result is None and the
 structure goes to the samplers (emcee, then the tempered ladder).
 
@@ -42,6 +47,12 @@ ESS_MIN_IMPORTANCE = 1000
 #: ln Z from the raw weights needs their variance finite: k̂ below 0.5.
 K_HAT_EVIDENCE = 0.5
 
+NEWTON = 4
+#: Rounds of importance sampling: the Laplace mixture, then one adapted to the weighted draws
+#: of the first (see _adapted). Measured on the 20 °C isotherm: the second round certifies the
+#: Zener under constant noise (k̂ 0.82 → 0.27); third and fourth rounds left the Maxwell's ridge
+#: at an ESS of 190-230 of 20 000, uncertified, so they are not run.
+MAX_ROUNDS = 2
 DF = 5.0        # Student-t degrees of freedom: heavier tails than the Laplace approximation
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
 
@@ -75,6 +86,38 @@ def _hessian(f, u0: np.ndarray, h: np.ndarray):
     return f0, grad, hess
 
 
+def _polish(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The maximum of the log posterior ``f`` near ``u0`` within the box, by L-BFGS-B.
+
+    The optima come from least squares weighted by the data's magnitude; under another noise
+    model (a constant σ) the posterior's mode lies elsewhere, tens of nats higher (measured on
+    the bundled 20 °C isotherm: 31 nats for the Zener), beyond the reach of a few Newton steps
+    that must stay inside the box where a coefficient sits on its prior bound."""
+    from scipy.optimize import minimize
+
+    f0 = f(u0[None, :])[0]
+    if not np.isfinite(f0):
+        return u0
+
+    d = u0.size
+    h = 1e-6 * np.where(np.isfinite(hi - lo), hi - lo, 1.0)
+    stencil = np.vstack([np.zeros(d), np.diag(h), -np.diag(h)])
+
+    def neg(u):
+        # Value and central-difference gradient in one vectorised call.
+        v = f(u[None, :] + stencil)
+        if not np.all(np.isfinite(v)):
+            v0 = v[0]
+            return (-v0 if np.isfinite(v0) else 1e300), np.zeros(d)
+        return -v[0], -(v[1:d + 1] - v[d + 1:]) / (2 * h)
+
+    bounds = [(a if np.isfinite(a) else None, b if np.isfinite(b) else None)
+              for a, b in zip(lo + h, hi - h, strict=True)]
+    res = minimize(neg, np.clip(u0, lo + h, hi - h), jac=True, method="L-BFGS-B",
+                   bounds=bounds, options={"maxiter": 200, "ftol": 1e-12})
+    return res.x if np.isfinite(res.fun) and -res.fun > f0 else u0
+
+
 def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: int = 4):
     """The mode near ``u0`` (a few Newton steps on the log posterior) and the Laplace
     approximation there, as the eigenvalues and eigenvectors ``(w, v)`` of its precision
@@ -84,7 +127,7 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
     h = 1e-4 * span
     # An optimum on a bound of the prior box (a coefficient at its smallest value) is moved just
     # inside, so that the difference stencil stays in the box.
-    u = np.clip(u0, lo + 3 * h, hi - 3 * h)
+    u = _polish(f, np.clip(u0, lo + 3 * h, hi - 3 * h), lo + 3 * h, hi - 3 * h)
     best = None
     for _ in range(newton_steps + 1):
         out = _hessian(f, u, h)
@@ -172,46 +215,30 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     """
     from .evidence import Evidence, log_support_fraction
     from .results import result_from_draws
-    from .transform import _log_prob_fn, _Transform
+    from .transform import _Transform
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
     tr = _Transform(lik)
-    log_prob = _log_prob_fn(lik, tr)
-    modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
-    if modes.size == 0:
-        return None, None, {"reason": "no optimum"}
-    if lik.noise_param:
-        modes = np.column_stack([modes, lik.noise_estimate(modes)])
-    u_modes = tr.to_u(modes)
-    peaks = []
-    for u0 in u_modes:
-        if not np.all(np.isfinite(u0)) or not np.isfinite(log_prob(u0[None, :])[0]):
-            continue
-        peak = _laplace(log_prob, u0, tr.lo_u, tr.hi_u)
-        if peak is None:
-            return None, None, {"reason": "no curvature at an optimum (the support ends or "
-                                          "the Hessian is singular there)"}
-        if not any(np.allclose(peak[1], p[1], rtol=1e-6, atol=1e-8) for p in peaks):
-            peaks.append(peak)
-    if not peaks:
-        return None, None, {"reason": "no optimum lies in the support"}
-    means = np.array([p[1] for p in peaks])
-    factors = [(w / SCALE**2, v) for _, _, (w, v) in peaks]
-    # Each mode weighted by its Laplace mass: height × sqrt(det covariance).
-    log_weights = np.array([p[0] - 0.5 * np.sum(np.log(p[2][0])) for p in peaks])
-    x, log_q = _mvt(factors, means, log_weights, n_proposals, rng)
-    lp = log_prob(x)
-    log_w = np.where(np.isfinite(lp), lp - log_q(x), -np.inf)
-    finite = np.isfinite(log_w)
-    if finite.sum() < 0.1 * n_proposals:
-        return None, None, {"reason": "most proposal draws leave the support"}
+    out = _weights(lik, tr, modes_scaled, n_proposals, rng)
+    if isinstance(out, dict):
+        return None, None, out
     az = arviz()
-    smoothed, k_hat = az.psislw(log_w[finite].copy())
-    k_hat = float(k_hat)
-    w = np.exp(smoothed - logsumexp(smoothed))
-    ess = float(1.0 / np.sum(w**2))
-    info = {"k_hat": k_hat, "ess": ess, "n_modes": len(peaks), "n_proposals": n_proposals}
+    rounds = 1
+    while True:
+        x, log_w, finite, n_modes, _ = out
+        smoothed, k_hat = az.psislw(log_w[finite].copy())
+        k_hat = float(k_hat)
+        w = np.exp(smoothed - logsumexp(smoothed))
+        ess = float(1.0 / np.sum(w**2))
+        if (k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE) or rounds == MAX_ROUNDS:
+            break
+        adapted = _adapted(out, n_proposals, rng)
+        if adapted is None:
+            break
+        out, rounds = adapted, rounds + 1
+    info = {"k_hat": k_hat, "ess": ess, "n_modes": n_modes, "n_proposals": n_proposals,
+            "rounds": rounds}
     if not (k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE):
         info["reason"] = (f"importance weights not certified (Pareto k {k_hat:.2f}, ESS "
                           f"{ess:.0f})")
@@ -248,3 +275,128 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
                             method="importance", log_support=log_s,
                             n_likelihood=int(n_proposals), seconds=info["seconds"])
     return post, evidence, info
+
+
+def _weights(lik: Likelihood, tr, modes_scaled, n_proposals: int, rng: np.random.Generator):
+    """Proposal draws ``x`` (u coordinates) from the Student-t mixture at the Laplace
+    approximations of the modes, their log importance weights, which are finite, and the number
+    of distinct modes; or a dict with the ``reason`` the route does not apply."""
+    from .transform import _log_prob_fn
+
+    log_prob = _log_prob_fn(lik, tr)
+    modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
+    if modes.size == 0:
+        return {"reason": "no optimum"}
+    if lik.noise_param:
+        modes = np.column_stack([modes, lik.noise_estimate(modes)])
+    u_modes = tr.to_u(modes)
+    peaks = []
+    for u0 in u_modes:
+        if not np.all(np.isfinite(u0)) or not np.isfinite(log_prob(u0[None, :])[0]):
+            continue
+        peak = _laplace(log_prob, u0, tr.lo_u, tr.hi_u, newton_steps=NEWTON)
+        if peak is None:
+            return {"reason": "no curvature at an optimum (the support ends or the Hessian is "
+                              "singular there)"}
+        if not any(np.allclose(peak[1], p[1], rtol=1e-6, atol=1e-8) for p in peaks):
+            peaks.append(peak)
+    if not peaks:
+        return {"reason": "no optimum lies in the support"}
+    means = np.array([p[1] for p in peaks])
+    factors = [(w / SCALE**2, v) for _, _, (w, v) in peaks]
+    # Each mode weighted by its Laplace mass: height × sqrt(det covariance).
+    log_weights = np.array([p[0] - 0.5 * np.sum(np.log(p[2][0])) for p in peaks])
+    x, log_q = _mvt(factors, means, log_weights, n_proposals, rng)
+    lp = log_prob(x)
+    log_w = np.where(np.isfinite(lp), lp - log_q(x), -np.inf)
+    finite = np.isfinite(log_w)
+    if finite.sum() < 0.1 * n_proposals:
+        return {"reason": "most proposal draws leave the support"}
+    proposal = {"factors": factors, "means": means, "log_weights": log_weights,
+                "log_prob": log_prob}
+    return x, log_w, finite, len(peaks), proposal
+
+
+def _adapted(first, n_proposals: int, rng: np.random.Generator):
+    """A second round of importance sampling whose proposal adds, with half the weight, a
+    Student-t matched to the mean and covariance of the first round's weighted draws (one step
+    of population Monte Carlo). The half of the first proposal keeps its coverage of every
+    mode; the matched component reaches the skewed or bounded directions the Laplace
+    approximations miss (measured on the bundled 20 °C isotherm: the Zener under constant noise,
+    whose b1 leans on its prior bound, goes from Pareto k̂ 0.75-0.82 to certified). None where
+    the first round's draws are too few to estimate a covariance."""
+    x, log_w, finite, n_modes, prop = first
+    xs = x[finite]
+    smoothed, _ = arviz().psislw(log_w[finite].copy())
+    w = np.exp(smoothed - logsumexp(smoothed))
+    d = xs.shape[1]
+    if 1.0 / np.sum(w**2) < 10 * d:
+        return None
+    mean = w @ xs
+    centred = xs - mean
+    cov = (centred * w[:, None]).T @ centred
+    eig, vec = np.linalg.eigh(cov)
+    if not np.all(np.isfinite(eig)) or eig.min() <= 0:
+        return None
+    base = prop.get("base", prop)
+    lw0 = base["log_weights"] - logsumexp(base["log_weights"])
+    factors = list(base["factors"]) + [(1.0 / eig, vec)]
+    means = np.vstack([base["means"], mean])
+    log_weights = np.append(lw0 + math.log(0.5), math.log(0.5))
+    x2, log_q = _mvt(factors, means, log_weights, n_proposals, rng)
+    lp = prop["log_prob"](x2)
+    log_w2 = np.where(np.isfinite(lp), lp - log_q(x2), -np.inf)
+    finite2 = np.isfinite(log_w2)
+    if finite2.sum() < 0.1 * n_proposals:
+        return None
+    return x2, log_w2, finite2, n_modes, {**prop, "factors": factors, "means": means,
+                                          "log_weights": log_weights, "base": base}
+
+
+def _log_support(lik, rng):
+    from .evidence import log_support_fraction
+
+    return log_support_fraction(lik, rng, n=5000)
+
+
+def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: int = 5000,
+                 interval: float = 0.94) -> dict | None:
+    """A quick, uncertified ln Z of ``lik`` and central intervals of its exponents, from the
+    raw importance weights of the same proposal, whatever their Pareto k̂; None where the
+    route does not apply.
+
+    Used to choose between noise models when one is far ahead (see
+    :func:`bayesfo.comparison.run.compare`): a structure's two noise models share its ridges and
+    modes, so the proposal's shortfall largely cancels in the difference of their ln Z, and a
+    gap of many nats decides without a certified posterior of the loser. ``k_hat`` is returned
+    so that the caller can see how rough the estimate is.
+    """
+    from .transform import _Transform
+
+    rng = np.random.default_rng(seed)
+    tr = _Transform(lik)
+    out = _weights(lik, tr, modes_scaled, n_proposals, rng)
+    if isinstance(out, dict):
+        return None
+    x, log_w, finite, _, _ = out
+    lw = log_w[finite]
+    smoothed, k_hat = arviz().psislw(lw.copy())
+    try:
+        log_s, _ = _log_support(lik, rng)
+    except InputError:
+        return None
+    log_z = float(logsumexp(np.where(finite, log_w, -np.inf)) - math.log(n_proposals)) - log_s
+    w = np.exp(smoothed - logsumexp(smoothed))
+    theta = tr.to_theta(x[finite])
+    tail = (1.0 - interval) / 2.0
+    intervals = {}
+    for i, p in enumerate(lik.structure.parameters):
+        if p.role != "exponent":
+            continue
+        order = np.argsort(theta[:, i])
+        cdf = np.cumsum(w[order])
+        lo = theta[order[min(np.searchsorted(cdf, tail), cdf.size - 1)], i]
+        hi = theta[order[min(np.searchsorted(cdf, 1.0 - tail), cdf.size - 1)], i]
+        intervals[p.name] = (float(lo), float(hi))
+    return {"log_z": log_z, "k_hat": float(k_hat), "intervals": intervals,
+            "method": "importance (uncertified)"}

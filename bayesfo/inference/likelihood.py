@@ -44,7 +44,11 @@ NOISE_PRIORS = {
 
 
 def choose_noise(data: FrequencyResponse, noise: str = "auto") -> tuple[str, str]:
-    """Resolve ``"auto"`` and say why.
+    """Resolve ``"auto"`` by a rule, and say why.
+
+    This is the default of a bare :class:`Likelihood`. :func:`bayesfo.compare` does not use the
+    rule: without σ it runs each structure under both ``constant`` and ``proportional`` noise
+    and keeps the one with the larger evidence (see ``docs/adequacy.md``).
 
     Returns
     -------

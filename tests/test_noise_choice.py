@@ -1,0 +1,120 @@
+"""The noise model as part of the model: without a stated σ, ``compare`` runs each structure
+under constant and under proportional noise and keeps the one with the larger evidence, states
+both, and flags the exponents whose intervals differ between them (``noise_sensitive``)."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import bayesfo as bf
+from bayesfo.comparison.run import NOISE_DECISIVE
+from bayesfo.data import FrequencyResponse
+from bayesfo.structures import get_structure
+
+OMEGA = np.logspace(np.log10(0.6), np.log10(300.0), 25)
+#: Zener compliance (b0 + b1 s^q)/(1 + a1 s^q), a1 = 1, b0 = 3, b1 = 0.6, q = 0.6: |G| spans
+#: half a decade over OMEGA, where a constant and a relative σ differ by a factor 3 at the ends.
+ZENER = [1.0, 3.0, 0.6, 0.6]
+#: The same with b0 = 10, b1 = 0.1: |G| spans 1.2 decades, and on 4 seeds with 4 % noise the
+#: true noise model's ln Z leads by 16-36 nats (proportional) and 13-51 (constant).
+WIDE = [1.0, 10.0, 0.1, 0.6]
+
+
+def zener_data(seed: int, noise: str, level: float = 0.02, theta=ZENER) -> FrequencyResponse:
+    """Zener compliance with complex noise of sd ``level``·|G| (proportional) or ``level``·
+    median |G| (constant); no σ in the data."""
+    rng = np.random.default_rng(seed)
+    g = get_structure("zener").response(theta, OMEGA, "compliance")
+    sd = level * (np.abs(g) if noise == "proportional" else np.median(np.abs(g)))
+    noisy = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
+    return FrequencyResponse(OMEGA, noisy, kind="compliance", name=f"zener {noise} {seed}")
+
+
+def _compare(data, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return bf.compare(data, "zener", seed=3, progress=False, **kw)
+
+
+def test_span_is_half_a_decade():
+    g = np.abs(get_structure("zener").response(ZENER, OMEGA, "compliance"))
+    assert 0.45 < np.log10(g.max() / g.min()) < 0.6
+
+
+@pytest.mark.parametrize("truth", ["proportional", "constant"])
+def test_evidence_picks_the_noise_model_that_made_the_data(truth):
+    result = _compare(zener_data(0, truth, level=0.04, theta=WIDE))["zener"]
+    record = result.to_dict()
+    assert record["noise"] == truth
+    models = record["noise_models"]
+    assert set(models["models"]) == {"constant", "proportional"}
+    assert models["chosen"] == truth
+    assert models["models"][truth]["probability"] > NOISE_DECISIVE
+    other = ({"constant", "proportional"} - {truth}).pop()
+    assert models["models"][truth]["log_evidence"] > models["models"][other]["log_evidence"] + 5
+    assert "chosen by evidence" in record["noise_reason"]
+    # The reported ln Z is that of the chosen noise model.
+    assert record["log_evidence"] == pytest.approx(models["models"][truth]["log_evidence"])
+
+
+def test_a_forced_or_stated_noise_model_is_not_second_guessed():
+    data = zener_data(1, "proportional")
+    forced = _compare(data, noise="constant")["zener"].to_dict()
+    assert forced["noise"] == "constant" and forced["noise_models"] is None
+    assert forced["noise_sensitive"] is None
+    with_sigma = FrequencyResponse(data.omega, data.response, 0.02 * np.abs(data.response),
+                                   kind="compliance")
+    known = _compare(with_sigma)["zener"].to_dict()
+    assert known["noise"] == "known" and known["noise_models"] is None
+
+
+def test_noise_sensitive_when_the_intervals_part():
+    # Unit check of the rule on two fabricated runs: q 0.50…0.52 against 0.55…0.60 do not
+    # overlap; 0.50…0.56 against 0.55…0.60 do.
+    from types import SimpleNamespace
+
+    from bayesfo.comparison.run import _choose_noise
+
+    def run(noise, lo, hi, log_z):
+        summary = {"q": SimpleNamespace(hdi_low=lo, hdi_high=hi)}
+        post = SimpleNamespace(summary=summary)
+        structure = SimpleNamespace(parameters=[SimpleNamespace(name="q", role="exponent"),
+                                                SimpleNamespace(name="b0", role="coefficient")])
+        lik = SimpleNamespace(noise=noise, structure=structure)
+        ev = SimpleNamespace(log_z=log_z, log_z_err=0.01, method="importance")
+        return {"lik": lik, "post": post, "criteria": {"evidence": ev, "warnings": []}}
+
+    import dataclasses
+
+    @dataclasses.dataclass(frozen=True)
+    class Post:
+        summary: dict
+        noise_reason: str = ""
+
+    for (lo, hi), sensitive in (((0.50, 0.52), True), ((0.50, 0.56), False)):
+        runs = [run("constant", lo, hi, -10.0), run("proportional", 0.55, 0.60, -10.5)]
+        for r in runs:
+            r["post"] = Post(r["post"].summary)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            chosen, record = _choose_noise("zener", runs, None)
+        assert chosen is runs[0] and record["chosen"] == "constant"
+        assert record["sensitive"] is sensitive
+        assert record["sensitive_parameters"] == (["q"] if sensitive else [])
+        # ln Z differ by 0.5: probabilities 0.62 / 0.38, which does not decide: a warning.
+        assert record["models"]["constant"]["probability"] == pytest.approx(
+            1 / (1 + np.exp(-0.5)))
+        assert bool(caught) is sensitive
+        assert "chosen by evidence" in chosen["post"].noise_reason
+
+
+def test_q_coverage_with_half_a_decade_and_relative_noise():
+    """Issue check: Zener data with |G| spanning half a decade and 2 % proportional noise; the
+    default's 94 % HDI of q covers the truth in at least 17 of 20 seeds (binomial: a calibrated
+    94 % interval misses more than 3 times in 20 with probability 0.12). Measured: 12 s."""
+    covered = []
+    for seed in range(20):
+        q = _compare(zener_data(seed, "proportional"))["zener"].posterior.summary["q"]
+        covered.append(q.hdi_low <= ZENER[3] <= q.hdi_high)
+    assert sum(covered) >= 17, covered

@@ -237,6 +237,7 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     elif result.structure.integer:
         out.append((f"{name} is an integer-order structure (its exponents are fixed at 1).",
                     False))
+    out.extend(_noise_sentences(name, result))
     poor = [r["structure"] for r in rows[1:]
             if (o := _order(comparison[r["structure"]]))[1] is not None and o[1].poorly_determined]
     if poor:
@@ -246,7 +247,8 @@ def verdict(comparison) -> list[tuple[str, bool]]:
         post = result.posterior
         out.append((f"Caution: the posterior of {name} did not converge (R-hat "
                     f"{post.rhat_max:.3f}, ESS {post.ess_min:.0f}); its log-evidence and the "
-                    "ranking that rests on it are unreliable.", True))
+                    "ranking that rests on it are unreliable. Try a longer run (--max-steps "
+                    "40000), more walkers (--walkers) or a narrower prior (--prior).", True))
         conv = next((r for r in rows if r["converged"]), None)
         if conv is not None and conv["log_evidence"] is not None and best["log_evidence"] is not None:
             out.append((f"The best-supported structure whose posterior converged is "
@@ -274,11 +276,48 @@ def _join(items) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
+def _noise_sentences(name, result) -> list[tuple[str, bool]]:
+    """How the winner's noise model was chosen, and whether its exponents depend on it."""
+    from .comparison.run import NOISE_DECISIVE
+
+    record = result.criteria.get("noise_models")
+    if not record:
+        return []
+    chosen = record["chosen"]
+    models = record["models"]
+    p = models[chosen]["probability"]
+    others = [n for n in models if n != chosen]
+    text = (f"Noise model of {name}: {chosen}, chosen by evidence over "
+            f"{_join(others)} noise" + (f" (probability {p:.3f})." if p is not None else "."))
+    if not record["sensitive"]:
+        return [(text, False)]
+    parts = []
+    for param in record["sensitive_parameters"]:
+        spans = [f"{models[n]['hdi'][param][0]:.3g}–{models[n]['hdi'][param][1]:.3g} under {n} "
+                 "noise" for n in [chosen, *others] if param in models[n]["hdi"]]
+        parts.append(f"{param} {'; '.join(spans)}")
+    decided = p is not None and p >= NOISE_DECISIVE
+    text += (f" Its exponents depend on the noise model ({HDI_PERCENT} % intervals that do not "
+             f"overlap: {'; '.join(parts)})"
+             + ("; the evidence decides between them." if decided else
+                "; the evidence does not decide between them, so state σ per point or choose "
+                "the noise model (--noise) from what you know of the instrument."))
+    return [(text, not decided)]
+
+
 def _noise(comparison) -> list[tuple[str, str]]:
     seen = []
+    chosen: dict[str, list[str]] = {}
     for r in comparison.results:
-        if r.posterior is not None and (r.posterior.noise, r.posterior.noise_reason) not in seen:
+        if r.posterior is None:
+            continue
+        if r.criteria.get("noise_models"):
+            chosen.setdefault(r.posterior.noise, []).append(r.name)
+        elif (r.posterior.noise, r.posterior.noise_reason) not in seen:
             seen.append((r.posterior.noise, r.posterior.noise_reason))
+    if chosen:
+        seen.append(("by evidence per structure", "; ".join(
+            f"{noise} for {_join(names)}" for noise, names in chosen.items())))
     return seen
 
 
@@ -306,7 +345,7 @@ RANKING_COLUMNS = (
     # (key, header, format)
     ("log_evidence", "ln Z", ".2f"), ("log_evidence_err", "± err", ".2f"),
     ("delta_log_evidence", "Δln Z", ".2f"), ("posterior_probability", "P", None),
-    ("loo", "elpd LOO", ".2f"), ("loo_se", "± se", ".2f"), ("waic", "elpd WAIC", ".2f"),
+    ("loo", "elpd LOO", ".2f"), ("loo_se", "± se", ".2f"),
     ("aic", "AIC", ".2f"), ("bic", "BIC", ".2f"), ("rmse", "RMSE", ".3g"),
     ("pareto_k_max", "Pareto k max", ".2f"), ("rhat_max", "R-hat", ".3f"),
     ("ess_min", "ESS min", ".0f"),
@@ -317,7 +356,7 @@ def _ranking_table(comparison) -> str:
     holdout = comparison.holdout is not None
     cols = list(RANKING_COLUMNS)
     if holdout:
-        cols.insert(10, ("holdout_lpd", "held-out lpd", ".2f"))
+        cols.insert(9, ("holdout_lpd", "held-out lpd", ".2f"))
     head = ('<tr><th>#</th><th class="text">structure</th><th>k</th>'
             + "".join(f"<th>{_e(h)}</th>" for _, h, _ in cols)
             + '<th>q (sd)</th><th class="text">converged</th></tr>')
@@ -345,10 +384,13 @@ def _ranking_table(comparison) -> str:
         ok = row["converged"]
         cells.append(f'<td class="text{"" if ok else " flag"}">{"yes" if ok else "NO"}</td>')
         body.append(f'<tr id="row-{_e(name)}">' + "".join(cells) + "</tr>")
-    note = ("<p class='small'>Ranked by ln Z (bridge sampling from the posterior draws; where "
-            "a posterior did not converge, from the particles of a tempered ladder, marked L); Δln Z to the best; P: posterior "
+    note = ("<p class='small'>Ranked by ln Z (from the certified importance weights where "
+            "they gave the posterior, else bridge sampling from the emcee draws, or the "
+            "particles of a tempered ladder, marked L); Δln Z to the best; P: posterior "
             "model probability; elpd: expected log pointwise predictive density (higher is "
-            "better) with the standard error of each estimate; AIC and BIC: lower is better; "
+            "better) with the standard error of each estimate, by PSIS-LOO, whose Pareto k "
+            "says where it is unreliable (WAIC, which estimates the same without a diagnostic "
+            "of its own, is in ranking.csv and summary.json); AIC and BIC: lower is better; "
             "RMSE at the posterior mode (thesis eq. (3.23)); q: posterior mean and sd of the "
             "fractional order (β for the generalised Maxwell model).</p>")
     return f"<table>{head}{''.join(body)}</table>{note}"
@@ -463,38 +505,24 @@ def _diagnostics_section(comparison) -> str:
 
 
 def _caption(name: str, comparison=None) -> str:
+    """The caption of a figure: what it shows for this comparison (:mod:`bayesfo.plotting.captions`),
+    else the generic text."""
+    if comparison is not None:
+        from .plotting.captions import figure_caption
+
+        text = figure_caption(name, comparison)
+        if text:
+            return text
     if name in CAPTIONS:
         return CAPTIONS[name]
     kind, _, structure = name.partition("_")
-    post = None
-    if comparison is not None and kind == "trace":
-        try:
-            post = comparison[structure].posterior
-        except KeyError:
-            post = None
-    if post is not None:
-        diag = f"R-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f}"
-        if getattr(post, "sampler", "emcee") == "importance":
-            return (f"Posterior draws of {structure} resampled from importance weights (ESS "
-                    f"{post.ess_min:.0f}; no chain to trace): the marginal of each parameter.")
-        if getattr(post, "sampler", "emcee") == "ladder":
-            return (f"Particles of {structure} from {post.n_walkers} independent tempered-ladder "
-                    f"runs, one histogram per run: "
-                    + ("they agree, which certifies the posterior" if post.converged else
-                       "they disagree, so the posterior is not certified") + f" ({diag}).")
-        if post.converged:
-            return (f"Walker traces of {structure} after burn-in: the walkers overlap and show "
-                    f"no trend ({diag}).")
-        return (f"Walker traces of {structure} after burn-in: the walkers have not converged "
-                f"({diag}; the targets are R-hat < 1.01 and ESS ≥ 400), so they drift or do "
-                "not overlap and the posterior is flagged.")
     if kind == "corner":
         return (f"Posterior of {structure}: marginal and pairwise distributions (log10 of "
                 "parameters with a log-uniform prior; contours hold 50 % and 90 %), with the "
                 "posterior mode and the least-squares optimum.")
     if kind == "trace":
-        return (f"Walker traces of {structure} after burn-in: well-mixed walkers overlap and "
-                "show no trend.")
+        return (f"Walker traces of {structure} after burn-in; whether they converged is stated "
+                "under 'Warnings and convergence'.")
     return name
 
 

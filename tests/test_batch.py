@@ -291,6 +291,8 @@ def test_temperature_table_and_figure(reference):
     q_best = {r["dataset"]: float(r["q_mean"]) for r in rows if r["best"] == "True"}
     assert q_best["Tm010C"] > q_best["Tp150C"] + 0.1
 
+    from matplotlib.colors import to_rgba
+
     from bayesfo.batch import temperature_rows
     from bayesfo.plotting.batch import plot_q_temperature
 
@@ -298,8 +300,11 @@ def test_temperature_table_and_figure(reference):
     fig = plot_q_temperature(trows)
     ax_q, ax_p = fig.axes[:2]
     # Filled markers are the best structure at each temperature, at its posterior mean of q.
-    filled = [(x, y) for line in ax_q.lines if line.get_marker() == "o"
-              and line.get_markerfacecolor() != "white"
+    # (each structure has its own marker; "x" marks an unconverged posterior, "_" the caps of
+    # the HDI bars)
+    filled = [(x, y) for line in ax_q.lines if line.get_linestyle() in ("None", "none", "")
+              and line.get_marker() not in ("x", "_", "None", "")
+              and to_rgba(line.get_markerfacecolor()) != to_rgba("white")
               for x, y in zip(line.get_xdata(), line.get_ydata())]
     expected = sorted((r["temperature_C"], r["q_mean"]) for r in trows if r["best"])
     got = sorted(filled)

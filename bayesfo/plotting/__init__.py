@@ -8,16 +8,25 @@ artists, so that what a figure shows can be checked against an independent compu
 Modules
 -------
 ``style``
-    The one figure style (:func:`style`, a matplotlib ``rc_context``), colours by ranking.
+    The one figure style (:func:`style`, a matplotlib ``rc_context``) and the one style of each
+    structure (:func:`~bayesfo.plotting.style.structure_styles`: colour, line style, marker by
+    the structure's position among those requested), shared by comparison and batch figures.
 ``response``
-    :func:`plot_bode`, :func:`plot_nyquist`, :func:`plot_residuals`: posterior response bands
-    against the data.
+    :func:`plot_bode`, :func:`plot_nyquist` (log-magnitude form for data over many decades),
+    :func:`plot_residuals`: posterior response bands against the data; structures whose
+    curves coincide are named in the legend.
 ``posterior``
     :func:`plot_corner`, :func:`plot_trace` (one structure), :func:`plot_q_posteriors`.
 ``ranking``
     :func:`plot_ranking`: Δln Z and the information criteria.
 ``output``
     :func:`save_figure` (atomic) and :func:`write_figures` (every figure of a comparison).
+``captions``
+    :func:`~bayesfo.plotting.captions.figure_caption`: what each written figure shows for its
+    structure and data (e.g. a trace that did not converge), without matplotlib.
+``batch``
+    :func:`~bayesfo.plotting.batch.plot_batch_summary`,
+    :func:`~bayesfo.plotting.batch.plot_q_temperature`: figures of a batch of comparisons.
 ``studies``
     :func:`plot_rmse_surface` (thesis Figure 3.2).
 

@@ -24,21 +24,26 @@ class Drawn:
         in the units of the axes before any display offsets.
     artists : Mapping[str, object]
         The matplotlib artists, under the same keys as the values they show.
+    caption : str
+        What the figure shows for the results it was drawn from (e.g. that the walkers of a
+        trace did not converge), for a caption under it; empty where the function gives none.
     """
 
     figure: Any
     axes: tuple
     values: Mapping[str, np.ndarray]
     artists: Mapping[str, Any]
+    caption: str = ""
 
     @classmethod
-    def build(cls, figure, axes, values: dict, artists: dict) -> Drawn:
+    def build(cls, figure, axes, values: dict, artists: dict, caption: str = "") -> Drawn:
         frozen = {}
         for k, v in values.items():
             a = np.array(v)
             a.setflags(write=False)
             frozen[k] = a
-        return cls(figure, tuple(axes), MappingProxyType(frozen), MappingProxyType(dict(artists)))
+        return cls(figure, tuple(axes), MappingProxyType(frozen), MappingProxyType(dict(artists)),
+                   caption)
 
 
 def new_figure(fig, size, *, layout: str = "constrained"):

@@ -270,3 +270,82 @@ def loo_differences(results) -> dict[str, tuple[float, float]]:
         diff = pointwise[best] - lpd
         out[name] = (float(-diff.sum()), float(np.sqrt(diff.size * np.var(diff))))
     return out
+
+
+#: Two curves that differ by less than this fraction of their axis' span at every point are
+#: drawn within a line width of each other (a 1.2 pt line on an axes of about 150 pt).
+COINCIDE_FRACTION = 0.008
+
+
+def coincident_groups(curves: dict, span: float, fraction: float = COINCIDE_FRACTION
+                      ) -> list[list[str]]:
+    """Groups (of two or more names, in the order given) of curves that coincide on a figure.
+
+    Parameters
+    ----------
+    curves : dict of str to ndarray
+        The curves in the plotted coordinates (log10 for a logarithmic axis), all of one shape;
+        complex values are points of a plane with equal axes.
+    span : float
+        The span of the axis (or the larger span of the two equal axes), in the same coordinates.
+    fraction : float
+        Curves closer than ``fraction * span`` at every point coincide.
+
+    Returns
+    -------
+    list of list of str
+
+    Examples
+    --------
+    >>> coincident_groups({"a": np.zeros(3), "b": np.full(3, 1e-3), "c": np.ones(3)}, 1.0)
+    [['a', 'b']]
+    """
+    tol = fraction * float(span) if np.isfinite(span) and span > 0 else 0.0
+    groups: list[list[str]] = []
+    for name, y in curves.items():
+        y = np.asarray(y)
+        for g in groups:
+            ref = np.asarray(curves[g[0]])
+            if ref.shape == y.shape and bool(np.all(np.abs(y - ref) <= tol)):
+                g.append(name)
+                break
+        else:
+            groups.append([name])
+    return [g for g in groups if len(g) > 1]
+
+
+def join_names(names) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    names = list(names)
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def coincidence_note(groups_by_panel: dict) -> str:
+    """One sentence naming the structures whose curves coincide: ``{panel: groups}`` from
+    :func:`coincident_groups`; a group is named once, with the panels where it coincides unless
+    it coincides in all of them. Empty when nothing coincides."""
+    panels = list(groups_by_panel)
+    where: dict[tuple, list[str]] = {}
+    for panel, groups in groups_by_panel.items():
+        for g in groups:
+            where.setdefault(tuple(g), []).append(panel)
+    parts = []
+    for g, ps in where.items():
+        text = f"{join_names(g)} coincide"
+        if len(ps) < len(panels):
+            text += " in " + join_names(ps)
+        parts.append(text)
+    return "; ".join(parts)
+
+
+#: Above this many decades of |G| the Nyquist diagram is drawn with a logarithmic radius.
+NYQUIST_LOG_DECADES = 2.0
+
+
+def magnitude_decades(*responses) -> float:
+    """Decades spanned by the nonzero |G| of the given responses (0 for none)."""
+    mags = np.concatenate([np.abs(np.asarray(g)).ravel() for g in responses if g is not None])
+    mags = mags[np.isfinite(mags) & (mags > 0)]
+    if mags.size == 0:
+        return 0.0
+    return float(np.log10(mags.max() / mags.min()))

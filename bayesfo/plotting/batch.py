@@ -2,7 +2,9 @@
 
 Both functions take the rows of ``batch_summary.csv`` / ``temperature_summary.csv`` as plain
 dicts (see :mod:`bayesfo.batch`), draw on a new :class:`matplotlib.figure.Figure` (no pyplot
-state) unless ``fig=`` is given, and return the figure.
+state) unless ``fig=`` is given, and return the figure. A structure has the style of
+:func:`~bayesfo.plotting.style.structure_styles` by its position in the structures as requested
+(colour, line style or bar hatch, marker): the same as in the figures of each comparison.
 """
 
 from __future__ import annotations
@@ -12,11 +14,22 @@ import numpy as np
 HDI_LABEL = "94 % HDI"
 
 
-def _structure_colours(names):
-    from matplotlib import colormaps
+#: Hatches of the probability bars, one per line style of :data:`~.style.LINESTYLES`, so that
+#: bars of structures with one colour differ as their curves do.
+HATCHES = {"-": "", "--": "////", ":": "....", "-.": "xxxx"}
+#: Width of the temperature axis [°C] when all data sets have one temperature.
+ONE_TEMPERATURE_WIDTH = 20.0
 
-    cmap = colormaps["tab10"]
-    return {name: cmap(i % 10) for i, name in enumerate(names)}
+
+def _structure_styles(rows, order=None):
+    """``{name: StructureStyle}``: by position in ``order`` (the structures as requested, as
+    in :func:`~.style.comparison_styles`), then the others alphabetically, including
+    structures without results, so that a structure has one style in every figure."""
+    from .style import structure_styles
+
+    names = list(dict.fromkeys(order or []))
+    others = {r["structure"] for r in rows if r.get("structure")} - set(names)
+    return structure_styles(names + sorted(others))
 
 
 def _figure(fig, width, height):
@@ -40,17 +53,17 @@ def _has_q(row) -> bool:
     return all(row.get(k) is not None for k in ("q_mean", "q_hdi_low", "q_hdi_high"))
 
 
-def _q_errorbar(ax, x, rows, colour, filled_mask, marker="o"):
-    """q means with HDI bars; filled markers where ``filled_mask`` (the best structure), a
-    cross where the posterior did not converge."""
+def _q_errorbar(ax, x, rows, st, filled_mask):
+    """q means with HDI bars in the style ``st`` of the structure; filled markers where
+    ``filled_mask`` (the best structure), a cross where the posterior did not converge."""
     mean = np.array([r["q_mean"] for r in rows], dtype=float)
     low = np.array([r["q_hdi_low"] for r in rows], dtype=float)
     high = np.array([r["q_hdi_high"] for r in rows], dtype=float)
     yerr = np.vstack([np.clip(mean - low, 0, None), np.clip(high - mean, 0, None)])
-    ax.errorbar(x, mean, yerr=yerr, fmt="none", ecolor=colour, elinewidth=1.2, capsize=2.5)
+    ax.errorbar(x, mean, yerr=yerr, fmt="none", ecolor=st.color, elinewidth=1.2, capsize=2.5)
     filled = np.asarray(filled_mask, dtype=bool)
-    ax.plot(x[filled], mean[filled], marker, color=colour, markersize=6, linestyle="none")
-    ax.plot(x[~filled], mean[~filled], marker, markerfacecolor="white", color=colour,
+    ax.plot(x[filled], mean[filled], st.marker, color=st.color, markersize=6, linestyle="none")
+    ax.plot(x[~filled], mean[~filled], st.marker, markerfacecolor="white", color=st.color,
             markersize=6, linestyle="none")
     unconverged = np.array([r.get("converged") is False for r in rows], dtype=bool)
     if unconverged.any():
@@ -58,18 +71,19 @@ def _q_errorbar(ax, x, rows, colour, filled_mask, marker="o"):
                 linestyle="none")
 
 
-def _q_legend(ax, labels, colours, **kwargs):
-    """One entry per structure, and what filled and hollow markers mean."""
+def _q_legend(ax, labels, styles, **kwargs):
+    """One entry per structure, and what filled and hollow markers mean (``ax`` may be the
+    figure: a legend beside the axes)."""
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], marker="o", color=c, linestyle="none", markersize=6)
-               for c in colours]
+    handles = [Line2D([], [], marker=st.marker, color=st.color, linestyle="none", markersize=6)
+               for st in styles]
     handles += [Line2D([], [], marker="o", color="0.3", linestyle="none", markersize=6),
                 Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
                        linestyle="none", markersize=6),
                 Line2D([], [], marker="x", color="0.15", linestyle="none", markersize=4)]
-    ax.legend(handles, [*labels, "best structure", "not the best", "not converged"],
-              frameon=False, **kwargs)
+    return ax.legend(handles, [*labels, "best structure", "not the best", "not converged"],
+                     frameon=False, **kwargs)
 
 
 def plot_batch_summary(rows, structures=None, fig=None):
@@ -103,8 +117,8 @@ def plot_batch_summary(rows, structures=None, fig=None):
         # Isotherms: in order of temperature, not of name (Tm010C would precede Tm040C).
         datasets.sort(key=lambda d: float(temps[d]))
     failed = {r["dataset"] for r in rows if r.get("status") != "ok"}
+    styles = _structure_styles(rows, structures)
     structures = _structures_in_order(rows, structures)
-    colours = _structure_colours(structures)
     n = len(datasets)
     fig = _figure(fig, min(max(6.0, 0.5 * n + 2.5), 30.0), 6.0)
     ax_p, ax_q = fig.subplots(2, 1, sharex=True, height_ratios=[1, 1.4])
@@ -117,7 +131,9 @@ def plot_batch_summary(rows, structures=None, fig=None):
         for r in rows:
             if r.get("structure") == name and r.get("posterior_probability") is not None:
                 p[index[r["dataset"]]] = r["posterior_probability"]
-        ax_p.bar(x, p, bottom=bottom, color=colours[name], width=0.75, label=name)
+        st = styles[name]
+        ax_p.bar(x, p, bottom=bottom, color=st.color, width=0.75, label=name,
+                 hatch=HATCHES.get(st.linestyle, ""), edgecolor="white", linewidth=0.4)
         bottom += p
     for r in rows:
         if r.get("best"):
@@ -143,7 +159,7 @@ def plot_batch_summary(rows, structures=None, fig=None):
         xs = np.array([index[r["dataset"]] + off for r in sel])
         qname = sel[0].get("q_parameter") or "q"
         labels.append(name if qname == "q" else f"{name} ({qname})")
-        _q_errorbar(ax_q, xs, sel, colours[name], [bool(r.get("best")) for r in sel])
+        _q_errorbar(ax_q, xs, sel, styles[name], [bool(r.get("best")) for r in sel])
     ax_q.set_ylabel(f"q: posterior mean, {HDI_LABEL}")
     ax_q.set_xticks(x)
     ax_q.set_xticklabels([d + (" (failed)" if d in failed else "") for d in datasets],
@@ -156,7 +172,8 @@ def plot_batch_summary(rows, structures=None, fig=None):
     fig.legend(handles, structures, loc="outside right upper", fontsize=8, frameon=False,
                title="structure", title_fontsize=8)
     if with_q:
-        _q_legend(ax_q, labels, [colours[s] for s in with_q], fontsize=7, loc="best")
+        _q_legend(fig, labels, [styles[s] for s in with_q], fontsize=7,
+                  loc="outside right lower", title="q of", title_fontsize=8)
     ax_q.set_xlim(-0.7, n - 0.3)
     return fig
 
@@ -168,7 +185,9 @@ def plot_q_temperature(rows, structures=None, fig=None):
     against temperature, one colour per structure, filled where the structure is the best at
     that temperature, crossed where its posterior did not converge. Bottom: the posterior
     probability of each structure against temperature (equal prior odds), so the best structure
-    per temperature is the top curve.
+    per temperature is the top curve. With a single temperature the axis is
+    :data:`ONE_TEMPERATURE_WIDTH` °C wide around it, with that temperature as its only tick and
+    the title saying that there is no trend to show.
 
     Parameters
     ----------
@@ -184,39 +203,60 @@ def plot_q_temperature(rows, structures=None, fig=None):
         With two axes: q, then probabilities.
     """
     rows = [r for r in rows if r.get("temperature_C") is not None]
+    styles = _structure_styles(rows, structures)
     structures = _structures_in_order(rows, structures)
-    colours = _structure_colours(structures)
     fig = _figure(fig, 6.5, 6.0)
     ax_q, ax_p = fig.subplots(2, 1, sharex=True, height_ratios=[1.6, 1])
     temps = sorted({float(r["temperature_C"]) for r in rows})
-    span = (temps[-1] - temps[0]) if len(temps) > 1 else 1.0
+    one = len(temps) == 1
+    span = (temps[-1] - temps[0]) if not one else ONE_TEMPERATURE_WIDTH
     with_q = [s for s in structures if any(r.get("structure") == s and _has_q(r) for r in rows)]
-    offsets = (np.linspace(-0.006, 0.006, len(with_q)) * span if len(with_q) > 1
+    # Points of the structures side by side at each temperature: wider apart on the axis of a
+    # single temperature, where nothing else needs the room.
+    spread = 0.08 if one else 0.006
+    offsets = (np.linspace(-spread, spread, len(with_q)) * span if len(with_q) > 1
                else np.zeros(len(with_q)))
     labels = []
     for name, off in zip(with_q, offsets):
         sel = sorted((r for r in rows if r.get("structure") == name and _has_q(r)),
                      key=lambda r: r["temperature_C"])
         t = np.array([float(r["temperature_C"]) for r in sel]) + off
-        ax_q.plot(t, [r["q_mean"] for r in sel], "-", color=colours[name], linewidth=0.8,
-                  alpha=0.6)
+        st = styles[name]
+        if len(sel) > 1:
+            ax_q.plot(t, [r["q_mean"] for r in sel], color=st.color, linestyle=st.linestyle,
+                      linewidth=0.8, alpha=0.6)
         qname = sel[0].get("q_parameter") or "q"
         labels.append(name if qname == "q" else f"{name} ({qname})")
-        _q_errorbar(ax_q, t, sel, colours[name], [bool(r.get("best")) for r in sel])
+        _q_errorbar(ax_q, t, sel, st, [bool(r.get("best")) for r in sel])
     ax_q.set_ylabel(f"q: posterior mean, {HDI_LABEL}")
     if with_q:
-        _q_legend(ax_q, labels, [colours[s] for s in with_q], fontsize=8, loc="best")
+        _q_legend(fig, labels, [styles[s] for s in with_q], fontsize=8,
+                  loc="outside right upper", title="q of", title_fontsize=8)
     ax_q.set_title("Posterior of the fractional order against temperature", fontsize=10)
 
-    for name in structures:
+    # At a single temperature the probabilities sit side by side too.
+    p_offsets = (np.linspace(-spread, spread, len(structures)) * span if one and
+                 len(structures) > 1 else np.zeros(len(structures)))
+    for name, off in zip(structures, p_offsets):
         sel = sorted((r for r in rows if r.get("structure") == name
                       and r.get("posterior_probability") is not None),
                      key=lambda r: r["temperature_C"])
         if sel:
-            ax_p.plot([r["temperature_C"] for r in sel], [r["posterior_probability"] for r in sel],
-                      "o-", color=colours[name], markersize=4, linewidth=1, label=name)
+            st = styles[name]
+            ax_p.plot([float(r["temperature_C"]) + off for r in sel],
+                      [r["posterior_probability"] for r in sel],
+                      color=st.color, linestyle=st.linestyle, marker=st.marker, markersize=4,
+                      linewidth=1, label=name)
     ax_p.set_ylim(-0.05, 1.05)
     ax_p.set_ylabel("posterior probability")
     ax_p.set_xlabel("temperature [°C]")
     ax_p.legend(fontsize=8, frameon=False, ncols=min(len(structures), 3) or 1)
+    if one:
+        # One isotherm: an axis of a sensible width around it, its temperature as the only
+        # tick, and a note that there is no trend to read.
+        t0 = temps[0]
+        ax_p.set_xlim(t0 - ONE_TEMPERATURE_WIDTH / 2, t0 + ONE_TEMPERATURE_WIDTH / 2)
+        ax_p.set_xticks([t0], [f"{t0:g}"])
+        ax_q.set_title(f"Posterior of the fractional order at one temperature ({t0:g} °C):\n"
+                       "a single isotherm, so no trend with temperature to show", fontsize=10)
     return fig

@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 import os
-import re
 import tempfile
 from pathlib import Path
 
 from ..errors import InputError
 from ..identify.optimize import linear_fits
 from ._compute import ok_results, order_parameter
+from .captions import file_stem
 from .posterior import plot_corner, plot_q_posteriors, plot_trace
 from .ranking import plot_ranking
 from .response import plot_bode, plot_nyquist, plot_residuals
-from .style import colors_for, style
+from .style import comparison_styles, style
 
 
 def save_figure(fig, path) -> None:
@@ -33,8 +33,7 @@ def save_figure(fig, path) -> None:
         raise
 
 
-def _file_stem(name: str) -> str:
-    return re.sub(r"[^A-Za-z0-9._-]", "_", name)
+_file_stem = file_stem
 
 
 def _check_formats(formats) -> tuple[str, ...]:
@@ -79,9 +78,9 @@ def figure_jobs(comparison, *, seed: int = 0) -> list[tuple[str, object]]:
     """``(name, make)`` for every figure of a comparison, ``make()`` returning a
     :class:`~bayesfo.plotting.Drawn`; structures that failed are left out."""
     jobs = list(_combined_makers(comparison, seed).items())
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     for r in ok_results(comparison):
-        jobs.extend(_structure_makers(r, comparison.data, colors[r.name]).items())
+        jobs.extend(_structure_makers(r, comparison.data, styles[r.name].color).items())
     return jobs
 
 
@@ -165,9 +164,10 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
         return written
     order = [name for name, _ in figure_jobs(comparison, seed=seed)]
     combined = list(_combined_makers(comparison, seed))
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     # Per-structure tasks carry one result only; the combined figures need all of them.
-    tasks = [("structure", r, comparison.data, colors[r.name]) for r in ok_results(comparison)]
+    tasks = [("structure", r, comparison.data, styles[r.name].color)
+             for r in ok_results(comparison)]
     tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
     futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed) for t in reversed(tasks)]
     drawn = {}

@@ -18,7 +18,8 @@ from ._compute import (
     scaled_label,
     to_coordinates,
 )
-from .style import COLUMN_WIDTH, FLAG_COLOR, PAGE_WIDTH, colors_for, style
+from .captions import corner_caption, trace_caption
+from .style import COLUMN_WIDTH, FLAG_COLOR, PAGE_WIDTH, comparison_styles, style
 
 #: Probability mass inside the 2-D contours of the corner plot (the bands of the response plots).
 CORNER_LEVELS = (0.5, 0.9)
@@ -44,7 +45,8 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
     a log-uniform prior (axis labels say so), the parameter itself otherwise, divided by a
     power of ten when its values are very small or large (the label gives the factor); noise
     parameters sampled with the structure are included. Contours enclose 50 % and 90 % of the
-    draws.
+    draws. However many parameters, the axis labels clear the tick labels and every label stays
+    inside the figure: they are placed, and the margins set, from the drawn tick labels.
 
     Parameters
     ----------
@@ -71,7 +73,8 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
         parameters or when no admissible optimum was found), ``"range"`` (ndim, 2) and
         ``"factor"`` (the divisor of each column: plotted = coordinate / factor), and with
         ``linear`` ``"linear"`` (k, ndim) in the plotted coordinates (NaN for noise
-        parameters) and ``"linear_labels"``. ``artists``: ``"legend"``.
+        parameters) and ``"linear_labels"``; ``"converged"``. ``artists``: ``"legend"``.
+        ``caption``: what the figure shows (:func:`~bayesfo.plotting.captions.corner_caption`).
 
     Raises
     ------
@@ -89,7 +92,9 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
     exponents = np.array([decade_exponent(samples[:, i]) for i in range(ndim)])
     factor = 10.0 ** exponents
     samples = samples / factor
-    labels = [scaled_label(lab, int(e)) for lab, e in zip(labels, exponents)]
+    # The factor on a second line: narrow panels of many parameters keep their labels apart.
+    labels = [scaled_label(lab, int(e)).replace(" (×", "\n(×")
+              for lab, e in zip(labels, exponents)]
     mode = to_coordinates(post.map_theta, is_log) / factor
     fit = np.full(ndim, np.nan)
     if result.fit is not None and result.fit.admissible:
@@ -143,6 +148,7 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
                             top=1 - 0.08 / h, wspace=0.06, hspace=0.06)
         for ax in fig.axes:
             ax.tick_params(labelsize=6.5)
+        _tidy_corner(fig, ndim)
         title = f"{result.name}: {post.samples.shape[0]} draws"
         if not post.converged:
             title += " (not converged)"
@@ -154,7 +160,121 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
               "factor": factor}
     if lin_labels:
         values.update(linear=lin, linear_labels=tuple(lin_labels))
-    return Drawn.build(fig, fig.axes, values, {"legend": legend})
+    values["converged"] = bool(post.converged)
+    return Drawn.build(fig, fig.axes, values, {"legend": legend}, corner_caption(result))
+
+
+#: Room [points] between tick labels and an axis label, and between any text and the edge.
+LABEL_PAD = 2.5
+EDGE_PAD = 3.0
+
+
+def _corner_text(fig, ndim):
+    """(left column, bottom row) of the corner grid: the axes with labels and tick labels."""
+    grid = np.array(fig.axes[: ndim * ndim], dtype=object).reshape(ndim, ndim)
+    return list(grid[1:, 0]), list(grid[-1, :])
+
+
+def _tick_boxes(labels, renderer):
+    return [t.get_window_extent(renderer) for t in labels if t.get_visible() and t.get_text()]
+
+
+def _shown_ticks(axis):
+    """(position, label) of the ticks of ``axis`` inside its view."""
+    lo, hi = sorted(axis.get_view_interval())
+    eps = 1e-9 * (hi - lo)
+    return [(t.get_loc(), t.label1) for t in axis.get_major_ticks()
+            if lo - eps <= t.get_loc() <= hi + eps]
+
+
+def _declutter(fig, left, bottom):
+    """Hide the first tick label of a panel where it would run into the last one of its
+    neighbour across the narrow gap between panels: x labels rotated by 45° need their ticks
+    √2 text heights apart, horizontal y labels one text height."""
+    fig.draw_without_rendering()
+    px = fig.dpi / 72.0
+
+    def height(label):
+        return 1.25 * label.get_fontsize() * px
+
+    for prev, cur in zip(bottom, bottom[1:]):
+        a, b = _shown_ticks(prev.xaxis), _shown_ticks(cur.xaxis)
+        if not a or not b:
+            continue
+        x_prev = max(prev.transData.transform((loc, 0.0))[0] for loc, _ in a)
+        loc, label = min(b, key=lambda t: t[0])
+        x_cur = cur.transData.transform((loc, 0.0))[0]
+        if x_cur - x_prev < np.sqrt(2.0) * height(label) + 1.0 * px:
+            label.set_visible(False)
+    for upper, lower in zip(left, left[1:]):
+        a, b = _shown_ticks(upper.yaxis), _shown_ticks(lower.yaxis)
+        if not a or not b:
+            continue
+        y_upper = min(upper.transData.transform((0.0, loc))[1] for loc, _ in a)
+        loc, label = max(b, key=lambda t: t[0])
+        y_lower = lower.transData.transform((0.0, loc))[1]
+        if y_upper - y_lower < height(label) + 1.0 * px:
+            label.set_visible(False)
+
+
+def _tidy_corner(fig, ndim, iterations: int = 4):
+    """Axis labels clear of the tick labels, and every label inside the figure.
+
+    corner places the axis labels at a fixed fraction of a panel, which does not clear tick
+    labels rotated across narrow panels, and its margins do not follow the size of the tick
+    labels. Here the y tick labels are horizontal, the x tick labels rotated by 45° and
+    right-aligned at their tick (so none reaches past the right edge of its panel), the axis
+    labels of the left column and of the bottom row are placed :data:`LABEL_PAD` points beyond
+    all the tick labels of that column or row, as measured after drawing, and the margins are set so that the outermost text keeps
+    :data:`EDGE_PAD` points from the figure's edges. A tick label that would run into its
+    neighbour's across the gap between two panels is hidden (:func:`_declutter`).
+    """
+    left, bottom = _corner_text(fig, ndim)
+    for ax in bottom:
+        for t in ax.get_xticklabels():
+            t.set(rotation=45, ha="right", va="top", rotation_mode="anchor")
+    for ax in left:
+        for t in ax.get_yticklabels():
+            t.set(rotation=0, ha="right", va="center", rotation_mode="default")
+    px = fig.dpi / 72.0
+
+    def place_labels():
+        # One x for the y labels of the left column and one y for the x labels of the bottom
+        # row, beyond every tick label of the column or row: a label taller or wider than its
+        # panel then clears the tick labels of its neighbours too, and the labels align.
+        fig.draw_without_rendering()
+        renderer = fig.canvas.get_renderer()
+        boxes = [b for ax in left for b in _tick_boxes(ax.get_yticklabels(), renderer)]
+        x = min([b.x0 for b in boxes] + [ax.bbox.x0 for ax in left]) - LABEL_PAD * px
+        for ax in left:
+            ax.yaxis.set_label_coords((x - ax.bbox.x0) / ax.bbox.width, 0.5)
+        boxes = [b for ax in bottom for b in _tick_boxes(ax.get_xticklabels(), renderer)]
+        y = min([b.y0 for b in boxes] + [ax.bbox.y0 for ax in bottom]) - LABEL_PAD * px
+        for ax in bottom:
+            ax.xaxis.set_label_coords(0.5, (y - ax.bbox.y0) / ax.bbox.height)
+        fig.draw_without_rendering()
+        return renderer
+
+    _declutter(fig, left, bottom)
+    for _ in range(iterations):
+        renderer = place_labels()
+        boxes = [b for ax in left + bottom
+                 for b in _tick_boxes([*ax.get_xticklabels(), *ax.get_yticklabels(),
+                                       ax.xaxis.label, ax.yaxis.label], renderer)]
+        if not boxes:
+            return
+        width, height = fig.bbox.width, fig.bbox.height
+        grow_left = EDGE_PAD * px - min(b.x0 for b in boxes)
+        grow_bottom = EDGE_PAD * px - min(b.y0 for b in boxes)
+        grow_right = max(b.x1 for b in boxes) - (width - EDGE_PAD * px)
+        if max(abs(grow_left), abs(grow_bottom), max(grow_right, 0.0)) < 0.5:
+            return
+        sp = fig.subplotpars
+        fig.subplots_adjust(left=sp.left + grow_left / width,
+                            bottom=sp.bottom + grow_bottom / height,
+                            right=min(sp.right, sp.right - grow_right / width))
+    _declutter(fig, left, bottom)  # the panels as the last margins left them
+    place_labels()  # against the tick labels where the last margins put them
 
 
 def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
@@ -178,8 +298,10 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
         ``axes``: one per parameter in the order of ``posterior.param_names``, then the log
         posterior when stored. ``values``: ``"<param>"`` (n_walkers, n_kept) in physical units
         (the axes show them as labelled: log10 or divided by a power of ten),
-        ``"lp"`` and ``"draw"`` (the x values). ``artists``: ``"<param>"`` (list of ``Line2D``,
-        one per walker).
+        ``"lp"`` and ``"draw"`` (the x values), ``"converged"``. ``artists``: ``"<param>"``
+        (list of ``Line2D``, one per walker). ``caption``: what the traces show for this
+        structure (:func:`~bayesfo.plotting.captions.trace_caption`: they overlap and show no
+        trend only when the draws converged; otherwise which target they miss).
 
     Raises
     ------
@@ -226,7 +348,8 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
             title += ": not converged"
         fig.suptitle(title, color=FLAG_COLOR if not post.converged else "black", fontsize=7.5)
         fig.align_ylabels(axes)
-    return Drawn.build(fig, axes, values, artists)
+    values["converged"] = bool(post.converged)
+    return Drawn.build(fig, axes, values, artists, trace_caption(result))
 
 
 def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
@@ -277,7 +400,14 @@ def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
         if not post.converged:
             title += ": the runs disagree"
         fig.suptitle(title, color=FLAG_COLOR if not post.converged else "black", fontsize=7.5)
-    return Drawn.build(fig, axes, values, artists)
+    values["converged"] = bool(post.converged)
+    return Drawn.build(fig, axes, values, artists, trace_caption(result))
+
+
+#: A ridge whose 94 % HDI is narrower than this fraction of the axis gets a zoomed inset.
+ZOOM_FRACTION = 0.06
+#: Below this fraction of its peak a ridge's outline is not drawn (its prior line shows there).
+OUTLINE_FLOOR = 2e-3
 
 
 def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Drawn:
@@ -288,8 +418,13 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     ridge is a kernel density of the draws, reflected at the prior bounds, scaled to its own
     peak; the dashed line is the prior density on the same scale, so a ridge that is no higher
     than its prior line is as uncertain as the prior. The bar under a ridge is the 94 % HDI
-    and the tick the posterior mean; the text gives mean ± sd, red when the summary flags the
-    order as poorly determined (HDI wider than half the prior range).
+    and the tick the posterior mean; the text gives mean ± sd and the HDI, red when the summary
+    flags the order as poorly determined (HDI wider than half the prior range).
+
+    A ridge whose HDI is narrower than :data:`ZOOM_FRACTION` of the axis would be a spike: it
+    gets an inset beside it, zoomed to the HDI and its surroundings, with the same ridge, HDI
+    bar, mean tick and dashed prior line, and the ratio of the peak to the prior density
+    stated (so a prior line on the floor of the inset reads as what it is).
 
     Parameters
     ----------
@@ -301,11 +436,15 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     Returns
     -------
     Drawn
-        ``axes`` = (ax,). ``values``: per structure ``"<name>/grid"``, ``"<name>/density"``
-        (unscaled: it integrates to one over the prior range), ``"<name>/prior_density"``,
-        ``"<name>/hdi"`` and ``"<name>/baseline"``; ``"structures"`` (names, top to bottom).
-        ``artists``: ``"<name>/ridge"`` (``PolyCollection``), ``"<name>/prior"``,
-        ``"<name>/hdi"`` (``Line2D``), ``"<name>/label"`` (``Text``).
+        ``axes`` = (ax, inset, …): the ridge axes, then the zoomed insets top to bottom.
+        ``values``: per structure ``"<name>/grid"``, ``"<name>/density"`` (unscaled: it
+        integrates to one over the prior range), ``"<name>/prior_density"``, ``"<name>/hdi"``,
+        ``"<name>/baseline"`` and, for a zoomed ridge, ``"<name>/zoom"`` (the inset's x
+        range); ``"structures"`` (names, top to bottom). ``artists``: ``"<name>/ridge"``
+        (``PolyCollection``), ``"<name>/outline"``, ``"<name>/prior"``, ``"<name>/hdi"``
+        (``Line2D``), ``"<name>/label"`` (``Text``) and for a zoomed ridge ``"<name>/inset"``
+        (``Axes``), ``"<name>/inset_ridge"``, ``"<name>/inset_prior"``, ``"<name>/inset_hdi"``
+        and ``"<name>/inset_note"``.
 
     Raises
     ------
@@ -318,20 +457,28 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     results = [(r, p) for r, p in results if p is not None]
     if not results:
         raise InputError("no structure of the comparison has a free fractional order (q or beta)")
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     n = len(results)
     values, artists = {"structures": np.array([r.name for r, _ in results])}, {}
-    spans = []
+    rows = []
+    for i, (r, p) in enumerate(results):
+        post = r.posterior
+        x = post.samples[:, post.param_names.index(p)]
+        prior = r.criteria.get("priors", {}).get(p, DEFAULT_ORDER_PRIOR)
+        lo, hi = prior_range(prior, x)
+        grid, dens = density_1d(x, lo, hi)
+        rows.append((r, p, x, prior, (lo, hi), grid, dens))
+    x_lo = min(row[4][0] for row in rows)
+    x_hi = max(row[4][1] for row in rows)
+    tight = [(row[0].posterior.summary[row[1]].hdi_high - row[0].posterior.summary[row[1]].hdi_low)
+             < ZOOM_FRACTION * (x_hi - x_lo) for row in rows]
+    insets = []
     with style():
-        fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 0.75 + 0.42 * n))
+        row_height = 0.62 if any(tight) else 0.42
+        fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 0.75 + row_height * n))
         text_at = blended_transform_factory(ax.transAxes, ax.transData)
-        for i, (r, p) in enumerate(results):
+        for i, (r, p, x, prior, _, grid, dens) in enumerate(rows):
             post = r.posterior
-            x = post.samples[:, post.param_names.index(p)]
-            prior = r.criteria.get("priors", {}).get(p, DEFAULT_ORDER_PRIOR)
-            lo, hi = prior_range(prior, x)
-            spans.append((lo, hi))
-            grid, dens = density_1d(x, lo, hi)
             pd = prior_density(prior, grid)
             peak = float(dens.max())
             base = float(n - 1 - i)
@@ -339,35 +486,102 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
             values.update({f"{r.name}/grid": grid, f"{r.name}/density": dens,
                            f"{r.name}/prior_density": pd, f"{r.name}/baseline": base,
                            f"{r.name}/hdi": (s.hdi_low, s.hdi_high)})
-            c = colors[r.name]
+            c = styles[r.name].color
             top = base + ridge_height * dens / peak
             artists[f"{r.name}/ridge"] = ax.fill_between(grid, base, top, color=c, alpha=0.45,
                                                          lw=0, zorder=2 + i)
-            ax.plot(grid, top, color=c, lw=0.9, zorder=2 + i)
+            # The outline stops where the ridge meets its baseline, so that the dashed prior
+            # line is not hidden under it.
+            outline = np.where(dens / peak > OUTLINE_FLOOR, top, np.nan)
+            (artists[f"{r.name}/outline"],) = ax.plot(grid, outline, color=c, lw=0.9,
+                                                      zorder=2 + i)
             (artists[f"{r.name}/prior"],) = ax.plot(grid, base + ridge_height * pd / peak,
-                                                    color="0.35", lw=0.7, ls="--", zorder=2 + i)
+                                                    color="0.35", lw=0.7, ls="--", zorder=3 + i)
             (artists[f"{r.name}/hdi"],) = ax.plot([s.hdi_low, s.hdi_high], [base, base], color=c,
                                                   lw=2.6, solid_capstyle="butt", zorder=3 + i)
             ax.plot([s.mean, s.mean], [base - 0.1, base + 0.1], color="black", lw=0.9,
                     zorder=3 + i)
             sym = "q" if p == "q" else r"\beta"
-            label = f"${sym}$ = {s.mean:.3g} ± {s.sd:.2g}"
+            digits = _hdi_digits(s.hdi_high - s.hdi_low)
+            label = (f"${sym}$ = {s.mean:.3g} ± {s.sd:.2g}\n"
+                     f"HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}")
             if s.poorly_determined:
                 label += "\npoorly determined"
             if not post.converged:
                 label += "\nnot converged"
             artists[f"{r.name}/label"] = ax.text(
-                1.02, base + 0.12, label, transform=text_at, fontsize=6.5, va="bottom",
+                1.02, base + 0.05, label, transform=text_at, fontsize=6.5, va="bottom",
                 color=FLAG_COLOR if s.poorly_determined or not post.converged else "black",
                 clip_on=False)
+            if tight[i]:
+                insets.append(_zoom_inset(ax, r.name, s, grid, dens, pd, base, c,
+                                          (x_lo, x_hi), ridge_height, values, artists))
         ax.set_yticks([n - 1 - i for i in range(n)],
                       [r.name if p == "q" else f"{r.name} (β)" for r, p in results])
         ax.set_ylim(-0.35, n - 1 + ridge_height + 0.25)
-        lo = min(s[0] for s in spans)
-        hi = max(s[1] for s in spans)
-        ax.set_xlim(lo, hi)
+        ax.set_xlim(x_lo, x_hi)
         ax.grid(axis="y", visible=False)
         ax.set_xlabel("fractional order $q$" + (r" ($\beta$ for maxwell)"
                                                 if any(p == "beta" for _, p in results) else "")
-                      + "; dashed: prior")
-    return Drawn.build(fig, (ax,), values, artists)
+                      + f"\nbar: {HDI_LABEL}, tick: mean; dashed: prior")
+    return Drawn.build(fig, (ax, *insets), values, artists)
+
+
+#: The posterior's highest-density interval in the labels (as the summaries).
+HDI_LABEL = "94 % HDI"
+
+
+def _hdi_digits(width: float) -> int:
+    """Decimals that resolve an interval of ``width`` to about two significant digits."""
+    if not np.isfinite(width) or width <= 0:
+        return 3
+    return int(min(6, max(2, 1 - np.floor(np.log10(width)))))
+
+
+def _zoom_inset(ax, name, s, grid, dens, pd, base, color, span, ridge_height, values, artists):
+    """An inset beside a spike-like ridge: the ridge zoomed to its HDI and surroundings."""
+    from matplotlib.ticker import MaxNLocator
+    from matplotlib.transforms import blended_transform_factory
+
+    x_lo, x_hi = span
+    width = max(s.hdi_high - s.hdi_low, 1e-12)
+    z_lo, z_hi = s.hdi_low - width, s.hdi_high + width
+    values[f"{name}/zoom"] = (z_lo, z_hi)
+    # On the side of the axis away from the spike, in the upper part of its row.
+    centre = (s.mean - x_lo) / (x_hi - x_lo)
+    x0 = 0.04 if centre > 0.5 else 0.54
+    where = blended_transform_factory(ax.transAxes, ax.transData)
+    inset = ax.inset_axes([x0, base + 0.32, 0.42, 0.55 * ridge_height], transform=where,
+                          zorder=20)
+    peak = float(dens.max())
+    inside = (grid >= z_lo) & (grid <= z_hi)
+    g, d = grid[inside], dens[inside] / peak
+    artists[f"{name}/inset"] = inset
+    artists[f"{name}/inset_ridge"] = inset.fill_between(g, 0.0, d, color=color, alpha=0.45, lw=0)
+    inset.plot(g, d, color=color, lw=0.8)
+    (artists[f"{name}/inset_prior"],) = inset.plot(g, pd[inside] / peak, color="0.35", lw=0.7,
+                                                   ls="--")
+    (artists[f"{name}/inset_hdi"],) = inset.plot([s.hdi_low, s.hdi_high], [0.0, 0.0],
+                                                 color=color, lw=2.6, solid_capstyle="butt",
+                                                 clip_on=False)
+    inset.plot([s.mean, s.mean], [-0.1, 0.12], color="black", lw=0.8, clip_on=False)
+    prior_at = float(np.max(pd[inside])) if np.any(inside) else 0.0
+    ratio = peak / prior_at if prior_at > 0 else np.inf
+    note = ("prior ≈ 0" if not np.isfinite(ratio) else
+            f"prior\n÷ {ratio:.3g}" if ratio < 1e4 else f"prior\n÷ {ratio:.0e}")
+    artists[f"{name}/inset_note"] = inset.text(0.03, 0.95, note, transform=inset.transAxes,
+                                               fontsize=5.0, ha="left", va="top", color="0.25")
+    inset.set_xlim(z_lo, z_hi)
+    inset.set_ylim(-0.12, 1.08)
+    inset.set_yticks([])
+    inset.xaxis.set_major_locator(MaxNLocator(nbins=3))
+    inset.tick_params(axis="x", labelsize=5.5, length=2, pad=1)
+    inset.grid(False)
+    inset.patch.set_alpha(0.9)
+    for side in ("top", "right", "left"):
+        inset.spines[side].set_visible(True)
+        inset.spines[side].set_linewidth(0.5)
+    inset.spines["bottom"].set_linewidth(0.5)
+    ax.indicate_inset([z_lo, base - 0.12, z_hi - z_lo, ridge_height + 0.15], inset,
+                      edgecolor="0.45", lw=0.5, alpha=0.8)
+    return inset

@@ -7,7 +7,7 @@ import numpy as np
 from ..errors import InputError
 from ._base import Drawn, new_figure
 from ._compute import loo_differences
-from .style import COLUMN_WIDTH, FLAG_COLOR, colors_for, style
+from .style import COLUMN_WIDTH, FLAG_COLOR, comparison_styles, style
 
 #: Below this Δ (nats) the Δ axes switch to a symmetric-log scale, linear within ±SYMLOG_LINEAR.
 SYMLOG_FROM = -20.0
@@ -18,6 +18,12 @@ CRITERIA = (
     ("delta_aic_half", "−AIC/2", "^", "0.55", 0.0),
     ("delta_bic_half", "−BIC/2", "s", "white", -0.22),
 )
+#: Pareto k̂ above which PSIS-LOO is unreliable (Vehtari et al. 2017; as the comparison flags).
+PARETO_K_WARN = 0.7
+#: Why the figure shows PSIS-LOO and not WAIC, said once under the criteria.
+WAIC_NOTE = ("WAIC not shown: it estimates the same as PSIS-LOO, whose Pareto k̂\n"
+             f"(right: largest per structure; > {PARETO_K_WARN:g}, open marker) says where "
+             "LOO is unreliable")
 
 
 def _nan(v) -> float:
@@ -59,6 +65,18 @@ def _label(name: str, converged: bool, fits: str) -> str:
     return "\n".join([name, *notes])
 
 
+def _right_labels(ax, y, labels):
+    """A twin axes of ``ax`` carrying ``labels`` at ``y`` on the right (no ticks, no spines)."""
+    right = ax.twinx()
+    right.set_ylim(-0.6, len(labels) - 0.4)
+    right.set_yticks(y, labels)
+    right.tick_params(axis="y", length=0, labelsize=6.5)
+    right.grid(False)
+    for spine in right.spines.values():
+        spine.set_visible(False)
+    return right
+
+
 def plot_ranking(comparison, fig=None) -> Drawn:
     """The structures' log-evidence and information criteria relative to the best.
 
@@ -72,6 +90,13 @@ def plot_ranking(comparison, fig=None) -> Drawn:
     structure. Structures run from the best (top) down in the order of the ranking; a structure
     whose posterior did not converge has a red label and a red marker. When differences exceed
     20 nats the axes are symmetric-logarithmic (linear within ±2 nats).
+
+    The largest Pareto k̂ of each structure's PSIS-LOO is on the right of the criteria; above
+    0.7 (red) PSIS-LOO is unreliable at some frequency and its marker is open with a red edge.
+    WAIC is not drawn, and a note under the figure says why once: it estimates the same
+    expected log predictive density as PSIS-LOO, has no diagnostic of its own, and arviz's
+    variance warning on it fires for nearly every structure of real data, so a flag per
+    structure would carry no information.
 
     Parameters
     ----------
@@ -87,9 +112,12 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         ``"posterior_probability"``, ``"delta_loo"``, ``"delta_loo_se"``, ``"delta_aic_half"``,
         ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing), ``"fits"``
         (``"yes"``, ``"small"``, ``"no"`` from the adequacy checks; labels say "misfits the
-        data" or "small misfit"). ``artists``:
-        ``"<name>/log_evidence"`` (``ErrorbarContainer``) and one ``ErrorbarContainer`` per
-        criterion under its value key.
+        data" or "small misfit"), ``"pareto_k_max"``; ``"note"`` (why WAIC is not shown).
+        ``artists``: ``"<name>/log_evidence"`` (``ErrorbarContainer``), one
+        ``ErrorbarContainer`` per criterion under its value key (the markers of PSIS-LOO shown
+        only where k̂ ≤ 0.7), ``"delta_loo_unreliable"`` (``Line2D``: the open markers where
+        k̂ > 0.7), ``"pareto_k"`` (the axes whose tick labels give k̂) and ``"note"``
+        (``Text``).
 
     Raises
     ------
@@ -116,8 +144,10 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         "delta_bic_half": np.array([-(r["bic"] - best_bic) / 2 for r in rows], float),
         "converged": np.array([bool(r["converged"]) for r in rows]),
         "fits": np.array([r.get("fits") or "" for r in rows]),
+        "pareto_k_max": np.array([_nan(r.get("pareto_k_max")) for r in rows]),
+        "note": WAIC_NOTE,
     }
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     artists = {}
     with style():
         fig = new_figure(fig, (COLUMN_WIDTH, min(9.0, 1.45 + 0.52 * n)))
@@ -125,8 +155,9 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         for i, name in enumerate(names):
             dz = values["delta_log_evidence"][i]
             ok = values["converged"][i]
-            c = colors.get(name, "0.4")
-            cont = ax_z.errorbar([dz], [y[i]], xerr=[values["log_evidence_err"][i]], fmt="o",
+            st = styles.get(name)
+            c, m = (st.color, st.marker) if st is not None else ("0.4", "o")
+            cont = ax_z.errorbar([dz], [y[i]], xerr=[values["log_evidence_err"][i]], fmt=m,
                                  ms=4.5, color=c, mfc=c if ok else "white",
                                  mec=c if ok else FLAG_COLOR, mew=1.1, elinewidth=1.0, zorder=4)
             artists[f"{name}/log_evidence"] = cont
@@ -134,22 +165,32 @@ def plot_ranking(comparison, fig=None) -> Drawn:
                 ax_z.text(0.0, y[i], "no ln Z  ", ha="right", va="center", fontsize=6.5)
         _set_delta_scale(ax_z, values["delta_log_evidence"])
         ax_z.set_xlabel(r"$\Delta \ln Z$ to the best [nats]")
-        right = ax_z.twinx()
-        right.set_ylim(-0.6, n - 0.4)
-        right.set_yticks(y, [_format_p(p) for p in values["posterior_probability"]])
-        right.tick_params(axis="y", length=0, labelsize=6.5)
-        right.grid(False)
-        for spine in right.spines.values():
-            spine.set_visible(False)
+        k = values["pareto_k_max"]
+        bad = np.isfinite(k) & (k > PARETO_K_WARN)
         for key, label, marker, face, dodge in CRITERIA:
             err = values["delta_loo_se"] if key == "delta_loo" else None
             cont = ax_c.errorbar(values[key], y + dodge, xerr=err, fmt=marker, ms=3.6,
                                  color="black", mfc=face, mec="black", mew=0.7, elinewidth=0.8,
                                  label=label, zorder=4)
             artists[key] = cont
+        # PSIS-LOO where its Pareto k̂ says it is unreliable: an open marker with a red edge.
+        loo_marks = artists["delta_loo"].lines[0]
+        loo_marks.set_markevery(np.flatnonzero(~bad).tolist())
+        (artists["delta_loo_unreliable"],) = ax_c.plot(
+            values["delta_loo"][bad], (y + CRITERIA[0][4])[bad], ls="none", marker="o", ms=3.6,
+            mfc="white", mec=FLAG_COLOR, mew=0.9, zorder=5)
+        k_labels = ["k̂ n/a" if not np.isfinite(v) else f"k̂ {v:.2f}" for v in k]
+        right_c = _right_labels(ax_c, y, k_labels)
+        for tick, flagged in zip(right_c.get_yticklabels(), bad):
+            if flagged:
+                tick.set_color(FLAG_COLOR)
+        artists["pareto_k"] = right_c
         _set_delta_scale(ax_c, np.concatenate([values[k] for k, *_ in CRITERIA]
                                               + [values["delta_loo"] + values["delta_loo_se"]]))
         ax_c.set_xlabel(r"$\Delta$ to the best [nats], higher is better")
+        artists["note"] = fig.supxlabel(WAIC_NOTE, fontsize=6.0, color="0.25")
+        # Posterior probabilities on the right of the evidence (the last axes of the figure).
+        _right_labels(ax_z, y, [_format_p(p) for p in values["posterior_probability"]])
         ax_c.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=3, borderaxespad=0.1,
                     handletextpad=0.3, columnspacing=0.8)
         for ax in (ax_z, ax_c):

@@ -9,6 +9,11 @@ Error bars of the data: σ is the standard deviation of the complex value (real 
 parts σ/√2 each, see :class:`~bayesfo.data.FrequencyResponse`), so one standard deviation is
 σ/√2 along each of Re G and Im G, σ/√2 in |G| and σ/(√2 |G|) rad in arg G (small-noise
 approximation).
+
+Each structure has its own colour, line style and marker (:func:`~bayesfo.plotting.style.
+structure_styles`), so that curves drawn on top of each other stay visible; when the curves of
+two structures agree within a line width everywhere, the legend says so ("voigt and zener
+coincide").
 """
 
 from __future__ import annotations
@@ -17,10 +22,15 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
 from ._base import Drawn, axes_or_new, new_figure
 from ._compute import (
     N_DRAWS,
     N_GRID,
+    NYQUIST_LOG_DECADES,
+    coincidence_note,
+    coincident_groups,
+    magnitude_decades,
     omega_grid,
     quantiles,
     response_draws,
@@ -28,7 +38,14 @@ from ._compute import (
     thin_indices,
     unwrapped_phase_deg,
 )
-from .style import COLUMN_WIDTH, DATA_COLOR, colors_for, quantity_symbol, style, unit_suffix
+from .style import (
+    COLUMN_WIDTH,
+    DATA_COLOR,
+    comparison_styles,
+    quantity_symbol,
+    style,
+    unit_suffix,
+)
 
 OMEGA_LABEL = r"$\omega$ [rad/s]"
 BAND_ALPHA = {90: 0.16, 50: 0.34}
@@ -40,28 +57,41 @@ def _key(name: str, quantity: str, p: float) -> str:
     return f"{name}/{quantity}_" + ("median" if p == 0.5 else f"q{round(100 * p):02d}")
 
 
-def _band(ax, x, qs, color):
-    """90 % and 50 % bands and the median line; returns the three artists."""
-    outer = ax.fill_between(x, qs[0.05], qs[0.95], color=color, alpha=BAND_ALPHA[90], lw=0)
-    inner = ax.fill_between(x, qs[0.25], qs[0.75], color=color, alpha=BAND_ALPHA[50], lw=0)
-    (line,) = ax.plot(x, qs[0.5], color=color, lw=1.1)
+def _band(ax, x, qs, st):
+    """90 % and 50 % bands and the median line of a structure of style ``st``; returns the
+    three artists."""
+    outer = ax.fill_between(x, qs[0.05], qs[0.95], color=st.color, alpha=BAND_ALPHA[90], lw=0)
+    inner = ax.fill_between(x, qs[0.25], qs[0.75], color=st.color, alpha=BAND_ALPHA[50], lw=0)
+    (line,) = ax.plot(x, qs[0.5], **st.line(lw=1.1))
     return outer, inner, line
 
 
-def _band_handle(color):
+def _band_handle(st):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    return (Patch(color=color, alpha=BAND_ALPHA[90], lw=0),
-            Patch(color=color, alpha=BAND_ALPHA[50], lw=0), Line2D([], [], color=color, lw=1.1))
+    return (Patch(color=st.color, alpha=BAND_ALPHA[90], lw=0),
+            Patch(color=st.color, alpha=BAND_ALPHA[50], lw=0), Line2D([], [], **st.line(lw=1.1)))
 
 
-def _legend(fig, handles, labels):
+def _legend(fig, handles, labels, note: str = ""):
+    """The legend above the axes; ``note`` (what coincides) as its title."""
     from matplotlib.legend_handler import HandlerTuple
 
     ncols = min(len(handles), 3)
-    return fig.legend(handles, labels, loc="outside upper center", ncols=ncols,
-                      handler_map={tuple: HandlerTuple(ndivide=1, pad=0.0)})
+    leg = fig.legend(handles, labels, loc="outside upper center", ncols=ncols,
+                     handler_map={tuple: HandlerTuple(ndivide=1, pad=0.0)},
+                     title=note or None, title_fontsize=7.0)
+    return leg
+
+
+def _note_artists(legend, note: str) -> dict:
+    return {"note": legend.get_title()} if note else {}
+
+
+def _span(ax, log: bool = False) -> float:
+    lo, hi = ax.get_ylim()
+    return float(np.log10(hi / lo)) if log else float(hi - lo)
 
 
 def _points(data, phase: bool):
@@ -104,7 +134,9 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
         under ``"holdout/"`` for held-out points; per structure ``"<name>/magnitude_median"``,
         ``"<name>/magnitude_q05"``, ``_q25``, ``_q75``, ``_q95`` and the same for ``phase``.
         ``artists``: the median lines (``Line2D``) and bands (``"<name>/magnitude_band50"``,
-        ``_band90``, ``PolyCollection``) and the data (``ErrorbarContainer``).
+        ``_band90``, ``PolyCollection``) and the data (``ErrorbarContainer``); ``"note"``
+        (the legend title ``Text``) when the median curves of structures coincide, its text
+        also under ``values["note"]`` (empty otherwise).
 
     Raises
     ------
@@ -121,7 +153,7 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
     results = select_results(comparison, structures)
     data = comparison.data
     omega = omega_grid(comparison, n_grid)
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     sym = quantity_symbol(data.kind)
     values, artists = {"omega": omega}, {}
     handles, labels = [], []
@@ -130,17 +162,17 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
         ax_mag, ax_ph = fig.subplots(2, 1, sharex=True)
         for r in results:
             g = response_draws(r, omega, data.kind, n_draws, seed)
-            c = colors[r.name]
+            st = styles[r.name]
             for ax, quantity, x in ((ax_mag, "magnitude", np.abs(g)),
                                     (ax_ph, "phase", unwrapped_phase_deg(g, omega))):
                 qs = quantiles(x)
                 for p, v in qs.items():
                     values[_key(r.name, quantity, p)] = v
-                outer, inner, line = _band(ax, omega, qs, c)
+                outer, inner, line = _band(ax, omega, qs, st)
                 artists[f"{r.name}/{quantity}_band90"] = outer
                 artists[f"{r.name}/{quantity}_band50"] = inner
                 artists[f"{r.name}/{quantity}_median"] = line
-            handles.append(_band_handle(c))
+            handles.append(_band_handle(st))
             labels.append(r.name)
         for prefix, d in (("data", data), ("holdout", comparison.holdout)):
             if d is None:
@@ -168,13 +200,24 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
         ax_ph.set_ylabel(f"arg ${sym}$ [deg]")
         ax_ph.set_xlabel(OMEGA_LABEL)
         ax_ph.yaxis.set_major_locator(mticker.MaxNLocator(nbins=5, steps=[1, 1.5, 3, 5, 10]))
-        _legend(fig, handles, labels)
+        names = [r.name for r in results]
+        note = coincidence_note({
+            "magnitude": coincident_groups(
+                {n: np.log10(values[f"{n}/magnitude_median"]) for n in names},
+                _span(ax_mag, log=True)),
+            "phase": coincident_groups({n: values[f"{n}/phase_median"] for n in names},
+                                       _span(ax_ph))})
+        values["note"] = note
+        legend = _legend(fig, handles, labels, note)
+        artists.update(_note_artists(legend, note))
     return Drawn.build(fig, (ax_mag, ax_ph), values, artists)
 
 
 def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS, seed: int = 0,
-                 n_grid: int = N_GRID, n_lines: int = 40) -> Drawn:
-    """Nyquist diagram (Im G against Re G) of the data and each structure's posterior.
+                 n_grid: int = N_GRID, n_lines: int = 40, form: str = "auto") -> Drawn:
+    """Nyquist diagram of the data and each structure's posterior: linear (Im G against Re G on
+    equal axes) or, for data over many decades of |G|, log-magnitude (polar: angle arg G,
+    radius log10 |G|).
 
     The posterior is shown as its pointwise median curve (median of Re G and of Im G
     separately at each ω of the grid) and, for its spread, ``n_lines`` thin curves of single
@@ -182,61 +225,105 @@ def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS
     natural shape, while the draws show where the curve may run and how it is correlated
     along ω.
 
+    On linear axes, data over many decades of |G| crowd into one corner, so by default
+    (``form="auto"``) the diagram is log-magnitude when |G| of the data spans more than
+    :data:`~bayesfo.plotting._compute.NYQUIST_LOG_DECADES` decades: the same complex plane
+    with the true angle arg G and the radius log10 |G| from the decade below the smallest
+    measured |G| (values below it are drawn at the centre). The title states the form.
+
     Parameters
     ----------
     comparison : bayesfo.comparison.Comparison
     structures : sequence of str or StructureResult, optional
         Default: the best three by the ranking.
     ax : matplotlib.axes.Axes, optional
+        For the log-magnitude form a polar axes; a Cartesian one is replaced by a polar axes
+        at the same place.
     n_draws, seed, n_grid
         As in :func:`plot_bode`.
     n_lines : int
         Single-draw curves per structure (a subset of the ``n_draws``; 0 for none).
+    form : {"auto", "linear", "log"}
+        The form of the diagram (see above).
 
     Returns
     -------
     Drawn
-        ``axes`` = (ax,). ``values``: ``"omega"``; ``"data/real"``, ``"data/imag"`` (and
+        ``axes`` = (ax,). ``values``: ``"omega"``; ``"form"`` (``"linear"`` or ``"log"``),
+        ``"decades"`` (of |G| of the data); ``"data/real"``, ``"data/imag"`` (and
         ``"data/err"`` = σ/√2 when σ is known; ``"holdout/…"`` likewise); per structure
         ``"<name>/real_median"``, ``"<name>/imag_median"`` and ``"<name>/draws"`` (complex,
-        shape (n_lines, n_grid)). ``artists``: ``"<name>/median"`` (``Line2D``),
-        ``"<name>/draws"`` (``LineCollection``), ``"data"``, ``"holdout"``.
+        shape (n_lines, n_grid)); for the log form ``"log_origin"`` (log10 |G| at the centre).
+        ``"note"``: which structures coincide (empty when none). ``artists``:
+        ``"<name>/median"`` (``Line2D``: x, y = Re, Im, or angle [rad], log10 |G| in the log
+        form), ``"<name>/draws"`` (``LineCollection``), ``"data"``, ``"holdout"``, ``"title"``
+        and ``"note"`` (the legend title) when curves coincide.
 
     Raises
     ------
     InputError
-        If a structure is not in the comparison or failed.
+        If a structure is not in the comparison or failed, or ``form`` is unknown.
     """
     from matplotlib.collections import LineCollection
 
+    if form not in ("auto", "linear", "log"):
+        raise InputError(f"argument 'form' must be 'auto', 'linear' or 'log', got {form!r}")
     results = select_results(comparison, structures)
     data = comparison.data
+    holdout = comparison.holdout
+    decades = magnitude_decades(data.response,
+                                None if holdout is None else holdout.response)
+    if form == "auto":
+        form = "log" if decades > NYQUIST_LOG_DECADES else "linear"
+    log = form == "log"
     omega = omega_grid(comparison, n_grid)
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     sym = quantity_symbol(data.kind)
     units = unit_suffix(data.units)
-    values, artists = {"omega": omega}, {}
+    values = {"omega": omega, "form": form, "decades": decades}
+    artists = {}
     handles, labels = [], []
+    measured = np.concatenate([data.response] + ([] if holdout is None else [holdout.response]))
+    measured = measured[np.abs(measured) > 0]
+    if log:
+        origin = math.floor(math.log10(np.abs(measured).min()))
+        centre = float(np.angle(np.mean(measured / np.abs(measured))))
+        values["log_origin"] = origin
+
+    def coords(g):
+        """(x, y) of complex values in the plotted form."""
+        g = np.asarray(g)
+        if not log:
+            return g.real, g.imag
+        with np.errstate(divide="ignore"):
+            r = np.maximum(np.log10(np.abs(g)), origin)
+        return centre + np.angle(g * np.exp(-1j * centre)), r
+
+    own_figure = ax is None
     with style():
-        fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 3.4))
+        fig, ax = (_polar_axes(ax, (COLUMN_WIDTH, 3.6)) if log
+                   else axes_or_new(ax, (COLUMN_WIDTH, 3.4)))
+        medians = {}
         for r in results:
             g = response_draws(r, omega, data.kind, n_draws, seed)
-            c = colors[r.name]
+            st = styles[r.name]
             re_med, im_med = np.median(g.real, axis=0), np.median(g.imag, axis=0)
             values[f"{r.name}/real_median"] = re_med
             values[f"{r.name}/imag_median"] = im_med
+            medians[r.name] = re_med + 1j * im_med
             if n_lines > 0:
                 sub = g[thin_indices(g.shape[0], n_lines, seed + 1)]
                 values[f"{r.name}/draws"] = sub
-                segs = np.stack([sub.real, sub.imag], axis=-1)
-                coll = LineCollection(segs, colors=c, linewidths=0.4, alpha=0.25, zorder=1)
+                segs = np.stack(coords(sub), axis=-1)
+                coll = LineCollection(segs, colors=st.color, linewidths=0.4, alpha=0.25,
+                                      zorder=1)
                 ax.add_collection(coll)
                 artists[f"{r.name}/draws"] = coll
-            (line,) = ax.plot(re_med, im_med, color=c, lw=1.2, zorder=3)
+            (line,) = ax.plot(*coords(medians[r.name]), **st.line(lw=1.2, zorder=3))
             artists[f"{r.name}/median"] = line
             handles.append(line)
             labels.append(r.name)
-        for prefix, d in (("data", data), ("holdout", comparison.holdout)):
+        for prefix, d in (("data", data), ("holdout", holdout)):
             if d is None:
                 continue
             w, g, *_ = _points(d, phase=False)
@@ -245,24 +332,135 @@ def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS
                            f"{prefix}/imag": g.imag})
             if err is not None:
                 values[f"{prefix}/err"] = err
+            x, y = coords(g)
+            # One sd along Re and Im is σ/√2 in |G| and σ/(√2 |G|) rad in arg G.
+            xerr, yerr = ((err, err) if not log or err is None else
+                          (np.minimum(err / np.abs(g), np.pi),
+                           err / (np.abs(g) * math.log(10.0))))
             if prefix == "data":
-                cont = ax.errorbar(g.real, g.imag, xerr=err, yerr=err, **DATA_STYLE)
+                cont = ax.errorbar(x, y, xerr=xerr, yerr=yerr, **DATA_STYLE)
                 handles.append(cont)
                 labels.append("data ± 1 sd" if err is not None else "data")
             else:
-                cont = ax.errorbar(g.real, g.imag, xerr=err, yerr=err, fmt="none",
+                cont = ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="none",
                                    ecolor=DATA_COLOR, elinewidth=0.7, zorder=6)
-                (pts,) = ax.plot(g.real, g.imag, ls="none", zorder=6, **HOLDOUT_STYLE)
+                (pts,) = ax.plot(x, y, ls="none", zorder=6, **HOLDOUT_STYLE)
                 handles.append(pts)
                 labels.append("held out")
             artists[prefix] = cont
-        ax.autoscale_view()
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel(f"Re ${sym}${units}")
-        ax.set_ylabel(f"Im ${sym}${units}")
-        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
-        ax.legend(handles, labels, loc="best")
+        if log:
+            top, aspect = _log_nyquist_axes(ax, origin, measured, medians, coords)
+            if own_figure:
+                # The sector keeps its shape: the figure's height follows it, so that the
+                # sector fills the column width and its labels stay inside the figure.
+                fig.set_size_inches(COLUMN_WIDTH, min(6.0, 1.35 + 2.9 * aspect))
+            span = top - origin
+            planar = {n: (y - origin) * np.exp(1j * x)
+                      for n, (x, y) in ((n, coords(m)) for n, m in medians.items())}
+            title = (f"log-magnitude Nyquist: |${sym}$| spans {decades:.1f} decades\n"
+                     f"radius |${sym}$|{units} on a log scale, angle arg ${sym}$")
+        else:
+            ax.autoscale_view()
+            ax.set_aspect("equal", adjustable="datalim")
+            ax.set_xlabel(f"Re ${sym}${units}")
+            ax.set_ylabel(f"Im ${sym}${units}")
+            ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
+            (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+            span = max(x1 - x0, y1 - y0)
+            planar = medians
+            title = "Nyquist diagram (linear axes)"
+        artists["title"] = ax.set_title(title, fontsize=7.0)
+        note = coincidence_note({"plane": coincident_groups(planar, span)})
+        values["note"] = note
+        if own_figure:
+            legend = _legend(fig, handles, labels, note)
+        else:
+            legend = ax.legend(handles, labels, loc="best", title=note or None,
+                               title_fontsize=7.0)
+        artists.update(_note_artists(legend, note))
     return Drawn.build(fig, (ax,), values, artists)
+
+
+def _polar_axes(ax, size):
+    """(figure, polar axes): ``ax`` if polar, else a polar axes in its place (or a new one)."""
+    if ax is None:
+        fig = new_figure(None, size)
+        return fig, fig.add_subplot(projection="polar")
+    if ax.name == "polar":
+        return ax.figure, ax
+    fig = ax.figure
+    spec = ax.get_subplotspec()
+    where = spec if spec is not None else ax.get_position()
+    ax.remove()
+    return fig, (fig.add_subplot(where, projection="polar") if spec is not None
+                 else fig.add_axes(where, projection="polar"))
+
+
+#: Narrowest sector of a log-magnitude Nyquist diagram [deg].
+MIN_SECTOR = 45.0
+
+
+def _log_nyquist_axes(ax, origin, measured, medians, coords) -> float:
+    """Sector, radial decades and angles of a log-magnitude Nyquist diagram; returns the
+    outer radius (log10 |G|) and the height/width ratio of the sector."""
+    import matplotlib.ticker as mticker
+
+    seen = np.degrees(coords(measured)[0])
+    model = np.degrees(np.concatenate([coords(m)[0] for m in medians.values()] or [seen]))
+    # The sector holds the data with half a degree to spare and the model curves within a
+    # degree (a curve that ends just outside is cut rather than the sector widened by 15°).
+    lo = 15.0 * math.floor(min(seen.min() - 0.5, model.min() + 1.0) / 15.0)
+    hi = 15.0 * math.ceil(max(seen.max() + 0.5, model.max() - 1.0) / 15.0)
+    if hi - lo < MIN_SECTOR:
+        # A sector wide enough that the angle reads at a glance: from 0° up for data of
+        # positive phase (moduli), down for negative phase (compliances).
+        if lo >= 0.0:
+            hi = lo + MIN_SECTOR
+        elif hi <= 0.0:
+            lo = hi - MIN_SECTOR
+        else:
+            extra = MIN_SECTOR - (hi - lo)
+            lo, hi = lo - 15.0 * math.floor(extra / 30.0), hi + 15.0 * math.ceil(extra / 30.0)
+    if hi - lo >= 300.0:
+        lo, hi = -180.0, 180.0
+    ax.set_thetamin(lo)
+    ax.set_thetamax(hi)
+    step = 15.0 if hi - lo <= 120.0 else 30.0 if hi - lo <= 240.0 else 45.0
+    ticks = np.arange(lo, hi + 0.1, step)
+    ax.set_thetagrids(ticks, [f"{t:g}°".replace("-", "−") for t in ticks])
+    top = max([float(coords(measured)[1].max())]
+              + [float(coords(m)[1].max()) for m in medians.values()])
+    top = origin + 1.05 * (top - origin) if top > origin else origin + 1.0
+    ax.set_rlim(origin, top)
+    # Whole decades, none so near the rim that its label meets the angle labels.
+    decades = np.arange(origin, math.floor(top) + 1)
+    every = max(1, math.ceil(decades.size / 6))
+    decades = [k for k in decades[::every] if top - k > 0.08 * (top - origin)]
+    ax.yaxis.set_major_locator(mticker.FixedLocator(decades))
+    ax.yaxis.set_major_formatter(mticker.FuncFormatter(lambda v, _: f"$10^{{{v:.0f}}}$"))
+    ax.tick_params(axis="y", labelsize=6.5)
+    ax.tick_params(axis="x", labelsize=6.5, pad=1.0)
+    ax.set_rlabel_position(lo)
+    ax.xaxis.grid(True, color="0.85", lw=0.4, alpha=1.0)
+    ax.yaxis.grid(True, color="0.8", lw=0.5, alpha=1.0)
+    arc = np.radians(np.linspace(lo, hi, 91))
+    xs, ys = np.r_[0.0, np.cos(arc)], np.r_[0.0, np.sin(arc)]
+    return top, float(np.ptp(ys) / np.ptp(xs))
+
+
+#: Largest offset along ω between the residual points of neighbouring structures [decades].
+DODGE_MAX = 0.04
+
+
+def dodge_step(omega, n_structures: int) -> float:
+    """Offset along ω [decades] between neighbouring structures' residual points: at most
+    :data:`DODGE_MAX`, and the points of all structures at one frequency take at most 80 % of
+    the median spacing of the frequencies (so they stay nearer their own frequency)."""
+    if n_structures < 2:
+        return 0.0
+    lw = np.unique(np.log10(np.asarray(omega, float)))
+    spacing = float(np.median(np.diff(lw))) if lw.size > 1 else 1.0
+    return min(DODGE_MAX, 0.8 * spacing / n_structures)
 
 
 def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS,
@@ -272,9 +470,10 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
     The prediction is the pointwise posterior median of Re G and of Im G at the measured
     frequencies. With σ known the residuals are divided by σ/√2, the standard deviation of each
     part, so that they are standard normal when the model is right (dotted lines at ±2);
-    otherwise they are relative to the measured |G|, in percent. Points of different
-    structures are offset slightly along ω (by ±1.5 % of a decade per structure) to keep them
-    apart; held-out points are drawn as diamonds.
+    otherwise they are relative to the measured |G|, in percent. Each structure has its own
+    marker, and its points are offset along ω (by :func:`dodge_step`, at most 0.04 decades
+    between neighbours) to keep them apart; when the residuals of structures agree within a
+    marker's size the legend says that they coincide. Held-out points have a black edge.
 
     Parameters
     ----------
@@ -294,8 +493,10 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
         ``"data/omega"``; per structure ``"<name>/real"``, ``"<name>/imag"`` (normalised
         residuals at ``data/omega``), ``"<name>/prediction"`` (complex median prediction), and
         with held-out points ``"holdout/omega"``, ``"<name>/holdout_real"``,
-        ``"<name>/holdout_imag"``; ``"scale"`` (the divisor of the data points).
-        ``artists``: ``"<name>/real"``, ``"<name>/imag"`` (``Line2D``) and the hold-out ones.
+        ``"<name>/holdout_imag"``; ``"scale"`` (the divisor of the data points); ``"dodge"``
+        (decades between neighbouring structures); ``"note"`` (which structures coincide, or
+        empty). ``artists``: ``"<name>/real"``, ``"<name>/imag"`` (``Line2D``), the hold-out
+        ones, and ``"note"`` (the legend title) when residuals coincide.
 
     Raises
     ------
@@ -304,9 +505,11 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
     """
     results = select_results(comparison, structures)
     data = comparison.data
-    colors = colors_for(comparison.ranking)
+    styles = comparison_styles(comparison)
     known = data.sigma is not None
     values, artists = {}, {}
+    step = dodge_step(data.omega, len(results))
+    values["dodge"] = step
     with style():
         if ax is None:
             fig = new_figure(None, (COLUMN_WIDTH, 3.6))
@@ -333,15 +536,18 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
                 values[f"{r.name}/{tag}prediction"] = pred
                 values[f"{r.name}/{tag}real"] = res.real
                 values[f"{r.name}/{tag}imag"] = res.imag
-                dodge = w * 10 ** (0.015 * (i - (len(results) - 1) / 2))
-                c = colors[r.name]
-                marker = "o" if prefix == "data" else "D"
+                dodge = w * 10 ** (step * (i - (len(results) - 1) / 2))
+                st = styles[r.name]
+                c = st.color
+                edge = c if prefix == "data" else DATA_COLOR
                 for part, a, y in (("real", ax_re, res.real), ("imag", ax_im, res.imag)):
-                    filled = not (single and part == "imag") and prefix == "data"
+                    filled = not (single and part == "imag")
                     label = r.name if prefix == "data" and part == "real" else None
-                    (pts,) = a.plot(dodge, y, ls="none", marker=marker, color=c,
-                                    mfc=c if filled else "white", mec=c, ms=3.2 if filled else 3.6,
-                                    mew=0.8, label=label)
+                    (pts,) = a.plot(dodge, y, ls="none", marker=st.marker, color=c,
+                                    mfc=c if filled else "white", mec=edge,
+                                    ms=3.4 if filled else 3.8,
+                                    mew=0.8 if prefix == "data" else 1.0, label=label,
+                                    zorder=3 + (prefix != "data"))
                     artists[f"{r.name}/{tag}{part}"] = pts
         ylabel = "residual / (σ/√2)" if known else "residual / |data| [%]"
         for a, part in ((ax_re, "Re"), (ax_im, "Im")):
@@ -352,14 +558,25 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
             a.set_xscale("log")
             a.set_ylabel(ylabel if single else f"{part} {ylabel}")
         ax_im.set_xlabel(OMEGA_LABEL)
+        names = [r.name for r in results]
+        # Markers are about 1.5 % of an axes high: residuals closer than that sit on each other.
+        panels = {"Re": coincident_groups({n: values[f"{n}/real"] for n in names},
+                                          _span(ax_re), fraction=0.015),
+                  "Im": coincident_groups({n: values[f"{n}/imag"] for n in names},
+                                          _span(ax_im), fraction=0.015)}
+        note = coincidence_note(panels)
+        values["note"] = note
         handles, labels = ax_re.get_legend_handles_labels()
         if comparison.holdout is not None:
             from matplotlib.lines import Line2D
 
-            handles.append(Line2D([], [], ls="none", **HOLDOUT_STYLE))
-            labels.append("held out")
+            handles.append(Line2D([], [], ls="none", marker="o", mfc="0.75", mec=DATA_COLOR,
+                                  mew=1.0, ms=3.8))
+            labels.append("held out (black edge)")
         if single:
-            ax_re.legend(handles, labels, loc="best", title="filled Re, open Im")
+            legend = ax_re.legend(handles, labels, loc="best",
+                                  title="filled Re, open Im" + (f"; {note}" if note else ""))
         else:
-            _legend(fig, handles, labels)
+            legend = _legend(fig, handles, labels, note)
+        artists.update(_note_artists(legend, note))
     return Drawn.build(fig, (ax_re, ax_im), values, artists)

@@ -6,13 +6,19 @@ are chosen for a journal column: :data:`COLUMN_WIDTH` = 3.5 in with 8 pt text, a
 :data:`PAGE_WIDTH` = 7.1 in for figures that need the full page (corner plots of many
 parameters).
 
-Colours follow the ranking: the best structure of a comparison gets the first colour of the
-Okabe–Ito palette (distinguishable with the common forms of colour blindness) in every figure.
+Every structure has one style in every figure, from :func:`structure_styles`: a colour of the
+Okabe–Ito palette (distinguishable with the common forms of colour blindness), a line style and
+a marker, each cycling with its own period (7, 4 and 5), so that neighbours differ in all three
+and the first 140 structures get distinct combinations. The index of a structure is its
+position in the structures as requested (the order of ``Comparison.results``, the order given to
+a batch), which is the same for every data set of a batch: a structure looks the same in the
+figures of a comparison and in the batch figures.
 """
 
 from __future__ import annotations
 
 import contextlib
+from dataclasses import dataclass
 
 COLUMN_WIDTH = 3.5
 PAGE_WIDTH = 7.1
@@ -90,9 +96,60 @@ def style():
         yield
 
 
+#: Line styles of the structures' curves, cycled with period 4 (coprime with the palette's 7).
+LINESTYLES = ("-", "--", ":", "-.")
+#: Markers of the structures (all fillable: filled and open forms carry meaning), period 5.
+MARKERS = ("o", "s", "^", "D", "v")
+
+
+@dataclass(frozen=True)
+class StructureStyle:
+    """How one structure is drawn: ``color``, ``linestyle``, ``marker`` (and its ``index``)."""
+
+    index: int
+    color: str
+    linestyle: object
+    marker: str
+
+    @property
+    def key(self) -> tuple:
+        """(colour, line style, marker): distinct for distinct indices below 140."""
+        return (self.color, self.linestyle, self.marker)
+
+    def line(self, **kwargs) -> dict:
+        """Keyword arguments of ``Axes.plot`` for a curve of this structure."""
+        return {"color": self.color, "linestyle": self.linestyle, **kwargs}
+
+
+def structure_style(index: int) -> StructureStyle:
+    """The style of the structure at position ``index`` (from 0) of the requested structures.
+
+    Examples
+    --------
+    >>> structure_style(0).key
+    ('#0072B2', '-', 'o')
+    >>> len({structure_style(i).key for i in range(20)})
+    20
+    """
+    i = int(index)
+    return StructureStyle(i, PALETTE[i % len(PALETTE)], LINESTYLES[i % len(LINESTYLES)],
+                          MARKERS[i % len(MARKERS)])
+
+
+def structure_styles(names) -> dict[str, StructureStyle]:
+    """``{name: style}`` by position in ``names`` (the structures as requested)."""
+    return {n: structure_style(i) for i, n in enumerate(dict.fromkeys(names))}
+
+
+def comparison_styles(comparison) -> dict[str, StructureStyle]:
+    """The styles of a comparison's structures: by their order in ``comparison.results`` (the
+    order requested), the order a batch of the same structures uses too."""
+    return structure_styles([r.name for r in comparison.results])
+
+
 def colors_for(names) -> dict[str, str]:
-    """``{name: colour}`` in the order given (the ranking), cycling through :data:`PALETTE`."""
-    return {n: PALETTE[i % len(PALETTE)] for i, n in enumerate(names)}
+    """``{name: colour}`` of :func:`structure_styles`."""
+    return {n: st.color for n, st in structure_styles(names).items()}
 
 
 QUANTITY = {"compliance": "J^*", "modulus": "G^*", "generic": "G"}

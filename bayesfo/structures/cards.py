@@ -15,9 +15,10 @@ import numpy as np
 from .._io import read_text_file, show
 from ..errors import InputError, StructureError
 from ..priors import prior_from_dict
+from .physical import Picture
 from .structure import Parameter, Structure
-from .terms import _NAME, MAX_DEGREE, Exponent, Inequality, Term, _number
-from .variants import integer_variant, inverted_variant
+from .terms import MAX_DEGREE, Exponent, Inequality, Term, parse_coefficient
+from .variants import integer_is_degenerate, integer_variant, inverted_variant
 
 N_MAX_DEFAULT = 3
 
@@ -32,24 +33,8 @@ def _parse_terms(spec, where: str) -> tuple[Term, ...]:
     for i, item in enumerate(spec):
         if not isinstance(item, list) or len(item) != 2:
             raise StructureError(f"{where}, term {i + 1}: expected [coefficient, exponent], got {item!r}")
-        coef, expo = item
-        if isinstance(coef, bool) or not isinstance(coef, (str, int, float)):
-            raise StructureError(f"{where}, term {i + 1}: coefficient must be a name or a number")
-        if isinstance(coef, str):
-            value = _number(coef.strip())
-            if value is not None:
-                coef = value
-            elif not _NAME.fullmatch(coef) or coef.lower() in ("nan", "inf", "infinity"):
-                raise StructureError(
-                    f"{where}, term {i + 1}: bad coefficient {coef!r}; write a parameter name "
-                    "(letters, digits, '_') or a finite number"
-                )
-        else:
-            coef = float(coef)
-            if not math.isfinite(coef):
-                raise StructureError(f"{where}, term {i + 1}: a constant coefficient must be a "
-                                     f"finite number, got {item[0]!r}")
-        terms.append(Term(coef, Exponent.parse(expo, f"{where}, term {i + 1}")))
+        coef = parse_coefficient(item[0], f"{where}, term {i + 1}")
+        terms.append(Term(coef, Exponent.parse(item[1], f"{where}, term {i + 1}")))
     return tuple(terms)
 
 
@@ -90,7 +75,49 @@ def _common(card: dict, where: str) -> dict:
 
 
 CARD_KEYS = {"name", "title", "description", "reference", "numerator", "denominator",
-             "constraints", "parameters", "family", "n_max", "order"}
+             "constraints", "parameters", "family", "n_max", "order", "aliases", "physical",
+             "integer", "inverted"}
+
+_ALIAS = re.compile(r"[a-z][a-z0-9_]*")
+
+
+def _aliases(card: dict, where: str) -> tuple[str, ...]:
+    raw = card.get("aliases", [])
+    if not isinstance(raw, list) or not all(isinstance(a, str) for a in raw):
+        raise StructureError(f"{where}: 'aliases' must be a list of names, got {raw!r}")
+    for a in raw:
+        if not _ALIAS.fullmatch(a):
+            raise StructureError(f"{where}: alias {show(a)} must be lower-case letters, digits "
+                                 "or '_'")
+    return tuple(raw)
+
+
+def _pictures(card: dict, where: str, name: str) -> tuple[Picture, ...]:
+    raw = card.get("physical")
+    if raw is None:
+        return ()
+    raw = [raw] if isinstance(raw, dict) else raw
+    if not isinstance(raw, list) or not raw:
+        raise StructureError(f"{where}: 'physical' must be a table or a list of tables")
+    out = []
+    for i, spec in enumerate(raw):
+        pic = Picture.from_card(spec, f"{where}, physical {i + 1}", name)
+        for a in (pic.name,) + pic.aliases:
+            if not _ALIAS.fullmatch(a):
+                raise StructureError(f"{where}, physical {i + 1}: name {show(a)} must be "
+                                     "lower-case letters, digits or '_'")
+        out.append(pic)
+    return tuple(out)
+
+
+def _integer_option(card: dict, where: str):
+    value = card.get("integer", "auto")
+    if isinstance(value, bool) or value == "auto":
+        return value
+    if isinstance(value, str) and re.fullmatch(r"[a-z][a-z0-9_-]*", value):
+        return value
+    raise StructureError(f"{where}: 'integer' must be true, false, \"auto\" or the name of the "
+                         f"structure that is the integer-order baseline, got {value!r}")
 
 
 def structures_from_card(card: dict, source: str = "", n_max: int | None = None) -> list[Structure]:
@@ -115,16 +142,30 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
         raise StructureError(f"{where}: 'parameters' must be a table")
     common = _common(card, where)
     family = card.get("family")
+    inverted = card.get("inverted", True)
+    if not isinstance(inverted, bool):
+        raise StructureError(f"{where}: 'inverted' must be true or false, got {inverted!r}")
+    integer = _integer_option(card, where)
     out: list[Structure] = []
     if family is None:
         num = _parse_terms(card.get("numerator"), f"{where}, numerator")
         den = _parse_terms(card.get("denominator"), f"{where}, denominator")
-        expo = {t.exponent.param for t in num + den if t.exponent.param}
+        expo = {p for t in num + den for p in t.exponent.params}
         used = [n for n in table if not n.endswith("*")]
         params = _parameters(used, table, where, expo)
-        base = Structure(name, num, den, params, family=name, card=source, **common)
-        bases = [(base, True, True)]
+        pics = _pictures(card, where, name)
+        aliases = _aliases(card, where) + tuple(
+            a for p in pics for a in (p.name,) + p.aliases if a != name)
+        base = Structure(name, num, den, params, family=name, card=source, pictures=pics,
+                         aliases=aliases, baseline=integer if isinstance(integer, str)
+                         and integer != "auto" else "", **common)
+        for i, pic in enumerate(pics):
+            pic.check(base, f"{where}, physical {i + 1}")
+        bases = [(base, True, inverted)]
     elif family == "max-order":
+        for key in ("physical", "aliases"):
+            if key in card:
+                raise StructureError(f"{where}: {key!r} is not available for a family card")
         if n_max is not None:
             nmax = _check_n_max(n_max, "argument 'n_max'")
         else:
@@ -133,9 +174,9 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
         pairs = {(n, m) for n in range(1, nmax + 1) for m in range(n + 1)}
         inv_pairs = {(n, m) for m in range(1, nmax + 1) for n in range(m + 1)}
         for n, m in sorted(pairs | inv_pairs, key=lambda p: (max(p), p[0], p[1])):
-            num = tuple(Term(f"b{k}", Exponent(float(k), "q") if k else Exponent(0.0)) for k in range(m + 1))
-            den = (Term(1.0, Exponent(0.0)),) + tuple(
-                Term(f"a{k}", Exponent(float(k), "q")) for k in range(1, n + 1)
+            num = tuple(Term(f"b{k}", Exponent.of("q", k) if k else Exponent()) for k in range(m + 1))
+            den = (Term(1.0, Exponent()),) + tuple(
+                Term(f"a{k}", Exponent.of("q", k)) for k in range(1, n + 1)
             )
             names = [f"a{k}" for k in range(1, n + 1)] + [f"b{k}" for k in range(m + 1)] + ["q"]
             params = _parameters(names, table, where, {"q"})
@@ -143,7 +184,7 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
                 f"{name}-n{n}m{m}", num, den, params, family=name, degrees=(n, m), card=source,
                 **common,
             )
-            bases.append((s, (n, m) in pairs, (n, m) in inv_pairs))
+            bases.append((s, (n, m) in pairs, inverted and (n, m) in inv_pairs))
     else:
         raise StructureError(f"{where}: unknown family {family!r}; known: 'max-order'")
     for base, plain, inverse in bases:
@@ -152,9 +193,12 @@ def structures_from_card(card: dict, source: str = "", n_max: int | None = None)
             variants.append(base)
         if inverse:
             variants.append(inverted_variant(base))
+        make_int = bool(base.exponent_params) and (
+            integer is True or (family is not None and integer == "auto")
+            or (integer == "auto" and not integer_is_degenerate(base, integer_variant(base))))
         for v in variants:
             out.append(v)
-            if v.exponent_params:
+            if make_int:
                 out.append(integer_variant(v))
     return out
 
@@ -199,8 +243,54 @@ def card_paths(extra=()) -> list[Path]:
 MAX_CARD_BYTES = 1024 * 1024
 
 
-def load_library(extra=(), n_max: int | None = None) -> dict[str, Structure]:
-    """Every structure of every card, by name.
+#: Structures of recently read cards by (path, text, n_max): structures are immutable, and
+#: checking a card (units, pictures, integer baselines) costs more than reading it.
+_CARD_CACHE: dict[tuple, list[Structure]] = {}
+
+
+def _card_structures(card: dict, source: str, n_max, text: str) -> list[Structure]:
+    key = (source, text, n_max)
+    if key not in _CARD_CACHE:
+        if len(_CARD_CACHE) > 256:
+            _CARD_CACHE.clear()
+        _CARD_CACHE[key] = structures_from_card(card, source=source, n_max=n_max)
+    return _CARD_CACHE[key]
+
+
+class Library(dict):
+    """Structures by name (a dict), with their aliases.
+
+    ``aliases`` maps another name to ``(structure name, picture name or None)``: the names
+    users of rheology packages know (``fractional_kelvin_voigt_s`` for ``voigt``), the pictures
+    of a card (``fractional_poynting_thomson`` for ``zener`` read as a spring in series with a
+    fractional Kelvin–Voigt element) and integer baselines that are other structures
+    (``fractional_maxwell_gel-int`` is ``maxwell-int``). A structure's own name always wins over
+    an alias; of two cards claiming one alias the first loaded keeps it.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.aliases: dict[str, tuple[str, str | None]] = {}
+
+    def lookup(self, name: str) -> tuple[Structure, str | None] | None:
+        """``(structure, picture)`` for a name or an alias (also with ``-int``/``-inv``
+        suffixes, e.g. ``fkv-int``), or None."""
+        if name in self:
+            return self[name], None
+        if name in self.aliases:
+            target, picture = self.aliases[name]
+            return (self[target], picture) if target in self else None
+        for suffix in ("-inv-int", "-int", "-inv"):
+            if name.endswith(suffix) and name[: -len(suffix)] in self.aliases:
+                target, picture = self.aliases[name[: -len(suffix)]]
+                found = self.lookup(target + suffix)
+                if found is not None:
+                    return found[0], picture if suffix == "-int" else found[1]
+        return None
+
+
+def load_library(extra=(), n_max: int | None = None) -> Library:
+    """Every structure of every card, by name (a :class:`Library`, a dict with aliases).
 
     Parameters
     ----------
@@ -212,11 +302,12 @@ def load_library(extra=(), n_max: int | None = None) -> dict[str, Structure]:
     Raises
     ------
     StructureError
-        For an unreadable card, or two cards declaring the same structure name.
+        For an unreadable card, two cards declaring the same structure name, or an integer
+        baseline naming an unknown structure.
     """
     if n_max is not None:
         _check_n_max(n_max, "argument 'n_max'")
-    library: dict[str, Structure] = {}
+    library = Library()
     cards = []
     for i, path in enumerate(card_paths(extra)):
         try:
@@ -233,22 +324,36 @@ def load_library(extra=(), n_max: int | None = None) -> dict[str, Structure]:
         order = card.get("order", 1000)
         if isinstance(order, bool) or not isinstance(order, (int, float)) or not math.isfinite(order):
             raise StructureError(f"card '{path}': 'order' must be a finite number, got {order!r}")
-        cards.append((order, i, path, card))
-    for _, _, path, card in sorted(cards, key=lambda c: c[:2]):
-        for s in structures_from_card(card, source=str(path), n_max=n_max):
+        cards.append((order, i, path, card, text))
+    aliases: dict[str, tuple[str, str | None]] = {}
+    for _, _, path, card, text in sorted(cards, key=lambda c: c[:2]):
+        for s in _card_structures(card, str(path), n_max, text):
             if s.name in library:
                 raise StructureError(
                     f"card '{path}' declares structure '{s.name}', already declared by "
                     f"card '{library[s.name].card}'"
                 )
             library[s.name] = s
+            if s.inverted or s.integer:
+                continue
+            for a in s.aliases:
+                picture = next((p.name for p in s.pictures if a == p.name or a in p.aliases),
+                               None)
+                aliases.setdefault(a, (s.name, picture))
+            if s.baseline:
+                aliases.setdefault(f"{s.name}-int", (s.baseline, None))
+    for s in library.values():
+        if s.baseline and s.baseline not in library:
+            raise StructureError(f"card '{s.card}': 'integer' names {show(s.baseline)}, which "
+                                 "is not a structure of the library")
+    library.aliases = {a: t for a, t in aliases.items() if a not in library}
     return library
 
 
-_DEFAULT_LIBRARY: dict[str, Structure] | None = None
+_DEFAULT_LIBRARY: Library | None = None
 
 
-def default_library() -> dict[str, Structure]:
+def default_library() -> Library:
     """The packaged structures (cached)."""
     global _DEFAULT_LIBRARY
     if _DEFAULT_LIBRARY is None:
@@ -257,15 +362,26 @@ def default_library() -> dict[str, Structure]:
 
 
 def get_structure(name: str, library: dict[str, Structure] | None = None) -> Structure:
-    """The structure called ``name`` (e.g. ``"zener"``, ``"max-n2m1"``, ``"zener-inv-int"``)."""
+    """The structure called ``name`` (e.g. ``"zener"``, ``"max-n2m1"``, ``"zener-inv-int"``)
+    or one of its aliases (``"fractional_kelvin_voigt"``, ``"fzss"``)."""
     library = default_library() if library is None else library
-    try:
+    if name in library:
         return library[name]
-    except KeyError:
-        raise StructureError(
-            f"unknown structure {show(str(name))}; known structures: "
-            f"{', '.join(_short_list(library))}"
-        ) from None
+    found = library.lookup(name) if isinstance(library, Library) and isinstance(name, str) else None
+    if found is not None:
+        return found[0]
+    raise StructureError(
+        f"unknown structure {show(str(name))}; known structures: "
+        f"{', '.join(_short_list(library))}"
+    )
+
+
+def picture_for(name: str, library: dict[str, Structure] | None = None) -> str | None:
+    """The picture an alias names (``"fractional_poynting_thomson"`` → the Poynting–Thomson
+    picture of ``zener``), None for a structure's own name or an alias without a picture."""
+    library = default_library() if library is None else library
+    found = library.lookup(name) if isinstance(library, Library) else None
+    return None if found is None else found[1]
 
 
 def _short_list(library) -> list[str]:

@@ -4,7 +4,6 @@ and the scaling between physical units and the scaled problem."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -20,38 +19,9 @@ from ..response import (
     matignon_stable,
     power_ratio,
 )
-from .terms import Exponent, Inequality, Term
-
-
-@dataclass(frozen=True)
-class Scaling:
-    """Reference values that make the fitted quantities of order one.
-
-    Attributes
-    ----------
-    omega_ref : float
-        ω_ref [rad/s], the geometric mean of the measured frequencies.
-    g_ref : float
-        g_ref, the median of |G| of the data.
-    reciprocal : bool
-        True when the structure's transfer function is compared with the reciprocal of the data
-        (material structures against modulus data); then the transfer function scales with
-        1/g_ref.
-    """
-
-    omega_ref: float = 1.0
-    g_ref: float = 1.0
-    reciprocal: bool = False
-
-    @classmethod
-    def from_data(cls, data) -> Scaling:
-        """Scaling for a :class:`~bayesfo.data.FrequencyResponse` (its kind sets ``reciprocal``)."""
-        return cls(data.omega_ref, data.g_ref, data.kind == "modulus")
-
-    @property
-    def tf_gain(self) -> float:
-        """The reference magnitude of the structure's transfer function."""
-        return 1.0 / self.g_ref if self.reciprocal else self.g_ref
+from .passivity import side_stable, springpot_sum_passive
+from .scaling import ScalePlan, Scaling, scale_plan
+from .terms import Inequality, Term
 
 
 @dataclass(frozen=True)
@@ -97,6 +67,14 @@ class Structure:
     integer: bool = False
     degrees: tuple[int, int] | None = None  # (n, m) of A and B before any inversion
     card: str = ""
+    #: Physical pictures (:class:`~bayesfo.structures.physical.Picture`), the default first;
+    #: empty for inverted variants, whose reciprocal is not the material of the card.
+    pictures: tuple = ()
+    #: Other names of the structure (e.g. ``fractional_kelvin_voigt_s`` for ``voigt``).
+    aliases: tuple[str, ...] = ()
+    #: The integer-order baseline when it is another structure of the library (``maxwell-int``
+    #: for the fractional Maxwell gel), rather than a generated ``-int`` variant.
+    baseline: str = ""
 
     def __post_init__(self):
         self._validate()
@@ -118,7 +96,8 @@ class Structure:
 
     @property
     def exponent_params(self) -> tuple[str, ...]:
-        names = {t.exponent.param for t in self.numerator + self.denominator if t.exponent.param}
+        """Parameters in the exponents (free or fixed)."""
+        names = {p for t in self.numerator + self.denominator for p in t.exponent.params}
         return tuple(sorted(names))
 
     @property
@@ -131,21 +110,17 @@ class Structure:
     def formula(self) -> str:
         """The transfer function as text, e.g. ``b0 / (1 + a1 s^q)``."""
 
-        def fix(t):
-            e = t.exponent
-            if e.param in self.fixed:
-                return Term(t.coef, Exponent(e.multiple * float(self.fixed[e.param])))
-            return t
+        def side(terms, below=False):
+            fixed = [Term(t.coef, t.exponent.substitute(self.fixed)) for t in terms]
+            text = " + ".join(str(t) for t in fixed)
+            product = below and len(terms[0].factors) > 1
+            return f"({text})" if len(terms) > 1 or product else text
 
-        def side(terms):
-            text = " + ".join(str(fix(t)) for t in terms)
-            return f"({text})" if len(terms) > 1 else text
-
-        return f"{side(self.numerator)} / {side(self.denominator)}"
+        return f"{side(self.numerator)} / {side(self.denominator, below=True)}"
 
     def describe(self) -> dict:
         """Plain-Python description (name, formula, priors, constraints) for reports."""
-        return {
+        out = {
             "name": self.name,
             "family": self.family,
             "formula": self.formula,
@@ -158,6 +133,11 @@ class Structure:
             "title": self.title,
             "reference": self.reference,
         }
+        if self.aliases:
+            out["aliases"] = list(self.aliases)
+        if self.pictures:
+            out["pictures"] = [p.describe() for p in self.pictures]
+        return out
 
     def with_priors(self, priors: dict[str, Prior]) -> Structure:
         """A copy with some priors replaced (``{name: Prior}``)."""
@@ -193,21 +173,22 @@ class Structure:
         return vals, single
 
     def _side_arrays(self, terms, vals, n_sets):
+        """Coefficients and exponents of a side, each of shape (n_sets, n_terms)."""
         coef = np.empty((n_sets, len(terms)))
         expo = np.empty((n_sets, len(terms)))
-        for i, t in enumerate(terms):
-            coef[:, i] = vals[t.coef] if t.is_free else t.coef
-            e = t.exponent
-            expo[:, i] = e.multiple * vals[e.param] if e.param else e.multiple
+        with np.errstate(all="ignore"):
+            for i, t in enumerate(terms):
+                coef[:, i] = t.coefficient(vals, n_sets)
+                expo[:, i] = t.exponent.value(vals)
         return coef, expo
 
     def _polynomial(self, terms, vals, n_sets):
         """Ascending coefficients of a side that is a polynomial in λ = s^q."""
-        degree = max(int(round(t.exponent.multiple)) if t.exponent.param else 0 for t in terms)
+        degree = max(_degree(t) for t in terms)
         out = np.zeros((n_sets, degree + 1))
-        for t in terms:
-            k = int(round(t.exponent.multiple)) if t.exponent.param else 0
-            out[:, k] += vals[t.coef] if t.is_free else t.coef
+        with np.errstate(all="ignore"):
+            for t in terms:
+                out[:, _degree(t)] += t.coefficient(vals, n_sets)
         return out
 
     def polynomials(self, theta):
@@ -293,13 +274,16 @@ class Structure:
         return ok if np.ndim(theta) == 2 else ok[0]
 
     def stable(self, theta, kind: str = "generic") -> np.ndarray:
-        """Matignon stability (thesis Theorem 3) of the poles, and for materials of the zeros.
+        """Stability of the poles, and for materials of the zeros.
 
         The poles (roots of the denominator) are always tested. For compliance and modulus data
         the zeros are tested too: a passive material has a compliance whose reciprocal, the
         modulus, is again a stable response, so a root of the numerator in the unstable region
-        is as unphysical as a pole there. Roots at λ = 0 (integrators) are accepted. A side
-        that is not a polynomial in one s^p is not tested.
+        is as unphysical as a pole there. Roots at s = 0 (integrators) are accepted. A side that
+        is a polynomial in one λ = s^p is tested with Matignon's theorem (thesis Theorem 3); any
+        other side with the conditions of :mod:`bayesfo.structures.passivity` (a positive sum of
+        springpots with exponents spanning less than 2; integer exponents; else the argument
+        principle on the imaginary axis).
         """
         vals, single = self.values(theta)
         n_sets = np.atleast_2d(np.asarray(theta, float)).shape[0]
@@ -307,9 +291,16 @@ class Structure:
         sides = [self.denominator] + ([self.numerator] if kind in ("compliance", "modulus") else [])
         for terms in sides:
             p = _polynomial_order(terms)
-            if p:  # None: not a polynomial; "": a constant, without roots
+            if p == "":
+                continue  # a constant, without roots
+            if p is not None:
                 poly = self._polynomial(terms, vals, n_sets)
                 ok &= matignon_stable(poly, vals[p], allow_integrator=True)
+            elif ok.any():
+                rows = np.flatnonzero(ok)
+                coef, expo = self._side_arrays(terms, {k: v[rows] for k, v in vals.items()},
+                                               rows.size)
+                ok[rows] = side_stable(coef, expo)
         return ok[0] if single else ok
 
     def passive(self, theta, kind: str, omega_grid) -> np.ndarray:
@@ -318,7 +309,10 @@ class Structure:
         Commensurate structures of degree ≤ 1 on both sides use the exact condition instead of
         the grid: Im[(b0 + b1 λ)/(a0 + a1 λ)] = (b1 a0 − b0 a1) Im λ / |A|², and Im λ > 0 for
         0 < q < 2, so a compliance (and its reciprocal, a modulus) dissipates iff
-        b1 a0 ≤ b0 a1, at every frequency.
+        b1 a0 ≤ b0 a1, at every frequency. Otherwise parameter sets that satisfy an exact
+        sufficient condition (springpots in series or in parallel; a declared network with
+        positive coefficients and orders in [0, 1]; see :mod:`bayesfo.structures.passivity`)
+        are passive at every frequency, and the rest are checked on the grid.
         """
         theta2 = np.atleast_2d(np.asarray(theta, float))
         single = np.ndim(theta) != 2
@@ -333,18 +327,31 @@ class Structure:
             ok = (lhs <= rhs + 1e-12 * scale) | ~((q > 0) & (q < 2))
             ok &= np.all(np.isfinite(theta2), axis=1)
         else:
-            ok = is_dissipative(self.response(theta2, omega_grid, kind), kind)
+            ok = self._exactly_passive(theta2)
+            rest = np.flatnonzero(~ok)
+            if rest.size:
+                ok[rest] = is_dissipative(self.response(theta2[rest], omega_grid, kind), kind)
         return ok[0] if single else ok
+
+    def _exactly_passive(self, theta2) -> np.ndarray:
+        """Rows passive by an exact sufficient condition (the others may be passive too)."""
+        vals, _ = self.values(theta2)
+        n = theta2.shape[0]
+        ok = np.zeros(n, dtype=bool)
+        if self.pictures and self.pictures[0].network is not None:
+            ok |= self.pictures[0].network.positive(self.pictures[0].physical_values(self, vals))
+        sums = springpot_sum_passive(self._side_arrays(self.numerator, vals, n),
+                                     self._side_arrays(self.denominator, vals, n))
+        if sums is not None:
+            ok |= sums
+        return ok & np.all(np.isfinite(theta2), axis=1)
 
     @cached_property
     def _first_degree(self) -> bool:
         """Commensurate with numerator and denominator of degree ≤ 1 in λ = s^q."""
         if self.commensurate_order is None:
             return False
-        return all(
-            (t.exponent.multiple if t.exponent.param else 0) <= 1
-            for t in self.numerator + self.denominator
-        )
+        return all(_degree(t) <= 1 for t in self.numerator + self.denominator)
 
     def admissible(self, theta, kind: str, omega_grid=None) -> np.ndarray:
         """All declared constraints and prior supports at once: the support of the posterior.
@@ -373,7 +380,8 @@ class Structure:
                 ok &= c.holds(vals)
         names = {c for c in self.constraints if isinstance(c, str)}
         if "stable" in names and ok.any():
-            ok &= self.stable(theta, kind)
+            rows = np.flatnonzero(ok)
+            ok[rows] = self.stable(theta[rows], kind)
         if "passive" in names and kind != "generic" and ok.any():
             grid = dissipation_grid(1.0, 1.0) if omega_grid is None else omega_grid
             rows = np.flatnonzero(ok)
@@ -382,39 +390,24 @@ class Structure:
 
     # ------------------------------------------------------------------ units
     @cached_property
-    def _scale_plan(self):
-        """For each free coefficient: (column, term, side sign of the gain)."""
-        gain_side = _gain_side(self)
-        plan = []
-        for side, terms in (("numerator", self.numerator), ("denominator", self.denominator)):
-            g = -1.0 if side == "numerator" else 1.0
-            g = g if side == gain_side else 0.0
-            for t in terms:
-                if t.is_free and t.coef in self.param_names:
-                    plan.append((self.param_names.index(t.coef), t.exponent, g))
-        return plan
-
-    def _scale_factors(self, theta, scaling: Scaling) -> np.ndarray:
-        theta2 = np.atleast_2d(np.asarray(theta, float))
-        vals, _ = self.values(theta2)
-        factors = np.ones_like(theta2)
-        log_w = math.log(scaling.omega_ref)
-        log_g = math.log(scaling.tf_gain)
-        for col, e, g in self._scale_plan:
-            expo = e.multiple * vals[e.param] if e.param else e.multiple
-            factors[:, col] = np.exp(expo * log_w + g * log_g)
-        return factors
+    def scale_plan(self) -> ScalePlan:
+        """The units of the coefficients (:mod:`bayesfo.structures.scaling`)."""
+        return scale_plan(self)
 
     def to_scaled(self, theta, scaling: Scaling) -> np.ndarray:
         """Physical parameters → parameters of the scaled problem (ω/ω_ref, G/g_ref)."""
         theta = np.asarray(theta, float)
-        out = np.atleast_2d(theta) * self._scale_factors(theta, scaling)
+        theta2 = np.atleast_2d(theta)
+        vals, _ = self.values(theta2)
+        out = theta2 * self.scale_plan.factors(theta2, vals, scaling)
         return out[0] if theta.ndim == 1 else out
 
     def to_physical(self, theta, scaling: Scaling) -> np.ndarray:
         """Parameters of the scaled problem → physical parameters (exponents are unchanged)."""
         theta = np.asarray(theta, float)
-        out = np.atleast_2d(theta) / self._scale_factors(theta, scaling)
+        theta2 = np.atleast_2d(theta)
+        vals, _ = self.values(theta2)
+        out = theta2 / self.scale_plan.factors(theta2, vals, scaling)
         return out[0] if theta.ndim == 1 else out
 
     # ------------------------------------------------------------------ checks
@@ -422,11 +415,21 @@ class Structure:
         where = f"structure '{self.name}'" + (f" (card {self.card})" if self.card else "")
         if not self.numerator or not self.denominator:
             raise StructureError(f"{where}: numerator and denominator need at least one term")
-        coef_names = [t.coef for t in self.numerator + self.denominator if t.is_free]
-        dup = {n for n in coef_names if coef_names.count(n) > 1}
-        if dup:
-            raise StructureError(f"{where}: coefficient '{sorted(dup)[0]}' appears in two terms")
-        used = set(coef_names) | set(self.exponent_params)
+        terms = self.numerator + self.denominator
+        for side in (self.numerator, self.denominator):
+            seen = set()
+            for t in side:
+                key = (tuple(sorted(t.factors)), t.exponent)
+                if t.is_free and key in seen:
+                    raise StructureError(f"{where}: the term '{t}' appears twice in one side")
+                seen.add(key)
+        coef_names = {f for t in terms for f in t.factors}
+        expo_names = set(self.exponent_params)
+        both = coef_names & expo_names
+        if both:
+            raise StructureError(f"{where}: parameter '{sorted(both)[0]}' is used both as a "
+                                 "coefficient and in an exponent")
+        used = coef_names | expo_names
         declared = set(self.param_names) | set(self.fixed)
         missing = used - declared
         if missing:
@@ -434,8 +437,8 @@ class Structure:
         unused = set(self.param_names) - used
         if unused:
             raise StructureError(f"{where}: parameter {show(sorted(unused)[0])} does not appear in the formula")
-        for t in self.numerator + self.denominator:
-            if not t.is_free and (t.exponent.param or t.exponent.multiple != 0):
+        for t in terms:
+            if not t.is_free and (t.exponent.coefs or t.exponent.constant != 0):
                 raise StructureError(
                     f"{where}: a constant coefficient is only allowed on s^0, got term '{t}'"
                 )
@@ -450,12 +453,13 @@ class Structure:
                 raise StructureError(
                     f"{where}: unknown constraint {c!r}; use 'stable', 'passive' or an inequality"
                 )
-            elif c == "stable" and _polynomial_order(self.denominator) is None:
-                raise StructureError(
-                    f"{where}: 'stable' needs a denominator that is a polynomial in s^q for one "
-                    "exponent parameter q (Matignon's theorem)"
-                )
-        _gain_side(self)
+        _ = self.scale_plan  # units of the coefficients: raises for a card that cannot be scaled
+
+
+def _degree(t: Term) -> int:
+    """k of a term c·s^(k q) of a polynomial side (0 for a constant exponent)."""
+    one = t.exponent.single
+    return int(round(one[1])) if one else 0
 
 
 def _polynomial_order(terms) -> str | None:
@@ -463,29 +467,17 @@ def _polynomial_order(terms) -> str | None:
 
     Returns "" for constant-only sides and None if the terms are not a polynomial in s^p.
     """
-    params = {t.exponent.param for t in terms if t.exponent.param}
-    if len(params) > 1:
-        return None
+    params = set()
     for t in terms:
         e = t.exponent
-        if e.param is None and e.multiple != 0:
+        if not e.coefs:
+            if e.constant != 0:
+                return None
+            continue
+        one = e.single
+        if one is None or one[1] < 0 or one[1] != round(one[1]):
             return None
-        if e.param is not None and (e.multiple < 0 or e.multiple != round(e.multiple)):
-            return None
+        params.add(one[0])
+    if len(params) > 1:
+        return None
     return params.pop() if params else ""
-
-
-def _gain_side(s: Structure) -> str:
-    """The side whose coefficients are all free: it absorbs the magnitude scale g_ref."""
-    for side in ("numerator", "denominator"):
-        terms = getattr(s, side)
-        if all(t.is_free and t.coef in s.param_names for t in terms):
-            return side
-    if not s.parameters:
-        return "numerator"
-    # With every coefficient of both sides fixed or constant the gain cannot be scaled.
-    raise StructureError(
-        f"structure '{s.name}': one side of the transfer function must have only free "
-        "coefficients, so that the magnitude of the data can be scaled"
-    )
-

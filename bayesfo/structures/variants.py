@@ -1,9 +1,12 @@
-"""Structures derived from another: the integer-order baseline (q = 1), a structure with some
-parameters fixed, and the inverted (reciprocal) variant."""
+"""Structures derived from another: the integer-order baseline (orders → 1), a structure with
+some parameters fixed, and the inverted (reciprocal) variant; and the test whether an integer
+baseline is a model of its own or a degenerate one."""
 
 from __future__ import annotations
 
 from dataclasses import replace
+
+import numpy as np
 
 from .._io import show
 from ..errors import StructureError
@@ -23,7 +26,7 @@ def integer_variant(s: Structure) -> Structure:
     )
     return replace(
         s, name=f"{s.name}-int", parameters=params, fixed=fixed, constraints=constraints,
-        integer=True, title=f"{s.title} (integer order)",
+        integer=True, title=f"{s.title} (integer order)", aliases=(),
     )
 
 
@@ -58,9 +61,60 @@ def inverted_variant(s: Structure) -> Structure:
     constraints = tuple(
         c for c in s.constraints if not isinstance(c, Inequality) or c.names <= expo
     )
+    # The pictures describe the material of the card, not its reciprocal.
     return replace(
         s, name=f"{s.name}-inv", numerator=s.denominator, denominator=s.numerator,
-        constraints=constraints, inverted=True,
-        title=f"{s.title} (inverted)",
+        constraints=constraints, inverted=True, title=f"{s.title} (inverted)", pictures=(),
+        aliases=(),
     )
 
+
+# ---------------------------------------------------------------------------- degeneracy
+#: Relative singular value below which a direction of the parameter space does not change the
+#: response (central differences are good to ~1e-10 relative).
+RANK_TOL = 1e-6
+
+
+def identifiable_rank(s: Structure) -> int | None:
+    """How many parameter directions change the response: the largest rank of the Jacobian
+    of G(jω)/|G(jω)| (real and imaginary parts, ω from 1e-6 to 1e6) with respect to the free
+    parameters, over a few parameter sets inside the priors. None if it cannot be computed
+    (non-finite responses)."""
+    if s.n_params == 0:
+        return 0
+    w = np.logspace(-6, 6, 121)
+    quantiles = ([0.31, 0.62, 0.44, 0.57, 0.36, 0.71, 0.68], [0.55, 0.3, 0.66, 0.41, 0.72, 0.48,
+                 0.35], [0.67, 0.47, 0.33, 0.7, 0.52, 0.39, 0.6])
+    best = None
+    with np.errstate(all="ignore"):
+        for u in quantiles:
+            theta = np.array([p.prior.ppf(u[i % len(u)]) for i, p in enumerate(s.parameters)],
+                             dtype=float)
+            step = 1e-5 * np.maximum(np.abs(theta), 1e-3)
+            sets = [theta]
+            for i in range(s.n_params):
+                for sign in (1.0, -1.0):
+                    t = theta.copy()
+                    t[i] += sign * step[i]
+                    sets.append(t)
+            g = s.transfer(np.array(sets), w)
+            if not np.all(np.isfinite(g)) or np.any(g[0] == 0):
+                continue
+            d = (g[1::2] - g[2::2]) / (2 * step[:, None]) / g[0]
+            jac = np.concatenate([d.real, d.imag], axis=1) * np.maximum(np.abs(theta), 1e-3)[:, None]
+            if not np.all(np.isfinite(jac)):
+                continue
+            sv = np.linalg.svd(jac, compute_uv=False)
+            rank = int(np.sum(sv > RANK_TOL * sv.max())) if sv.max() > 0 else 0
+            best = rank if best is None else max(best, rank)
+    return best
+
+
+def integer_is_degenerate(base: Structure, integer: Structure) -> bool:
+    """True when fixing the orders to 1 loses more identifiable directions than orders fixed,
+    e.g. two springpots in parallel becoming ``1/(V s + G s)``: the baseline would then be a
+    smaller model with redundant parameters, not a model of its own."""
+    r_base, r_int = identifiable_rank(base), identifiable_rank(integer)
+    if r_base is None or r_int is None:
+        return False
+    return r_int < r_base - (base.n_params - integer.n_params)

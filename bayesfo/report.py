@@ -2,10 +2,11 @@
 
 From top to bottom: a plain-language verdict (which structure wins, by how much, whether the
 information criteria agree, how well the fractional order is determined, what did not
-converge), the data, the ranking table, the priors, the parameter summaries, warnings and
-convergence, and the figures with one-line captions. PNG figures are embedded as base64 data
-URIs and the style sheet is inline, so the file needs nothing else to be read or mailed. All
-text from data, files and results is escaped.
+converge; the winner's physical parameters), the data, the ranking table, the priors, the
+parameter summaries with units (the physical form and the card's coefficients, the form
+natural to the data first), warnings and convergence, and the figures with one-line captions.
+PNG figures are embedded as base64 data URIs and the style sheet is inline, so the file needs
+nothing else to be read or mailed. All text from data, files and results is escaped.
 
 This module does not draw: it takes the figure files written by
 :func:`bayesfo.plotting.write_figures`, so it needs no plotting library.
@@ -237,6 +238,7 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     elif result.structure.integer:
         out.append((f"{name} is an integer-order structure (its exponents are fixed at 1).",
                     False))
+    out.extend(_physical_sentence(name, result, skip=p))
     out.extend(_noise_sentences(name, result))
     poor = [r["structure"] for r in rows[1:]
             if (o := _order(comparison[r["structure"]]))[1] is not None and o[1].poorly_determined]
@@ -269,6 +271,26 @@ def verdict(comparison) -> list[tuple[str, bool]]:
         out.append(("Could not be run: " + "; ".join(f"{r.name} ({r.error})" for r in failed)
                     + ".", True))
     return out
+
+
+def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
+    """The winner's physical parameters: posterior median and 94 % HDI with units."""
+    phys = getattr(result, "physical", None)
+    if not phys or phys["picture"] is None:
+        return []
+    parts = []
+    for p, s in phys["physical"].items():
+        if p == skip or not _finite(s.get("median")):
+            continue
+        unit = f" {s['unit']}" if s["unit"] else ""
+        hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"
+               if _finite(s.get("hdi_low")) and _finite(s.get("hdi_high")) else "")
+        parts.append(f"{p} = {s['median']:.3g}{unit}{hdi}")
+    if not parts:
+        return []
+    picture = "" if phys["picture"] == name else f" ({phys['picture']})"
+    return [(f"In physical parameters{picture}, {name} has {_join(parts)} "
+             f"(posterior medians, {HDI_PERCENT} % HDI in brackets).", False)]
 
 
 def _join(items) -> str:
@@ -446,22 +468,68 @@ def _parameters_section(comparison) -> str:
     parts = []
     for name in comparison.ranking:
         r = comparison[name]
+        units = getattr(r, "units", {}) or {}
         rows = []
         for p, s in r.posterior.summary.items():
             flags = [f for f, on in (("poorly determined", s.poorly_determined),
                                      ("multimodal", s.multimodal)) if on]
             rows.append(
-                f"<tr>{_text_cell(p)}{_cell(s.mean, '.4g')}{_cell(s.sd, '.3g')}"
+                f"<tr>{_text_cell(p)}{_text_cell(units.get(p, ''))}{_cell(s.mean, '.4g')}"
+                f"{_cell(s.sd, '.3g')}"
                 f"{_cell(s.hdi_low, '.4g')}{_cell(s.hdi_high, '.4g')}{_cell(s.median, '.4g')}"
                 f"{_cell(s.map, '.4g')}"
                 f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
-        parts.append(f"<h3>{_e(name)}</h3><table><tr><th class='text'>parameter</th>"
-                     f"<th>mean</th><th>sd</th><th>HDI low</th><th>HDI high</th><th>median</th>"
-                     f"<th>MAP</th><th class='text'>flags</th></tr>{''.join(rows)}</table>")
-    return (f"<p class='small'>Posterior summaries in physical units; HDI: {HDI_PERCENT} % "
-            "highest-density interval; MAP: the draw of highest posterior density. "
-            "'Poorly determined': the HDI covers more than half of the prior range.</p>"
-            + "".join(parts))
+        sampled = (f"<table>{_PARAMETER_HEAD}<th class='text'>flags</th></tr>{''.join(rows)}"
+                   "</table>")
+        phys = getattr(r, "physical", None)
+        if phys is None or phys["picture"] is None:
+            parts.append(f"<h3>{_e(name)}</h3>{sampled}")
+            continue
+        physical = _physical_table(phys["physical"])
+        picture = _picture_text(r.structure, phys["picture"])
+        if phys["natural_form"] == "physical":
+            parts.append(f"<h3>{_e(name)}</h3><p class='small'>Physical parameters ({picture}):"
+                         f"</p>{physical}<p class='small'>As sampled: the card's coefficients "
+                         f"(compliance {_e(r.structure.formula)}) and the noise:</p>{sampled}")
+        else:
+            parts.append(f"<h3>{_e(name)}</h3><p class='small'>As sampled: the card's "
+                         f"coefficients (compliance {_e(r.structure.formula)}) and the noise:"
+                         f"</p>{sampled}<p class='small'>Physical parameters ({picture}):</p>"
+                         f"{physical}")
+    return (f"<p class='small'>Posterior summaries in physical units, the units derived from "
+            f"the data's; HDI: {HDI_PERCENT} % highest-density interval; MAP: the draw of "
+            "highest posterior density (for a physical parameter, its value at that draw). "
+            "'Poorly determined': the HDI covers more than half of the prior range. Each "
+            "structure's parameters are given in the form natural to the data first (modulus "
+            "data: moduli G [stress], quasi-properties c [stress·s^order], orders and times "
+            "τ [s]; compliance data: the card's coefficients a, b and orders), then in the "
+            "other form.</p>" + "".join(parts))
+
+
+_PARAMETER_HEAD = ("<tr><th class='text'>parameter</th><th class='text'>unit</th><th>mean</th>"
+                   "<th>sd</th><th>HDI low</th><th>HDI high</th><th>median</th><th>MAP</th>")
+
+
+def _physical_table(block: dict) -> str:
+    rows = "".join(
+        f"<tr>{_text_cell(p)}{_text_cell(s['unit'])}{_cell(s['mean'], '.4g')}"
+        f"{_cell(s['sd'], '.3g')}{_cell(s['hdi_low'], '.4g')}{_cell(s['hdi_high'], '.4g')}"
+        f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}</tr>"
+        for p, s in block.items())
+    return f"<table>{_PARAMETER_HEAD}</tr>{rows}</table>"
+
+
+def _picture_text(structure, picture: str) -> str:
+    """The picture's name, title and mechanical network, escaped."""
+    from .structures import picture_of
+
+    pic = picture_of(structure, picture)
+    text = pic.name + (f", {pic.title}" if pic.title else "")
+    if pic.network is not None:
+        text += f"; network {pic.network.text}"
+    if structure.fixed:
+        text += " with " + ", ".join(f"{k} = {float(v):g}" for k, v in structure.fixed.items())
+    return _e(text)
 
 
 def _diagnostics_section(comparison) -> str:

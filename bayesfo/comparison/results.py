@@ -3,15 +3,123 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
 from ..data import FrequencyResponse
+from ..errors import StructureError
 from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
-from ..structures import Structure
+from ..inference.results import HDI_PROB
+from ..structures import Structure, coefficient_units, parameter_forms, picture_of
+
+#: Noise parameters sampled with a structure: ``sigma`` has the data's unit, ``sigma_rel`` none.
+NOISE_UNITS = {"sigma": "data", "sigma_rel": ""}
+
+
+def parameter_units(structure, names, kind: str, units: str = "") -> dict[str, str]:
+    """The unit of each sampled parameter: the card's coefficients from the data's ``kind``
+    and ``units`` (:func:`~bayesfo.structures.coefficient_units`; ``""`` for orders), ``sigma``
+    in the data's unit and ``sigma_rel`` without one.
+
+    Examples
+    --------
+    >>> from bayesfo.structures import get_structure
+    >>> parameter_units(get_structure("voigt"), ("a1", "b0", "q", "sigma"), "modulus", "Pa")
+    {'a1': 's^q', 'b0': '1/Pa', 'q': '', 'sigma': 'Pa'}
+    """
+    own = coefficient_units(structure, kind, units)
+    out = {}
+    for n in names:
+        if n in own:
+            out[n] = own[n]
+        elif n in NOISE_UNITS:
+            out[n] = (units or "") if NOISE_UNITS[n] == "data" else NOISE_UNITS[n]
+        else:
+            out[n] = ""
+    return out
+
+
+def summarise_draws(values, map_value, unit: str) -> dict:
+    """``{unit, mean, sd, hdi_low, hdi_high, median, map}`` of the draws of one quantity, as
+    the posterior summarises its parameters (94 % HDI by arviz). A draw at ±inf (an order at
+    its bound makes a time overflow) leaves mean and sd undefined (NaN, null in JSON); the HDI
+    and the median are those of all draws."""
+    from ..inference._arviz import arviz
+
+    x = np.asarray(values, dtype=float).ravel()
+    x = x[~np.isnan(x)]
+    out = {"unit": unit}
+    if x.size < 2:
+        return out | dict.fromkeys(("mean", "sd", "hdi_low", "hdi_high", "median"), math.nan) \
+            | {"map": float(map_value)}
+    finite = bool(np.all(np.isfinite(x)))
+    lo, hi = arviz().hdi(x, hdi_prob=HDI_PROB)
+    return out | {"mean": float(x.mean()) if finite else math.nan,
+                  "sd": float(x.std(ddof=1)) if finite else math.nan,
+                  "hdi_low": float(lo), "hdi_high": float(hi), "median": float(np.median(x)),
+                  "map": float(map_value)}
+
+
+def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: str = "") -> dict:
+    """The parameters of ``structure`` in both forms, summarised, with units.
+
+    Parameters
+    ----------
+    structure : Structure
+    draws : dict
+        ``{name: draws}`` of the structure's free parameters in physical (unscaled) units, as
+        ``PosteriorResult.samples`` holds them.
+    map_values : dict
+        ``{name: value}`` of the draw of highest posterior density.
+    kind, units : str
+        The data's kind and unit.
+
+    Returns
+    -------
+    dict
+        ``natural_form``: ``"physical"`` for modulus data, ``"coefficients"`` for compliance
+        and generic data and for structures without a picture; ``picture``: the name of the structure's default picture (None for
+        structures without one: inverted variants, the max-order family); ``physical``:
+        ``{name: summary}`` of the physical parameters (moduli, quasi-properties, orders, derived
+        times; the card's coefficients for a structure without a picture); ``other``: the form
+        not natural to the data (the card's coefficients for modulus data, the physical
+        parameters otherwise; None for a structure without a picture); ``coefficient_units``.
+        Each summary is that of :func:`summarise_draws`.
+    """
+    natural, other = parameter_forms(structure, draws, kind, units)
+    at_map = parameter_forms(structure, map_values, kind, units)
+    modulus = kind == "modulus"
+    physical, coefficients = (natural, other) if modulus else (other, natural)
+    map_physical, map_coefficients = (at_map if modulus else at_map[::-1])
+
+    def block(form, at):
+        return {n: summarise_draws(v, at[n][0], u) for n, (v, u) in form.items()}
+
+    has_picture = bool(structure.pictures)
+    phys = block(physical, map_physical) if has_picture else block(coefficients, map_coefficients)
+    coefs = block(coefficients, map_coefficients)
+    return {"natural_form": "physical" if modulus and has_picture else "coefficients",
+            "picture": picture_of(structure).name if has_picture else None,
+            "physical": phys,
+            "other": None if not has_picture else (coefs if modulus else phys),
+            "coefficient_units": {n: u for n, (_, u) in coefficients.items()}}
+
+
+def physical_text(block: dict, key: str = "median") -> str:
+    """``"G_e=1.2e+05 Pa; c_q=3.4e+04 Pa s^q; q=0.57"``: one value of each parameter of a block
+    of :func:`physical_forms` (undefined values are left out)."""
+    parts = []
+    for name, s in (block or {}).items():
+        v = s.get(key)
+        if v is None or not math.isfinite(v):
+            continue
+        parts.append(f"{name}={v:.4g}" + (f" {s['unit']}" if s.get("unit") else ""))
+    return "; ".join(parts)
 
 
 @dataclass(frozen=True, eq=False)
@@ -26,10 +134,44 @@ class StructureResult:
     posterior: PosteriorResult | None = None
     criteria: dict = field(default_factory=dict)
     error: str | None = None
+    #: The kind and unit of the data the structure was run on (set by :class:`Comparison`);
+    #: they give the parameters their units.
+    data_kind: str | None = None
+    data_units: str = ""
 
     @property
     def name(self) -> str:
         return self.structure.name
+
+    @property
+    def units(self) -> dict[str, str]:
+        """``{parameter: unit}`` of the sampled parameters (:func:`parameter_units`); empty
+        when the data's kind is not known."""
+        if self.data_kind is None:
+            return {}
+        names = self.posterior.param_names if self.posterior is not None \
+            else self.structure.param_names
+        try:
+            return parameter_units(self.structure, names, self.data_kind, self.data_units)
+        except StructureError:
+            return {}
+
+    @cached_property
+    def physical(self) -> dict | None:
+        """The posterior's parameters in both forms with units (:func:`physical_forms`), or
+        None without a posterior, without the data's kind, or when the structure's units
+        cannot be derived."""
+        post = self.posterior
+        if post is None or self.data_kind is None:
+            return None
+        names = self.structure.param_names
+        idx = {n: post.param_names.index(n) for n in names}
+        draws = {n: post.samples[:, i] for n, i in idx.items()}
+        at_map = {n: np.asarray(post.map_theta[i], dtype=float) for n, i in idx.items()}
+        try:
+            return physical_forms(self.structure, draws, at_map, self.data_kind, self.data_units)
+        except StructureError:
+            return None
 
     @property
     def adequacy(self):
@@ -58,8 +200,19 @@ class StructureResult:
         post = self.posterior
         ev = self.criteria.get("evidence")
         check = self.criteria.get("evidence_check")
+        units = self.units
+        phys = self.physical
         out.update(
-            parameters={k: v.to_dict() for k, v in post.summary.items()},
+            # Each parameter as sampled (the card's coefficients and the noise), with its unit
+            # when the data's kind is known.
+            parameters={k: v.to_dict() | ({"unit": units[k]} if k in units else {})
+                        for k, v in post.summary.items()},
+            # Both forms with units (:func:`physical_forms`): which one is natural to the
+            # data's kind, the physical parameters and the form that is not natural.
+            natural_form=None if phys is None else phys["natural_form"],
+            picture=None if phys is None else phys["picture"],
+            parameters_physical=None if phys is None else phys["physical"],
+            parameters_other_form=None if phys is None else phys["other"],
             priors=self.criteria["priors"],
             noise=post.noise, noise_reason=post.noise_reason,
             # Under noise="auto" without σ: each candidate noise model's ln Z, probability and
@@ -128,6 +281,15 @@ class Comparison:
     seed: int
     ranked_by: str = "log_evidence"
     holdout: FrequencyResponse | None = None
+
+    def __post_init__(self):
+        # Each result learns the kind and unit of the data, which give its parameters units.
+        results = tuple(
+            dataclasses.replace(r, data_kind=self.data.kind, data_units=self.data.units or "")
+            if isinstance(r, StructureResult) and (r.data_kind, r.data_units)
+            != (self.data.kind, self.data.units or "") else r
+            for r in self.results)
+        object.__setattr__(self, "results", results)
 
     @property
     def data_warnings(self) -> list[str]:
@@ -202,6 +364,9 @@ class Comparison:
                 "max_log10_magnitude_error": None if r.adequacy is None
                 else r.adequacy.max_log10_magnitude_error,
                 "error": "",
+                # Posterior medians of the physical parameters, with units, as one text cell.
+                "physical_parameters": "" if r.physical is None
+                else physical_text(r.physical["physical"]),
             })
         return rows
 
@@ -303,5 +468,5 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "holdout_lpd", "holdout_rmse", "q_mean",
                   "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
                   "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
-                  "max_log10_magnitude_error", "error")
+                  "max_log10_magnitude_error", "error", "physical_parameters")
 

@@ -308,7 +308,7 @@ def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kep
     idata = az.from_dict(**groups, coords={"omega": omega}, dims=dims)
     idata.posterior.attrs.update(
         structure=lik.structure.name, noise=lik.noise, kind=lik.data.kind,
-        omega_units="rad/s", data=lik.data.label,
+        units=lik.data.units or "", omega_units="rad/s", data=lik.data.label,
     )
     return idata
 

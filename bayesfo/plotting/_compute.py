@@ -186,15 +186,55 @@ def sampling_coordinates(result):
     -------
     values : ndarray, shape (n_draws, ndim)
     labels : list of str
-        Mathtext labels (``log$_{10}$ a1`` for log coordinates).
+        Mathtext labels with the unit of each parameter where it has one
+        (``log$_{10}$ $b_{0}$ [1/Pa]`` for log coordinates, :func:`result_units`).
     is_log : ndarray of bool
     """
     post = result.posterior
     priors = result.criteria.get("priors", {})
     is_log = np.array([priors.get(n, {}).get("prior") == "log-uniform" for n in post.param_names])
     values = to_coordinates(post.samples, is_log)
-    labels = [_label(n, log) for n, log in zip(post.param_names, is_log)]
+    units = result_units(result)
+    labels = [_label(n, log, units.get(n, "")) for n, log in zip(post.param_names, is_log)]
     return values, labels, is_log
+
+
+def result_units(result) -> dict[str, str]:
+    """``{parameter: unit}`` of a result's sampled parameters, from the kind and unit of the
+    data it was run on (:attr:`bayesfo.comparison.StructureResult.units`); empty when the
+    result does not know them."""
+    units = getattr(result, "units", None)
+    return dict(units) if isinstance(units, dict) else {}
+
+
+GREEK_ORDERS = ("alpha", "beta", "gamma", "delta", "kappa", "nu", "eta", "tau", "sigma")
+
+
+def unit_mathtext(unit: str) -> str:
+    """A unit as mathtext: exponents raised, orders in Greek (``Pa s^q`` → ``Pa s$^{q}$``,
+    ``s^(beta-alpha)`` → ``s$^{\\beta-\\alpha}$``); a ``$`` of the unit itself is escaped.
+
+    Examples
+    --------
+    >>> unit_mathtext("s^q/Pa")
+    's$^{q}$/Pa'
+    """
+    import re
+
+    text = str(unit).replace("$", r"\$")
+
+    def power(match):
+        expo = (match.group(1) or match.group(2)).replace("*", "")
+        expo = re.sub(r"[A-Za-z_]+", lambda m: "\\" + m.group(0) if m.group(0) in GREEK_ORDERS
+                      else m.group(0), expo)
+        return f"$^{{{expo}}}$"
+
+    return re.sub(r"\^(?:\(([^()]*)\)|([A-Za-z0-9_.+-]+))", power, text)
+
+
+def unit_suffix(unit: str) -> str:
+    """`` [unit]`` in mathtext, or nothing for a parameter without a unit."""
+    return f" [{unit_mathtext(unit)}]" if unit else ""
 
 
 def to_coordinates(theta, is_log) -> np.ndarray:
@@ -223,21 +263,27 @@ def scaled_label(label: str, exponent: int) -> str:
     return label if exponent == 0 else f"{label} (×10$^{{{exponent}}}$)"
 
 
-GREEK = {"alpha": r"\alpha", "beta": r"\beta", "sigma": r"\sigma", "sigma_rel": r"\sigma_{rel}"}
+GREEK = {"alpha": r"\alpha", "beta": r"\beta", "sigma": r"\sigma", "sigma_rel": r"\sigma_{rel}",
+         "gamma": r"\gamma", "delta": r"\delta", "kappa": r"\kappa", "eta": r"\eta",
+         "tau": r"\tau", "nu": r"\nu"}
 
 
 def param_symbol(name: str) -> str:
-    """Mathtext of a parameter name: ``a1`` → ``$a_{1}$``, ``beta`` → ``$\\beta$``."""
+    """Mathtext of a parameter name: ``a1`` → ``$a_{1}$``, ``beta`` → ``$\\beta$``,
+    ``c_alpha`` → ``$c_{\\alpha}$``, ``G_e`` → ``$G_{e}$``."""
     if name in GREEK:
         return f"${GREEK[name]}$"
+    head, _, sub = name.partition("_")
+    if sub and head:
+        return f"${GREEK.get(head, head)}_{{{GREEK.get(sub, sub)}}}$"
     head = name.rstrip("0123456789")
     tail = name[len(head):]
     return f"${head}_{{{tail}}}$" if tail and head else f"${name}$"
 
 
-def _label(name: str, log: bool) -> str:
+def _label(name: str, log: bool, unit: str = "") -> str:
     sym = param_symbol(name)
-    return f"log$_{{10}}$ {sym}" if log else sym
+    return (f"log$_{{10}}$ {sym}" if log else sym) + unit_suffix(unit)
 
 
 def loo_differences(results) -> dict[str, tuple[float, float]]:

@@ -44,7 +44,9 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
     Parameters are shown in the coordinates of the summaries' flags: log10 of parameters with
     a log-uniform prior (axis labels say so), the parameter itself otherwise, divided by a
     power of ten when its values are very small or large (the label gives the factor); noise
-    parameters sampled with the structure are included. Contours enclose 50 % and 90 % of the
+    parameters sampled with the structure are included. Each label carries the parameter's
+    unit, derived from the data's units (``log10 b0 [1/Pa]``, ``a1 [s^q]``; orders have none)
+    when the result knows them (:attr:`~bayesfo.comparison.StructureResult.units`). Contours enclose 50 % and 90 % of the
     draws. However many parameters, the axis labels clear the tick labels and every label stays
     inside the figure: they are placed, and the margins set, from the drawn tick labels.
 
@@ -282,7 +284,7 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
 
     Uses the stored InferenceData (``posterior.idata``: chain = walker), i.e. the draws kept
     after burn-in and thinning. Parameters with a log-uniform prior are drawn as log10, as in
-    :func:`plot_corner`.
+    :func:`plot_corner`, and labelled with their units as there.
 
     Parameters
     ----------

@@ -1,0 +1,316 @@
+"""Physical parameters and units in every output: summary.json, ranking.csv, the report, corner
+and trace labels and ``bayesfo identify``.
+
+The known answers are the closed forms of the fractional Zener solid (spring G_e parallel to a
+spring G_m in series with a springpot c_q, q), whose compliance the card writes as
+(b0 + b1 s^q) / (1 + a1 s^q):
+
+    G_e = 1/b0,  G_m = (a1 b0 - b1) / (b0 b1),  c_q = (a1 b0 - b1) / b0²,  τ = (b1/b0)^(1/q),
+
+and of the fractional Kelvin-Voigt b0 / (1 + a1 s^q): G_e = 1/b0, c_q = a1/b0.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import warnings
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import bayesfo as bf  # noqa: E402
+from bayesfo.comparison import RANKING_FIELDS  # noqa: E402
+from bayesfo.comparison.results import (  # noqa: E402
+    parameter_units,
+    physical_forms,
+    physical_text,
+)
+from bayesfo.data import FrequencyResponse  # noqa: E402
+from bayesfo.plotting import plot_corner, plot_trace  # noqa: E402
+from bayesfo.plotting._compute import param_symbol, unit_mathtext  # noqa: E402
+from bayesfo.report import render_report, verdict  # noqa: E402
+from bayesfo.structures import get_structure  # noqa: E402
+
+W = np.logspace(-2, 3, 30)
+#: a1 [s^q], b0 [1/MPa], b1 [s^q/MPa], q: G_e = 1e5 MPa, G_m = 9e5 MPa, c_q = 1.8e5 MPa s^q,
+#: τ = 0.04 s.
+ZENER = (2.0, 1e-5, 2e-6, 0.5)
+
+
+def zener_by_hand(a1, b0, b1, q):
+    """The physical parameters of the fractional Zener solid from its compliance coefficients."""
+    return {"G_e": 1 / b0, "G_m": (a1 * b0 - b1) / (b0 * b1), "c_q": (a1 * b0 - b1) / b0**2,
+            "q": q, "tau": (b1 / b0) ** (1 / q)}
+
+
+# Columns of ranking.csv before the physical parameters were added: none may move or go.
+OLD_RANKING_FIELDS = (
+    "rank", "structure", "parent", "n_params", "log_evidence", "log_evidence_err",
+    "evidence_method", "delta_log_evidence", "bayes_factor", "posterior_probability",
+    "evidence_agree", "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic",
+    "rank_aic", "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",
+    "holdout_lpd", "holdout_rmse", "q_mean", "q_sd", "pareto_k_max", "rhat_max", "ess_min",
+    "converged", "sampler", "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
+    "max_log10_magnitude_error", "error")
+
+
+def _noisy(g, rel_sd, seed):
+    rng = np.random.default_rng(seed)
+    sd = rel_sd * np.abs(g)
+    return g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size)), sd
+
+
+@pytest.fixture(scope="module")
+def zener_run(tmp_path_factory):
+    """A fractional Zener modulus in MPa, 1 % noise with σ known, run through compare."""
+    g = get_structure("zener").response(np.array([ZENER]), W, "modulus")[0]
+    noisy, sd = _noisy(g, 0.01, 1)
+    data = FrequencyResponse(W, noisy, sd, kind="modulus", units="MPa", name="zener sim")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
+        result = bf.compare(data, "zener", seed=0, workers=1, progress=False)
+    out = tmp_path_factory.mktemp("zener")
+    bf.write_outputs(result, out, figures=False)
+    return result, out
+
+
+@pytest.fixture(scope="module")
+def voigt_compliance(tmp_path_factory):
+    """A fractional Kelvin-Voigt compliance in 1/Pa (G_e = 1000 Pa, c_q = 1000 Pa s^0.5)."""
+    g = get_structure("voigt").response([1.0, 1e-3, 0.5], np.logspace(-1, 2.5, 20), "compliance")
+    noisy, sd = _noisy(g, 0.03, 3)
+    data = FrequencyResponse(np.logspace(-1, 2.5, 20), noisy, sd, kind="compliance",
+                             units="1/Pa", name="voigt sim")
+    result = bf.compare(data, "voigt", seed=2, workers=1, progress=False)
+    out = tmp_path_factory.mktemp("voigt")
+    bf.write_outputs(result, out, figures=False)
+    return result, out
+
+
+def test_summary_reports_the_physical_parameters_of_a_zener_modulus(zener_run):
+    result, out = zener_run
+    (s,) = json.loads((out / "summary.json").read_text())["structures"]
+    assert (s["natural_form"], s["picture"]) == ("physical", "fractional_zener_ss")
+    phys = s["parameters_physical"]
+    assert list(phys) == ["G_e", "G_m", "c_q", "q", "tau"]
+    assert {n: p["unit"] for n, p in phys.items()} == {
+        "G_e": "MPa", "G_m": "MPa", "c_q": "MPa s^q", "q": "", "tau": "s"}
+    truth = zener_by_hand(*ZENER)
+    post = result["zener"].posterior
+    draws = dict(zip(post.param_names, post.samples.T))
+    by_hand = zener_by_hand(draws["a1"], draws["b0"], draws["b1"], draws["q"])
+    at_map = zener_by_hand(*post.map_theta)
+    for name, p in phys.items():
+        # The summary is that of the closed form applied to each draw ...
+        assert p["mean"] == pytest.approx(np.mean(by_hand[name]), rel=1e-12)
+        assert p["sd"] == pytest.approx(np.std(by_hand[name], ddof=1), rel=1e-9)
+        assert p["median"] == pytest.approx(np.median(by_hand[name]), rel=1e-12)
+        assert p["map"] == pytest.approx(at_map[name], rel=1e-12)
+        assert p["hdi_low"] < p["median"] < p["hdi_high"]
+        # ... and the posterior recovers the true material within its spread.
+        assert abs(p["mean"] - truth[name]) < 4 * p["sd"] + 1e-3 * truth[name], name
+        assert p["mean"] == pytest.approx(truth[name], rel=0.03), name
+
+
+def test_the_parameters_block_is_unchanged_and_gains_units(zener_run):
+    result, out = zener_run
+    (s,) = json.loads((out / "summary.json").read_text())["structures"]
+    post = result["zener"].posterior
+    units = {"a1": "s^q", "b0": "1/MPa", "b1": "s^q/MPa", "q": ""}
+    for name, summary in post.summary.items():
+        assert s["parameters"][name] == summary.to_dict() | {"unit": units[name]}
+    # For modulus data the other form is the card's compliance coefficients, the same numbers.
+    other = s["parameters_other_form"]
+    assert list(other) == ["a1", "b0", "b1", "q"]
+    for name, p in other.items():
+        assert p["unit"] == units[name]
+        for key in ("mean", "sd", "hdi_low", "hdi_high", "median", "map"):
+            assert p[key] == pytest.approx(s["parameters"][name][key], rel=1e-12)
+
+
+def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_run):
+    result, out = zener_run
+    assert RANKING_FIELDS[: len(OLD_RANKING_FIELDS)] == OLD_RANKING_FIELDS
+    assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == ("physical_parameters",)
+    with (out / "ranking.csv").open(newline="") as fh:
+        (row,) = list(csv.DictReader(fh))
+    text = row["physical_parameters"]
+    parts = dict(p.split("=") for p in text.split("; "))
+    assert list(parts) == ["G_e", "G_m", "c_q", "q", "tau"]
+    assert parts["G_e"].endswith(" MPa") and parts["c_q"].endswith(" MPa s^q")
+    assert parts["tau"].endswith(" s") and " " not in parts["q"]
+    phys = result["zener"].physical["physical"]
+    for name, value in parts.items():
+        assert float(value.split()[0]) == pytest.approx(phys[name]["median"], rel=1e-3)
+    assert "," not in text  # one cell, readable without quoting
+
+
+def test_units_follow_the_data_units():
+    z = get_structure("zener")
+    names = ("a1", "b0", "b1", "q", "sigma")
+    assert parameter_units(z, names, "modulus", "Pa") == {
+        "a1": "s^q", "b0": "1/Pa", "b1": "s^q/Pa", "q": "", "sigma": "Pa"}
+    assert parameter_units(z, names, "modulus", "MPa")["b0"] == "1/MPa"
+    # Compliance data in 1/Pa: the coefficients keep their compliance units, σ is in 1/Pa.
+    assert parameter_units(z, names, "compliance", "1/Pa") == {
+        "a1": "s^q", "b0": "1/Pa", "b1": "s^q/Pa", "q": "", "sigma": "1/Pa"}
+    assert parameter_units(z, ("a1", "b0", "q", "sigma_rel"), "modulus", "Pa")["sigma_rel"] == ""
+    # Known coefficients through the summariser: every draw equal gives the value itself.
+    coef = dict(zip(("a1", "b0", "b1", "q"), ZENER))
+    draws = {k: np.full(50, v) for k, v in coef.items()}
+    forms = physical_forms(z, draws, coef, "modulus", "Pa")
+    truth = zener_by_hand(*ZENER)
+    for name, p in forms["physical"].items():
+        assert p["mean"] == pytest.approx(truth[name], rel=1e-12) and p["sd"] == 0.0
+        assert p["map"] == pytest.approx(truth[name], rel=1e-12)
+    assert forms["physical"]["G_m"]["unit"] == "Pa" and forms["physical"]["c_q"]["unit"] == "Pa s^q"
+    assert physical_text(forms["physical"]) == ("G_e=1e+05 Pa; G_m=9e+05 Pa; c_q=1.8e+05 Pa s^q; "
+                                                "q=0.5; tau=0.04 s")
+    # The fractional Maxwell model: c_delta has the unit of its own order beta - alpha.
+    m = get_structure("maxwell")
+    mcoef = {"a1": 3.0, "b1": 0.5, "alpha": 0.2, "beta": 0.7}
+    mforms = physical_forms(m, {k: np.full(4, v) for k, v in mcoef.items()}, mcoef, "modulus",
+                            "kPa")
+    assert mforms["physical"]["c_beta"]["unit"] == "kPa s^beta"
+    assert mforms["physical"]["c_delta"]["unit"] == "kPa s^(beta-alpha)"
+    assert mforms["physical"]["c_delta"]["mean"] == pytest.approx(3.0 / 0.5)  # c_δ = a1/b1
+
+
+def test_inverted_and_max_order_structures_report_their_own_coefficients():
+    for name in ("voigt-inv", "max-n2m1"):
+        s = get_structure(name)
+        coef = {n: 0.5 for n in s.param_names}
+        forms = physical_forms(s, {k: np.full(5, v) for k, v in coef.items()}, coef, "modulus",
+                               "Pa")
+        assert forms["picture"] is None and forms["other"] is None
+        assert forms["natural_form"] == "coefficients"
+        assert list(forms["physical"]) == list(s.param_names)
+    inv = physical_forms(get_structure("voigt-inv"), {"a1": [1.0, 1.0], "b0": [2.0, 2.0],
+                                                      "q": [0.5, 0.5]},
+                         {"a1": 1.0, "b0": 2.0, "q": 0.5}, "modulus", "Pa")
+    assert inv["physical"]["b0"]["unit"] == "Pa" and inv["physical"]["a1"]["unit"] == "s^q"
+
+
+def test_compliance_data_report_stress_in_pa(voigt_compliance):
+    result, out = voigt_compliance
+    (s,) = json.loads((out / "summary.json").read_text())["structures"]
+    assert s["natural_form"] == "coefficients" and s["picture"] == "voigt"
+    assert s["parameters"]["b0"]["unit"] == "1/Pa" and s["parameters"]["a1"]["unit"] == "s^q"
+    phys = s["parameters_physical"]
+    assert s["parameters_other_form"] == phys  # the other form of compliance data
+    assert (phys["G_e"]["unit"], phys["c_q"]["unit"], phys["tau"]["unit"]) == ("Pa", "Pa s^q",
+                                                                               "s")
+    # G_e = 1/b0 = 1000 Pa and c_q = a1/b0 = 1000 Pa s^0.5, τ = a1^(1/q) = 1 s.
+    for name, truth in (("G_e", 1000.0), ("c_q", 1000.0), ("tau", 1.0)):
+        assert abs(phys[name]["mean"] - truth) < 4 * phys[name]["sd"], name
+    post = result["voigt"].posterior
+    i = post.param_names.index("b0")
+    assert phys["G_e"]["mean"] == pytest.approx(np.mean(1 / post.samples[:, i]), rel=1e-12)
+
+
+def test_units_change_with_the_data_units_of_a_result(zener_run):
+    result, _ = zener_run
+    r = result["zener"]
+    assert r.units == {"a1": "s^q", "b0": "1/MPa", "b1": "s^q/MPa", "q": ""}
+    as_pa = dataclasses.replace(r, data_units="Pa")
+    assert as_pa.units["b0"] == "1/Pa" and as_pa.physical["physical"]["G_e"]["unit"] == "Pa"
+    unknown = dataclasses.replace(r, data_kind=None)
+    assert unknown.units == {} and unknown.physical is None
+    # Without the data's units the stress unit is named by its dimension.
+    bare = dataclasses.replace(r, data_units="")
+    assert bare.units["b0"] == "1/[G]" and bare.physical["physical"]["c_q"]["unit"] == "[G] s^q"
+
+
+def test_corner_and_trace_labels_carry_units(zener_run):
+    result, _ = zener_run
+    r = result["zener"]
+    drawn = plot_corner(r)
+    ndim = len(r.posterior.param_names)
+    labels = [drawn.axes[ndim * (ndim - 1) + j].get_xlabel() for j in range(ndim)]
+    plt.close(drawn.figure)
+    assert labels[0].startswith("log$_{10}$ $a_{1}$ [s$^{q}$]")
+    assert labels[1].startswith("log$_{10}$ $b_{0}$ [1/MPa]")
+    assert labels[2].startswith("log$_{10}$ $b_{1}$ [s$^{q}$/MPa]")
+    assert labels[3] == "$q$"  # an order has no unit
+    drawn = plot_trace(r)
+    texts = [ax.get_xlabel() + ax.get_ylabel() for ax in drawn.axes]
+    plt.close(drawn.figure)
+    assert any("[1/MPa]" in t for t in texts) and any("[s$^{q}$/MPa]" in t for t in texts)
+
+
+def test_unit_and_symbol_mathtext():
+    assert unit_mathtext("Pa s^q") == "Pa s$^{q}$"
+    assert unit_mathtext("s^(beta-alpha)") == r"s$^{\beta-\alpha}$"
+    assert unit_mathtext("s^(2*q)") == "s$^{2q}$"
+    assert unit_mathtext("1/(µm/N)") == "1/(µm/N)"
+    assert param_symbol("c_alpha") == r"$c_{\alpha}$" and param_symbol("G_e") == "$G_{e}$"
+    assert param_symbol("b0") == "$b_{0}$" and param_symbol("sigma_rel") == r"$\sigma_{rel}$"
+    # Every label parses as mathtext.
+    from matplotlib.mathtext import MathTextParser
+
+    parser = MathTextParser("path")
+    for text in ("log$_{10}$ $b_{1}$ [s$^{q}$/Pa]", r"$c_{\delta}$ [Pa s$^{\beta-\alpha}$]"):
+        parser.parse(text)
+
+
+def test_report_shows_units_and_the_physical_form(zener_run):
+    result, _ = zener_run
+    text = render_report(result)
+    assert "<th class='text'>unit</th>" in text
+    assert "Physical parameters (fractional_zener_ss" in text
+    phys = result["zener"].physical["physical"]
+    g_e = phys["G_e"]
+    assert (f"<td class=\"text\">G_e</td><td class=\"text\">MPa</td>"
+            f"<td data-value=\"{g_e['mean']!r}\">{g_e['mean']:.4g}</td>") in text
+    assert "<td class=\"text\">b0</td><td class=\"text\">1/MPa</td>" in text
+    # The physical form comes first for modulus data.
+    section = text[text.index("<h2 id='parameters'>"):]
+    assert section.index("<td class=\"text\">G_e</td>") < section.index("<td class=\"text\">b0</td>")
+    sentence = next(t for t, _ in verdict(result) if t.startswith("In physical parameters"))
+    assert f"G_e = {g_e['median']:.3g} MPa" in sentence and "tau = " in sentence
+
+
+def _modulus_csv(tmp_path):
+    g = get_structure("zener").response(np.array([ZENER]), W, "modulus")[0]
+    noisy, _ = _noisy(g, 0.002, 5)
+    return FrequencyResponse(W, noisy, kind="modulus", units="Pa").to_csv(tmp_path / "z.csv")
+
+
+def test_identify_prints_units_and_the_physical_form(run_cli, tmp_path):
+    path = _modulus_csv(tmp_path)
+    status, out, err = run_cli("identify", path, "--structure", "zener", "--json")
+    assert status == 0, err
+    res = json.loads(out)
+    assert res["units"] == {"a1": "s^q", "b0": "1/Pa", "b1": "s^q/Pa", "q": ""}
+    assert (res["natural_form"], res["picture"]) == ("physical", "fractional_zener_ss")
+    phys = res["parameters_physical"]
+    p = res["parameters"]
+    by_hand = zener_by_hand(p["a1"], p["b0"], p["b1"], p["q"])
+    for name, value in by_hand.items():
+        assert phys[name]["value"] == pytest.approx(value, rel=1e-12)
+        assert phys[name]["value"] == pytest.approx(zener_by_hand(*ZENER)[name], rel=0.05)
+    assert phys["G_m"]["unit"] == "Pa" and phys["c_q"]["unit"] == "Pa s^q"
+    # The Poynting-Thomson alias reads the same fit as a spring in series with a Kelvin-Voigt
+    # element: G_g = a1/b1, G_k = a1/(a1 b0 - b1), c_q = a1²/(a1 b0 - b1).
+    status, out, err = run_cli("identify", path, "--structure", "fpt", "--json")
+    assert status == 0, err
+    res = json.loads(out)
+    p, phys = res["parameters"], res["parameters_physical"]
+    assert res["picture"] == "fractional_poynting_thomson"
+    d = p["a1"] * p["b0"] - p["b1"]
+    for name, value in (("G_g", p["a1"] / p["b1"]), ("G_k", p["a1"] / d),
+                        ("c_q", p["a1"] ** 2 / d)):
+        assert phys[name]["value"] == pytest.approx(value, rel=1e-12)
+        assert phys[name]["unit"] == ("Pa s^q" if name == "c_q" else "Pa")
+    status, out, _ = run_cli("identify", path, "--structure", "zener")
+    assert status == 0
+    assert "physical parameters (fractional_zener_ss):" in out
+    assert "G_e = " in out and " Pa\n" in out and "b0 = " in out and " 1/Pa\n" in out
+    assert out.index("G_e = ") < out.index("b0 = ")

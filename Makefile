@@ -32,7 +32,7 @@ test-all: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 
 DEMO_DATA ?= examples/data/adhesive_468mp/Tp020C.csv
-DEMO_STRUCTURES ?= voigt,zener,maxwell,voigt-int,zener-int,maxwell-int
+DEMO_STRUCTURES ?= voigt,zener,maxwell,fractional_kelvin_voigt,voigt-int,zener-int,maxwell-int
 
 demo: $(STAMP)
 	@echo "Comparing $(DEMO_STRUCTURES) on $(DEMO_DATA) (3M 468MP adhesive, 20 C, storage and loss modulus)"

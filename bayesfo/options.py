@@ -16,7 +16,7 @@ import numpy as np
 from ._io import parse_number, show
 from .errors import InputError
 
-DEFAULT_STRUCTURES = "voigt,zener,maxwell,voigt-int,zener-int,maxwell-int"
+DEFAULT_STRUCTURES = "voigt,zener,maxwell,fractional_kelvin_voigt,voigt-int,zener-int,maxwell-int"
 
 
 def parse_floats(text: str, option: str) -> list[float]:

@@ -536,3 +536,25 @@ def test_demo_figures_show_voigt_and_zener_apart(tmp_path):
         if name.startswith("trace_"):
             structure = comp[name[len("trace_"):]]
             assert ("NOT converged" in caption) == (not structure.posterior.converged)
+
+
+def test_a_long_coincidence_note_is_wrapped_inside_the_figure():
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    from bayesfo.plotting.response import _legend, _wrapped
+
+    note = ("fractional_kelvin_voigt, voigt and zener coincide in magnitude; voigt and zener "
+            "coincide in phase")
+    assert _wrapped(note).split("\n") == [
+        "fractional_kelvin_voigt, voigt and zener coincide in", "magnitude",
+        "voigt and zener coincide in phase"]
+    fig = plt.figure(figsize=(5, 4), layout="constrained")
+    fig.add_subplot()
+    handles = [Line2D([], []) for _ in range(3)]
+    legend = _legend(fig, handles, ["a", "b", "c"], note)
+    fig.canvas.draw()
+    box = legend.get_title().get_window_extent()
+    frame = fig.bbox
+    assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and box.y1 <= frame.y1
+    plt.close(fig)

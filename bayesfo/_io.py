@@ -139,19 +139,22 @@ def split_lines(text: str) -> list[str]:
     return lines
 
 
-def csv_cells(line: str, where: str, lineno: int) -> list[str]:
-    """The cells of one comma-separated line, or an InputError naming the file and line."""
+def csv_cells(line: str, where: str, lineno: int, delimiter: str = ",",
+              delimiter_name: str = "comma") -> list[str]:
+    """The cells of one delimited line (comma-separated by default), or an InputError naming the
+    file and line."""
     from .errors import InputError
 
     try:
-        return next(csv.reader([line]))
+        return next(csv.reader([line], delimiter=delimiter), [])
     except csv.Error as exc:
         if "field limit" in str(exc):
             raise InputError(f"{where}, line {lineno}: a cell has more than "
                              f"{csv.field_size_limit()} characters, far more than any value "
                              "needs; is it the right file?") from None
-        raise InputError(f"{where}, line {lineno}: cannot be read as comma-separated values "
-                         f"({exc})") from None
+        what = ("read as comma-separated values" if delimiter == ","
+                else f"split at {delimiter_name}s")
+        raise InputError(f"{where}, line {lineno}: cannot be {what} ({exc})") from None
 
 
 #: Longest cell :func:`parse_number` reads: a double has 17 significant digits, so even a

@@ -317,20 +317,27 @@ class FrequencyResponse:
     # ------------------------------------------------------------------ output
     def to_csv(self, path: str | os.PathLike) -> Path:
         """Write the response in the CSV contract (``omega,real,imag[,sigma]``), atomically."""
+        return atomic_write_text(path, self.to_csv_text())
+
+    def to_csv_text(self, comments=()) -> str:
+        """The response as CSV text of the contract (numbers written exactly), with ``# name:``,
+        ``# kind:`` and ``# units:`` lines and then ``comments`` (e.g. ``"temperature: 20 C"``),
+        each as a ``#`` line."""
         lines = []
         if self.name:
             lines.append(f"# name: {self.name}")
         lines.append(f"# kind: {self.kind}")
         if self.units:
             lines.append(f"# units: {self.units}")
+        lines.extend(f"# {c}" for c in comments)
         header = ["omega", "real", "imag"] + (["sigma"] if self.sigma is not None else [])
         lines.append(",".join(header))
-        for k in range(self.n_frequencies):
-            row = [self.omega[k], self.response[k].real, self.response[k].imag]
-            if self.sigma is not None:
-                row.append(self.sigma[k])
+        cols = [self.omega, self.response.real, self.response.imag]
+        if self.sigma is not None:
+            cols.append(self.sigma)
+        for row in np.column_stack(cols):
             lines.append(",".join(repr(float(v)) for v in row))
-        return atomic_write_text(path, "\n".join(lines) + "\n")
+        return "\n".join(lines) + "\n"
 
     def to_dict(self) -> dict:
         """Plain-Python summary for JSON output (no arrays of data)."""

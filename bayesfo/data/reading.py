@@ -6,8 +6,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from .frequency_response import FrequencyResponse
 
 
@@ -162,23 +160,12 @@ class Isotherm:
 
 def contract_text(data: FrequencyResponse, temperature: float | None = None) -> str:
     """``data`` as a CSV of the bayesfo contract (``omega,real,imag[,sigma]``, numbers written
-    exactly), with ``# name:``, ``# kind:``, ``# units:`` and ``# temperature:`` lines."""
-    lines = []
-    if data.name:
-        lines.append(f"# name: {data.name}")
-    lines.append(f"# kind: {data.kind}")
-    if data.units:
-        lines.append(f"# units: {data.units}")
+    exactly), with ``# name:``, ``# kind:``, ``# units:``, ``# temperature:``, ``# source:`` and
+    ``# note:`` lines (:meth:`FrequencyResponse.to_csv_text`)."""
+    comments = []
     if temperature is not None:
-        lines.append(f"# temperature: {temperature!r} C")
+        comments.append(f"temperature: {temperature!r} C")
     if data.source:
-        lines.append(f"# source: {data.source}")
-    lines.extend(f"# note: {note}" for note in data.notes)
-    header = ["omega", "real", "imag"] + (["sigma"] if data.sigma is not None else [])
-    lines.append(",".join(header))
-    cols = [data.omega, data.response.real, data.response.imag]
-    if data.sigma is not None:
-        cols.append(data.sigma)
-    for row in np.column_stack(cols):
-        lines.append(",".join(repr(float(v)) for v in row))
-    return "\n".join(lines) + "\n"
+        comments.append(f"source: {data.source}")
+    comments.extend(f"note: {note}" for note in data.notes)
+    return data.to_csv_text(comments)

@@ -7,13 +7,12 @@ Nothing here knows what a column means (see :mod:`bayesfo.data.columns`).
 
 from __future__ import annotations
 
-import csv
 import re
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .._io import _INVISIBLE, parse_number, read_text_file, show, text_position
+from .._io import _INVISIBLE, csv_cells, parse_number, read_text_file, show, text_position
 from ..errors import InputError
 from .units import looks_like_unit
 
@@ -137,17 +136,7 @@ def _split(line: str, delimiter: str, where: str, lineno: int) -> list[str]:
         if "\t" in line:
             return [c.strip() for c in line.split("\t")]
         return line.split()
-    try:
-        return [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
-    except csv.Error as exc:
-        if "field limit" in str(exc):
-            raise InputError(f"{where}, line {lineno}: a cell has more than "
-                             f"{csv.field_size_limit()} characters, far more than any value "
-                             "needs; is it the right file?") from None
-        raise InputError(f"{where}, line {lineno}: cannot be split at "
-                         f"{DELIMITERS[delimiter]}s ({exc})") from None
-    except StopIteration:
-        return []
+    return [c.strip() for c in csv_cells(line, where, lineno, delimiter, DELIMITERS[delimiter])]
 
 
 def _kind_of(cells: list[str]) -> str:

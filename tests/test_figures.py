@@ -558,3 +558,16 @@ def test_a_long_coincidence_note_is_wrapped_inside_the_figure():
     frame = fig.bbox
     assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and box.y1 <= frame.y1
     plt.close(fig)
+
+
+def test_structures_that_misfit_are_marked_in_the_response_legends():
+    # Adequacy as the checks report it: maxwell rejected, zener within the small-misfit band.
+    comp = _demo_comparison(("voigt", "zener", "maxwell"))
+    comp.results[1].fits, comp.results[2].fits = "small", "no"
+    expected = ["voigt", "zener (small misfit)", "maxwell (misfits)"]
+    for drawn in (plot_bode(comp, n_draws=40), plot_nyquist(comp, n_draws=40, n_lines=0),
+                  plot_residuals(comp, n_draws=40)):
+        shown = [t.get_text() for legend in drawn.figure.legends for t in legend.get_texts()]
+        shown += [t.get_text() for ax in drawn.figure.axes if ax.get_legend()
+                  for t in ax.get_legend().get_texts()]
+        assert [s for s in shown if s.split(" (")[0] in ("voigt", "zener", "maxwell")] == expected

@@ -360,6 +360,14 @@ def coincident_groups(curves: dict, span: float, fraction: float = COINCIDE_FRAC
     return [g for g in groups if len(g) > 1]
 
 
+def legend_name(result) -> str:
+    """A structure's name in a legend, marked where the posterior predictive checks reject it
+    (``"maxwell (misfits)"``; ``"(small misfit)"`` within 2° and 3.5 %), so that a curve in a
+    Bode, Nyquist or residual figure is not read as a description of the data it fails."""
+    fits = getattr(result, "fits", None)
+    return result.name + {"no": " (misfits)", "small": " (small misfit)"}.get(fits, "")
+
+
 def join_names(names) -> str:
     """``a``, ``a and b``, ``a, b and c``."""
     names = list(names)

@@ -104,7 +104,7 @@ def figure_caption(name: str, comparison) -> str | None:
         return ("Magnitude and phase of the data (± 1 sd where σ is known) with each "
                 "structure's posterior median response (one line style per structure) and its "
                 "50 % and 90 % credible bands; the legend names structures whose curves "
-                "coincide.")
+                "coincide and marks those the posterior predictive checks reject (misfits).")
     if name == "nyquist":
         if nyquist_form(comparison) == "log":
             return ("The same in the complex plane, log-magnitude form (|G| spans more than "

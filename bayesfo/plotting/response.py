@@ -30,6 +30,7 @@ from ._compute import (
     NYQUIST_LOG_DECADES,
     coincidence_note,
     coincident_groups,
+    legend_name,
     magnitude_decades,
     omega_grid,
     quantiles,
@@ -183,7 +184,7 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
                 artists[f"{r.name}/{quantity}_band50"] = inner
                 artists[f"{r.name}/{quantity}_median"] = line
             handles.append(_band_handle(st))
-            labels.append(r.name)
+            labels.append(legend_name(r))
         for prefix, d in (("data", data), ("holdout", comparison.holdout)):
             if d is None:
                 continue
@@ -332,7 +333,7 @@ def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS
             (line,) = ax.plot(*coords(medians[r.name]), **st.line(lw=1.2, zorder=3))
             artists[f"{r.name}/median"] = line
             handles.append(line)
-            labels.append(r.name)
+            labels.append(legend_name(r))
         for prefix, d in (("data", data), ("holdout", holdout)):
             if d is None:
                 continue
@@ -552,7 +553,7 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
                 edge = c if prefix == "data" else DATA_COLOR
                 for part, a, y in (("real", ax_re, res.real), ("imag", ax_im, res.imag)):
                     filled = not (single and part == "imag")
-                    label = r.name if prefix == "data" and part == "real" else None
+                    label = legend_name(r) if prefix == "data" and part == "real" else None
                     (pts,) = a.plot(dodge, y, ls="none", marker=st.marker, color=c,
                                     mfc=c if filled else "white", mec=edge,
                                     ms=3.4 if filled else 3.8,

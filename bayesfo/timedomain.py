@@ -19,6 +19,9 @@ References
 A. Oustaloup, F. Levron, B. Mathieu, F. M. Nanot, "Frequency-band complex noninteger
 differentiator: characterization and synthesis", IEEE Trans. Circuits Syst. I 47 (2000) 25-39.
 Thesis §4.3.3 (model validation in the time domain), eq. for G_f(s) and omega_k^±.
+
+This module is longer than the project's 500-line guide: Oustaloup's approximation, the
+simulation and the validation metrics are one pipeline with one set of band checks.
 """
 
 from __future__ import annotations

@@ -14,6 +14,10 @@ Each structure has its own colour, line style and marker (:func:`~bayesfo.plotti
 structure_styles`), so that curves drawn on top of each other stay visible; when the curves of
 two structures agree within a line width everywhere, the legend says so ("voigt and zener
 coincide").
+
+This module is longer than the project's 500-line guide: Bode, Nyquist (linear and
+log-magnitude) and residuals share the posterior bands, the legend with its coincidence note
+and the per-structure styles.
 """
 
 from __future__ import annotations

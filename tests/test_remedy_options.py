@@ -3,6 +3,7 @@ reach emcee (``compare`` and ``batch``), and bad values are refused before any w
 
 import json
 import re
+from pathlib import Path
 
 import pytest
 
@@ -48,3 +49,22 @@ def test_cli_flags_reach_the_sampler(run_cli, tmp_path):
     assert status == 2
     assert "max_steps (--max-steps) must be an integer of at least 100, got 5" in err
     assert not (tmp_path / "p").exists()
+
+
+def test_manifest_columns_set_the_sampler_per_data_set(tmp_path):
+    from bayesfo.batch import expand_inputs
+
+    data = tmp_path / "a.csv"
+    data.write_bytes(Path(DATA).read_bytes())
+    manifest = tmp_path / "m.csv"
+    manifest.write_text("path,max_steps,walkers\na.csv,20000,48\n")
+    (ds,) = expand_inputs([], manifests=[manifest], options={"structures": "voigt"}, seed=1)
+    assert sampler_options(ds.options) == {"max_steps": 20000, "n_walkers": 48}
+    manifest.write_text("path,max_steps\na.csv,lots\n")
+    with pytest.raises(InputError, match=r"line 2, column 'max_steps': max_steps must be an "
+                                         r"integer, got 'lots'"):
+        expand_inputs([], manifests=[manifest], options={}, seed=1)
+    manifest.write_text("path,walkers\na.csv,2\n")
+    with pytest.raises(InputError, match=r"line 2: walkers \(--walkers\) must be an integer of "
+                                         r"at least 8, got 2"):
+        expand_inputs([], manifests=[manifest], options={}, seed=1)

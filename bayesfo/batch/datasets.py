@@ -26,7 +26,7 @@ from .temperature import parse_temperature, temperature_of_file
 #: Manifest columns; ``invert`` is another name for ``reciprocal``.
 MANIFEST_COLUMNS = ("path", "id", "kind", "reciprocal", "invert", "structures", "noise", "prior",
                     "seed", "holdout", "evidence", "evidence_check", "temperature",
-                    "sampler")
+                    "sampler", "max_steps", "walkers")
 
 
 #: Files written at the top of the output directory (no data-set id may take these names).
@@ -320,6 +320,11 @@ def _read_manifest(path, *, defaults: dict | None = None, seed: int = 0) -> list
                 opts["priors"] = tuple(p.strip() for p in cell.split(";") if p.strip())
             elif col == "holdout":
                 opts["holdout"] = _float_list(cell, here)
+            elif col in ("max_steps", "walkers"):
+                try:
+                    opts[col] = int(cell)
+                except ValueError:
+                    raise InputError(f"{here}: {col} must be an integer, got {cell!r}") from None
             elif col == "seed":
                 try:
                     row_seed = int(cell)

@@ -36,7 +36,8 @@ def add_parser(subparsers):
                         "'path' column and per-file options)")
     p.add_argument("--manifest", action="append", default=[], metavar="FILE",
                    help="manifest CSV: path[,id,kind,reciprocal|invert,structures,noise,prior,"
-                        "seed,holdout,evidence,evidence_check,temperature,sampler]; repeatable")
+                        "seed,holdout,evidence,evidence_check,temperature,sampler,max_steps,"
+                        "walkers]; repeatable")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--kind", choices=KINDS,
                    help="what the responses are (default: each file's '# kind:' line, else "

@@ -1,7 +1,8 @@
 """Run structures on one data set and rank them: the engine behind ``bayesfo compare``.
 
 For every structure: the global least-squares optimisation (modes and a maximum-likelihood
-start); a certified posterior, by importance sampling from the optima where its weights certify
+start); without σ in the data, the choice between a constant and a proportional noise model by
+their evidence; a certified posterior, by importance sampling from the optima where its weights certify
 it (:mod:`bayesfo.inference.importance`), else emcee, and where the walkers do not converge the
 particles of the tempered ladder if its independent runs agree; the criteria that follow:
 maximum log-likelihood, AIC, AICc, BIC (from the higher of the optimiser's and the sampler's
@@ -55,6 +56,11 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     structures : str or sequence of Structure or str
         Structures, names or comma lists of names (``"voigt,zener"``, ``"max3"``).
     noise : {"auto", "known", "constant", "proportional"}
+        ``auto``: ``known`` when the data carry σ; else every structure runs under
+        ``constant`` and ``proportional`` noise and keeps the one with the larger ln Z
+        (:data:`SCREEN_MARGIN` lets a quick estimate set aside a model that trails far behind);
+        both are stated in the result (``criteria["noise_models"]``). Any other value forces
+        that model.
     seed : int
         The same seed gives the same numbers.
     priors : dict, optional

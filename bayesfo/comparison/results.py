@@ -59,8 +59,12 @@ def summarise_draws(values, map_value, unit: str) -> dict:
             | {"map": float(map_value)}
     finite = bool(np.all(np.isfinite(x)))
     lo, hi = arviz().hdi(x, hdi_prob=HDI_PROB)
-    return out | {"mean": float(x.mean()) if finite else math.nan,
-                  "sd": float(x.std(ddof=1)) if finite else math.nan,
+    # Finite draws can still overflow the moments (a time b1**(1/alpha) near alpha = 0 reaches
+    # 1e200): those moments are undefined too.
+    with np.errstate(over="ignore", invalid="ignore"):
+        mean, sd = (float(x.mean()), float(x.std(ddof=1))) if finite else (math.nan, math.nan)
+    return out | {"mean": mean if math.isfinite(mean) and math.isfinite(sd) else math.nan,
+                  "sd": sd if math.isfinite(sd) else math.nan,
                   "hdi_low": float(lo), "hdi_high": float(hi), "median": float(np.median(x)),
                   "map": float(map_value)}
 

@@ -129,6 +129,28 @@ def _into_support(lik: Likelihood, tr: _Transform, theta, anchor, *, steps: int 
     return tr.to_theta((u_in + lo * (u_out - u_in))[None, :])[0]
 
 
+def _snooker_move():
+    """emcee's DE snooker move, with the proposal through a walker's own position made a null move.
+
+    emcee divides by the distance between the walker and the chosen point ``z``; when walkers
+    coincide (all of them pinned in a corner of the prior box, as the integer Voigt is on the
+    26-decade NREL curve), that proposal is NaN and emcee raises. Staying put instead is a
+    rejected proposal, which leaves the target invariant.
+    """
+    import emcee
+
+    class _SnookerMove(emcee.moves.DESnookerMove):
+        def get_proposal(self, s, c, random):
+            with np.errstate(invalid="ignore", divide="ignore"):
+                q, factors = super().get_proposal(s, c, random)
+            bad = ~np.all(np.isfinite(q), axis=1) | ~np.isfinite(factors)
+            q[bad] = s[bad]
+            factors = np.where(bad, 0.0, factors)
+            return q, factors
+
+    return _SnookerMove()
+
+
 def sample_posterior(
     lik: Likelihood,
     seeds_scaled,
@@ -192,7 +214,7 @@ def sample_posterior(
     # (a degree-k polynomial in s^q is one of degree 2k in s^(q/2)); without this move the
     # walkers keep the split between the modes they started with.
     moves = [(emcee.moves.DEMove(), 0.5), (emcee.moves.DEMove(gamma0=1.0), 0.1),
-             (emcee.moves.DESnookerMove(), 0.2), (emcee.moves.StretchMove(), 0.2)]
+             (_snooker_move(), 0.2), (emcee.moves.StretchMove(), 0.2)]
     sampler = emcee.EnsembleSampler(n_walkers, ndim, _log_prob_fn(lik, tr), moves=moves,
                                     vectorize=True)
     sampler.random_state = np.random.RandomState(seed).get_state()

@@ -1,0 +1,45 @@
+"""Degenerate posteriors give reasons, not exceptions: walkers that coincide in a corner of the
+prior box, and draws whose moments overflow."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from bayesfo.comparison.results import summarise_draws
+from bayesfo.inference.posterior import _snooker_move
+
+
+def test_snooker_proposal_through_a_walkers_own_position_stays_put():
+    # emcee's snooker move divides by |walker - z|: with z equal to the walker it proposes NaN
+    # (and emcee raises). Here every walker sits on one point, as the integer Voigt's do in the
+    # corner of its prior box on the 26-decade NREL curve.
+    point = np.array([-9.21034037, 9.21034037, 2.30258509])
+    s = np.tile(point, (8, 1))
+    c = [np.tile(point, (8, 1)) for _ in range(3)]  # nsplits = 4: three complementary sets
+    q, factors = _snooker_move().get_proposal(s, c, np.random.RandomState(0))
+    assert np.array_equal(q, s)
+    assert np.all(factors == 0.0)
+
+
+def test_snooker_proposal_is_emcees_where_walkers_differ():
+    import emcee
+
+    rng = np.random.default_rng(1)
+    s, c = rng.normal(size=(8, 3)), [rng.normal(size=(8, 3)) for _ in range(3)]
+    ours = _snooker_move().get_proposal(s, c, np.random.RandomState(4))
+    theirs = emcee.moves.DESnookerMove().get_proposal(s, c, np.random.RandomState(4))
+    np.testing.assert_array_equal(ours[0], theirs[0])
+    np.testing.assert_array_equal(ours[1], theirs[1])
+
+
+def test_moments_that_overflow_are_undefined_not_a_warning():
+    # A relaxation time b1**(1/alpha) with alpha near 0: finite draws whose square overflows.
+    draws = np.array([1e200, 3e200, 2e200, 5e200, 4e200])
+    s = summarise_draws(draws, 2e200, "s")
+    assert math.isnan(s["sd"]) and math.isnan(s["mean"])
+    assert s["median"] == 3e200
+    assert s["hdi_low"] <= s["median"] <= s["hdi_high"]
+    ordinary = summarise_draws(np.arange(5.0), 2.0, "s")
+    assert ordinary["mean"] == 2.0 and math.isclose(ordinary["sd"], math.sqrt(2.5))

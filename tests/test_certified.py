@@ -2,9 +2,15 @@
 final particles of the tempered-ladder runs (which give ln Z) are the posterior, if the runs
 agree.
 
-Known answer: on the bundled 20 °C adhesive isotherm the Zener posterior from a converged emcee
-run. The walkers are stopped early (300 steps) so that they cannot converge; the ladder's
-posterior must then agree with the converged one within Monte Carlo error.
+Known answer: on the bundled 20 °C adhesive isotherm the Zener posterior by importance sampling
+with weights of Pareto k̂ < 0.5 (an exact route with its own certificate). The walkers are
+stopped early (300 steps) so that they cannot converge; the ladder's posterior must then agree
+with the reference within Monte Carlo error.
+
+A converged emcee run is not the reference: on these data its standard deviations come out
+4–7 % below those of importance sampling and of the ladder, which agree with each other
+(measured, seeds 1–5: a1 0.057–0.059 against 0.060–0.062), so emcee's passed the 15 % bar
+below only by the seed's luck.
 """
 
 from __future__ import annotations
@@ -25,15 +31,15 @@ DATA = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tp0
 @pytest.fixture(scope="module")
 def runs():
     data = bf.read(DATA)
-    with warnings.catch_warnings():
-        # Pareto k near 0.7 at the lowest frequency, depending on the draws.
-        warnings.simplefilter("ignore", PredictiveWarning)
-        reference = bf.compare(data, "zener", seed=2, workers=1, progress=False,
-                               sampler="emcee")
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
         short = bf.compare(data, "zener", seed=1, workers=1, progress=False, max_steps=300,
                            sampler="emcee")
+    with warnings.catch_warnings():
+        # Pareto k near 0.7 at the lowest frequency, depending on the draws.
+        warnings.simplefilter("ignore", PredictiveWarning)
+        reference = bf.compare(data, "zener", seed=1, workers=1, progress=False,
+                               noise=short["zener"].criteria["noise_models"]["chosen"])
     assert {w.category for w in record} <= {ConvergenceWarning, CertifiedWarning,
                                              PredictiveWarning}
     return reference["zener"], short["zener"], record
@@ -41,7 +47,8 @@ def runs():
 
 def test_the_ladder_certifies_where_the_walkers_did_not_converge(runs):
     reference, short, record = runs
-    assert reference.posterior.sampler == "emcee" and reference.posterior.converged
+    assert reference.posterior.sampler == "importance" and reference.posterior.converged
+    assert reference.criteria["importance"]["k_hat"] < 0.5
     post = short.posterior
     assert post.sampler == "ladder" and post.converged
     assert post.rhat_max < 1.01 and post.ess_min >= 400 and post.n_walkers == 2
@@ -57,7 +64,7 @@ def test_the_ladder_certifies_where_the_walkers_did_not_converge(runs):
     assert post.idata.log_likelihood["G"].shape == (2, 1000, 17)
 
 
-def test_the_ladder_posterior_agrees_with_converged_emcee(runs):
+def test_the_ladder_posterior_agrees_with_importance_sampling(runs):
     reference, short, _ = runs
     a, b = short.posterior, reference.posterior
     for name in b.param_names:

@@ -251,7 +251,9 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
     with pytest.warns(EvidenceWarning, match="ended 1[0-9].[0-9] nats below the best fit"):
         _evidence(lik, result["voigt"].posterior, 1, False, "ladder",
                   best_log_likelihood=ev.reached_log_likelihood + 12)
-    assert result.table()[0]["evidence_method"] == "bridge"
+    # The default route: importance weights where they certify the posterior, else the ladder
+    # whose runs agree (bridge sampling only follows emcee, which neither needed here).
+    assert {row["evidence_method"] for row in result.table()} <= {"importance", "ladder"}
     with pytest.raises(InputError, match="evidence must be"):
         compare(data, voigt, evidence="nested")
 

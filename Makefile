@@ -3,15 +3,17 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
+DOCS_STAMP := $(VENV)/.docs-stamp
 DEMO_OUT ?= demo-output
 
-.PHONY: help venv test test-slow test-all demo bench clean
+.PHONY: help venv test test-slow test-all demo bench docs clean
 
 help:
 	@echo "make demo       create $(VENV), install bayesfo, run a model comparison on bundled data"
 	@echo "make test       create $(VENV), install bayesfo, run the default test suite"
 	@echo "make test-slow  the long validation runs (thesis tables in full, GPL reference data)"
 	@echo "make bench      run the benchmarks in benchmarks/"
+	@echo "make docs       build the documentation site into docs/_build/html (index.html)"
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -41,6 +43,15 @@ demo: $(STAMP)
 
 bench: $(STAMP)
 	@for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f || exit 1; done
+
+$(DOCS_STAMP): pyproject.toml $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[test,docs]"
+	@touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	rm -rf docs/api/generated   # regenerated from the docstrings: no page of a removed name stays
+	MPLBACKEND=Agg $(BIN)/sphinx-build -W --keep-going -b html docs docs/_build/html
+	@echo "Open docs/_build/html/index.html"
 
 clean:
 	rm -rf $(VENV) build *.egg-info $(DEMO_OUT)

@@ -248,8 +248,10 @@ class FrequencyResponse:
 
         Returns
         -------
-        train, test : FrequencyResponse
-            The remaining points and the held-out points.
+        train : FrequencyResponse
+            The remaining points.
+        test : FrequencyResponse
+            The held-out points.
 
         Raises
         ------

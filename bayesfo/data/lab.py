@@ -227,8 +227,10 @@ def _is_contract(lines: list[str], where: str) -> bool:
 
 
 def columns_from_text(text: str | None) -> dict:
-    """The ``columns`` mapping of a command-line text such as
-    ``omega="Ang. Freq.",storage="G'",temperature=`` (an empty column: no such column).
+    """The ``columns`` mapping of the text of a ``--columns`` option.
+
+    For example ``omega="Ang. Freq.",storage="G'",temperature=`` (an empty column: no such
+    column).
 
     Raises
     ------

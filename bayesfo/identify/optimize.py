@@ -177,13 +177,13 @@ def fit_structure(
     seed_methods : bool
         Also start from the linear methods 2 and 3 (thesis Table 3.1) on a coarse q grid, for
         structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
-    scaling : Scaling, optional
-        Units of the scaled problem, in which the prior bounds hold (default
-        ``Scaling.from_data(data)``).
     min_starts, stop_after : int
         Stop once at least ``min_starts`` starts have run and ``stop_after`` of them ended at
         the best admissible cost found so far (``stop_after=None`` runs every start). Given and
         seeded starts alternate with random ones, so an early stop still has both kinds.
+    scaling : Scaling, optional
+        Units of the scaled problem, in which the prior bounds hold (default
+        ``Scaling.from_data(data)``).
 
     Returns
     -------

@@ -52,9 +52,11 @@ def choose_noise(data: FrequencyResponse, noise: str = "auto") -> tuple[str, str
 
     Returns
     -------
-    noise, reason : str
+    noise : str
         ``known`` when the data carry σ; else ``proportional`` when |G| spans more than a decade
         (a constant σ would let the largest values dominate); else ``constant``.
+    reason : str
+        Why, in a few words (e.g. "|G| spans 1.2 decades").
     """
     if noise not in NOISE_MODELS + ("auto",):
         raise InputError(f"noise model must be auto, {', '.join(NOISE_MODELS)}; got {noise!r}")

@@ -176,7 +176,7 @@ def sample_posterior(
         Seed of the walker jitter, the moves and the posterior predictive draws.
     n_walkers : int, optional
         Default max(32, 4·ndim), rounded up to a multiple of 4 (the walker groups of R-hat).
-    tau_factor, max_steps, check_every
+    tau_factor, max_steps, check_every : float, int, int
         Run until the chain is ``tau_factor``·τ long (τ changing by < 10 % between checks) and
         R-hat < 1.01 and bulk and tail ESS ≥ 400 hold, at most ``max_steps`` steps, checking
         every ``check_every`` steps.

@@ -254,7 +254,7 @@ def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS
     ax : matplotlib.axes.Axes, optional
         For the log-magnitude form a polar axes; a Cartesian one is replaced by a polar axes
         at the same place.
-    n_draws, seed, n_grid
+    n_draws, seed, n_grid : int
         As in :func:`plot_bode`.
     n_lines : int
         Single-draw curves per structure (a subset of the ``n_draws``; 0 for none).
@@ -498,7 +498,7 @@ def plot_residuals(comparison, structures=None, ax=None, *, n_draws: int = N_DRA
     ax : matplotlib.axes.Axes or pair of Axes, optional
         Two axes (real part, imaginary part), or one axes for both (real parts filled, imaginary
         parts open markers). Default: a new figure with two stacked axes.
-    n_draws, seed
+    n_draws, seed : int
         As in :func:`plot_bode`.
 
     Returns

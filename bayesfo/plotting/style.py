@@ -82,6 +82,11 @@ def _rc() -> dict:
 def style():
     """Context in which figures get the bayesfo style (matplotlib ``rc_context``).
 
+    Yields
+    ------
+    None
+        Figures drawn inside the ``with`` block get the style.
+
     Examples
     --------
     >>> import matplotlib

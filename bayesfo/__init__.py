@@ -20,6 +20,9 @@ Example
 >>> result = bf.compare(data, "voigt,zener", workers=1)                # doctest: +SKIP
 >>> result.ranking                                                     # doctest: +SKIP
 ['voigt', 'zener']
+>>> bf.write_outputs(result, "out")                                    # doctest: +SKIP
+>>> bf.load("out").table() == result.table()   # read back, nothing re-run  # doctest: +SKIP
+True
 """
 
 from importlib.metadata import PackageNotFoundError
@@ -36,8 +39,8 @@ from .structures import get_structure, resolve_structures  # noqa: E402
 
 #: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
 #: ``import bayesfo`` and ``bayesfo --help`` stay fast.
-_LAZY = {"compare": "comparison", "write_outputs": "comparison", "Comparison": "comparison",
-         "StructureResult": "comparison"}
+_LAZY = {"compare": "comparison", "write_outputs": "comparison", "load": "comparison",
+         "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison"}
 
 
 def __getattr__(name):
@@ -50,9 +53,11 @@ def __getattr__(name):
 __all__ = [
     "BayesfoError",
     "Comparison",
+    "Criteria",
     "OutputError",
     "StructureResult",
     "compare",
+    "load",
     "read",
     "write_outputs",
     "FrequencyResponse",

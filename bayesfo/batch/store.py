@@ -112,43 +112,45 @@ class BatchResult:
         return 2 if INPUT_ERROR in statuses else 0
 
 
+#: The columns of ``batch_summary.csv`` that are those of the ranking table
+#: (:func:`~bayesfo.comparison.results.ranking_rows`).
+_RANKING_COLUMNS = ("rank", "n_params", "log_evidence", "log_evidence_err", "delta_log_evidence",
+                    "posterior_probability", "loo", "loo_se", "waic", "aic", "aicc", "bic",
+                    "max_log_likelihood", "rmse", "q_mean", "q_sd", "rhat_max", "ess_min",
+                    "converged", "pareto_k_max", "sampler", "adequate", "max_phase_error_deg")
+
+
 def summary_rows(summary: dict) -> list[dict]:
     """Rows of ``batch_summary.csv`` for one data set from its ``summary.json`` (without the
-    data-set columns), ranked by ln Z; structures that could not be run come last."""
+    data-set columns), ranked by ln Z; structures that could not be run come last.
+
+    Each row is the ranking row of the structure (:func:`~bayesfo.comparison.results.ranking_rows`,
+    the rows of ``Comparison.table`` and ``ranking.csv``), with what a batch adds: whether it
+    is the best, the order parameter's HDI and MAP, the noise model, the data's kind and size
+    and the warnings."""
+    from ..comparison.results import order_parameter, ranking_rows
+
     structures = {s["name"]: s for s in summary["structures"]}
     ranking = list(summary.get("ranking", []))
-    zs = [s.get("log_evidence") for s in structures.values() if s.get("log_evidence") is not None]
-    best_z = max(zs) if zs else None
     best = ranking[0] if ranking else None
+    data = {"kind": summary["data"].get("kind"),
+            "n_frequencies": summary["data"].get("n_frequencies")}
     rows = []
-    for name in ranking + [n for n in structures if n not in ranking]:
+    for table_row in ranking_rows(list(structures.values()), ranking):
+        name = table_row["structure"]
         s = structures[name]
-        row = {"structure": name, "n_params": s.get("n_params"),
-               "kind": summary["data"].get("kind"),
-               "n_frequencies": summary["data"].get("n_frequencies")}
+        row = {"structure": name, "n_params": table_row["n_params"], **data}
         if "error" in s:
             row["error"] = s["error"]
             rows.append(row)
             continue
+        row.update({k: table_row[k] for k in _RANKING_COLUMNS})
         params = s.get("parameters", {})
-        qname = "q" if "q" in params else ("beta" if "beta" in params else None)
-        q = params.get(qname, {}) if qname else {}
-        z = s.get("log_evidence")
-        row.update(
-            rank=ranking.index(name) + 1, best=name == best,
-            log_evidence=z, log_evidence_err=s.get("log_evidence_err"),
-            delta_log_evidence=None if z is None or best_z is None else z - best_z,
-            posterior_probability=s.get("posterior_probability"),
-            q_parameter=qname, q_mean=q.get("mean"), q_sd=q.get("sd"),
-            q_hdi_low=q.get("hdi_low"), q_hdi_high=q.get("hdi_high"), q_map=q.get("map"),
-            noise=s.get("noise"), warnings="; ".join(s.get("warnings", [])),
-        )
-        for key in ("loo", "loo_se", "waic", "aic", "aicc", "bic", "max_log_likelihood", "rmse",
-                    "rhat_max", "ess_min", "converged", "pareto_k_max", "sampler"):
-            row[key] = s.get(key)
-        adequacy = s.get("adequacy") or {}
-        row["adequate"] = adequacy.get("adequate")
-        row["max_phase_error_deg"] = adequacy.get("max_phase_error_deg")
+        q_name = order_parameter(params)
+        q = params.get(q_name, {}) if q_name else {}
+        row.update(best=name == best, q_parameter=q_name, q_hdi_low=q.get("hdi_low"),
+                   q_hdi_high=q.get("hdi_high"), q_map=q.get("map"), noise=s.get("noise"),
+                   warnings="; ".join(s.get("warnings", [])))
         rows.append(row)
     return rows
 

@@ -1,14 +1,17 @@
 """Compare structures on one data set: run each (optimisation, posterior, criteria, evidence),
-rank them, and write the output directory.
+rank them, and write the output directory; read it back.
 
-``run`` (:func:`compare`) → ``criteria`` (per structure) → ``results`` (:class:`Comparison`)
-→ ``output`` (:func:`write_outputs`).
+``run`` (:func:`compare`) → ``criteria`` (per structure; ``criteria_types``: :class:`Criteria`)
+→ ``results`` (:class:`Comparison`) → ``output`` (:func:`write_outputs`) → ``stored``
+(:func:`load`).
 """
 
 from .criteria import LADDER_SHORTFALL, PARETO_K_WARN
+from .criteria_types import Criteria
 from .output import ranking_csv, write_outputs
-from .results import RANKING_FIELDS, Comparison, StructureResult
+from .results import RANKING_FIELDS, Comparison, StructureResult, ranking_rows
 from .run import compare
+from .stored import load
 
-__all__ = ["LADDER_SHORTFALL", "PARETO_K_WARN", "RANKING_FIELDS", "Comparison", "StructureResult",
-           "compare", "ranking_csv", "write_outputs"]
+__all__ = ["LADDER_SHORTFALL", "PARETO_K_WARN", "RANKING_FIELDS", "Comparison", "Criteria",
+           "StructureResult", "compare", "load", "ranking_csv", "ranking_rows", "write_outputs"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
@@ -176,18 +177,20 @@ def _evidence_check(lik, post, evidence, seed) -> dict:
     return out
 
 
-def _model_probabilities(results, prior_odds: dict) -> None:
-    """Posterior model probabilities from ln Z and the prior odds, in place."""
+def _model_probabilities(results, prior_odds: dict) -> list:
+    """The results with their posterior model probabilities (from ln Z and the prior odds) in
+    their criteria: new objects (``dataclasses.replace``); the structures without an evidence
+    are returned as they are."""
     with_z = [r for r in results if r.error is None and r.criteria.get("evidence") is not None]
     unknown = set(prior_odds) - {r.name for r in results}
     if unknown:
         raise InputError(f"prior odds given for unknown structure '{sorted(unknown)[0]}'")
     if not with_z:
-        return
+        return list(results)
     log_w = np.array([r.criteria["evidence"].log_z + math.log(prior_odds.get(r.name, 1.0))
                       for r in with_z])
     p = np.exp(log_w - log_w.max())
     p /= p.sum()
-    for r, prob in zip(with_z, p, strict=True):
-        r.criteria["posterior_probability"] = float(prob)
-
+    prob = {id(r): float(x) for r, x in zip(with_z, p, strict=True)}
+    return [replace(r, criteria=replace(r.criteria, posterior_probability=prob[id(r)]))
+            if id(r) in prob else r for r in results]

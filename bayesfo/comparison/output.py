@@ -15,6 +15,7 @@ from .._io import atomic_write_text
 from ..inference import save_netcdf
 from ..outdir import final_path, staged_run
 from .results import RANKING_FIELDS, Comparison
+from .stored import netcdf_for
 
 
 def ranking_csv(comparison: Comparison) -> str:
@@ -53,7 +54,8 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
                   formats=("png", "pdf"), pool=None) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
-    One NetCDF per structure, the figures (``formats``; see
+    One NetCDF per structure (arviz InferenceData with the attributes that :func:`load` needs,
+    see :mod:`bayesfo.comparison.stored`), the figures (``formats``; see
     :func:`bayesfo.plotting.write_figures`), ``report.html`` (self-contained, figures embedded),
     ``ranking.csv`` and ``summary.json``. Everything is written into a staging directory inside
     ``out_dir`` and swapped in at the end (:mod:`bayesfo.outdir`), so ``out_dir`` always holds the
@@ -85,7 +87,7 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     with staged_run(out_dir) as stage:
         for r in comparison.results:
             if r.posterior is not None:
-                written[r.name] = save_netcdf(r.posterior.idata, stage / f"{r.name}.nc")
+                written[r.name] = save_netcdf(netcdf_for(comparison, r), stage / f"{r.name}.nc")
         if figures:
             from ..plotting import write_figures
             from ..report import write_report

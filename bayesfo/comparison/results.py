@@ -16,6 +16,7 @@ from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.results import HDI_PROB
 from ..structures import Structure, coefficient_units, parameter_forms, picture_of
+from .criteria_types import Criteria
 
 #: Noise parameters sampled with a structure: ``sigma`` has the data's unit, ``sigma_rel`` none.
 NOISE_UNITS = {"sigma": "data", "sigma_rel": ""}
@@ -130,18 +131,25 @@ def physical_text(block: dict, key: str = "median") -> str:
 class StructureResult:
     """Everything computed for one structure on one data set.
 
-    ``error`` holds the reason when the structure could not be run (the other fields are None).
+    ``error`` holds the reason when the structure could not be run (the other fields are None,
+    the criteria empty). ``criteria`` is a :class:`~bayesfo.comparison.criteria_types.Criteria`;
+    a dict given instead is turned into one (:meth:`Criteria.from_dict`, which refuses unknown
+    keys).
     """
 
     structure: Structure
     fit: FitResult | None = None
     posterior: PosteriorResult | None = None
-    criteria: dict = field(default_factory=dict)
+    criteria: Criteria = field(default_factory=Criteria)
     error: str | None = None
     #: The kind and unit of the data the structure was run on (set by :class:`Comparison`);
     #: they give the parameters their units.
     data_kind: str | None = None
     data_units: str = ""
+
+    def __post_init__(self):
+        if not isinstance(self.criteria, Criteria):
+            object.__setattr__(self, "criteria", Criteria.from_dict(self.criteria or {}))
 
     @property
     def name(self) -> str:
@@ -192,6 +200,75 @@ class StructureResult:
             return None
         return "yes" if a.adequate else ("small" if a.misfit_small else "no")
 
+    def __repr__(self) -> str:
+        if self.error is not None:
+            return f"<StructureResult {self.name}: failed: {self.error}>"
+        parts = []
+        ev = self.criteria.get("evidence")
+        if ev is not None:
+            parts.append(f"ln Z = {_fmt(ev.log_z, '.2f')} ± {_fmt(ev.log_z_err, '.2f')}")
+        prob = self.criteria.get("posterior_probability")
+        if prob is not None:
+            parts.append(f"P = {prob:.3f}")
+        post = self.posterior
+        if post is not None:
+            parts.append(("certified" if post.converged else "NOT certified")
+                         + f" ({getattr(post, 'sampler', 'emcee')})")
+        if self.fits is not None:
+            parts.append(f"fits: {self.fits}")
+        return f"<StructureResult {self.name}: {', '.join(parts)}>"
+
+    def summary(self) -> str:
+        """A few lines on this structure: its evidence, certificate and adequacy, then each
+        parameter (the physical form where the structure has one) with its unit, posterior
+        median and 94 % HDI. ``print(result["zener"].summary())``."""
+        s = self.structure
+        head = f"{s.name}: {s.formula}"
+        if self.error is not None:
+            return f"{head}\n  failed: {self.error}"
+        post = self.posterior
+        lines = [head]
+        ev = self.criteria.get("evidence")
+        prob = self.criteria.get("posterior_probability")
+        lines.append(
+            "  ln Z = " + ("-" if ev is None else
+                           f"{_fmt(ev.log_z, '.2f')} ± {_fmt(ev.log_z_err, '.2f')} ({ev.method})")
+            + ("" if prob is None else f", P = {prob:.3f}")
+            + f", elpd_loo = {_fmt(self.criteria.get('loo'), '.2f')}"
+            + f", BIC = {_fmt(self.criteria.get('bic'), '.2f')}")
+        if post is not None:
+            lines.append(
+                f"  posterior: {getattr(post, 'sampler', 'emcee')}, "
+                + ("certified" if post.converged else "NOT certified")
+                + f" (R-hat {_fmt(post.rhat_max, '.3f')}, ESS {_fmt(post.ess_min, '.0f')}); "
+                f"noise {post.noise}; fits: {self.fits or '-'}")
+        phys = self.physical
+        if phys is not None:
+            block = dict(phys["physical"])
+            units = self.units
+            noise = {n: summarise_draws(post.samples[:, post.param_names.index(n)],
+                                        post.map_theta[post.param_names.index(n)],
+                                        units.get(n, ""))
+                     for n in post.param_names if n not in s.param_names}
+            block.update(noise)
+        elif post is not None:
+            units = self.units
+            block = {n: {"unit": units.get(n, ""), "median": v.median, "hdi_low": v.hdi_low,
+                         "hdi_high": v.hdi_high} for n, v in post.summary.items()}
+        else:
+            block = {}
+        if block:
+            width = max(len(n) for n in block)
+            lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI")
+            for n, v in block.items():
+                unit = f" {v['unit']}" if v.get("unit") else ""
+                lines.append(f"  {n:<{width}}  {_fmt(v.get('median'), '11.4g')}  "
+                             f"[{_fmt(v.get('hdi_low'), '.4g')}, {_fmt(v.get('hdi_high'), '.4g')}]"
+                             f"{unit}")
+        for w in self.criteria.get("warnings", ()):
+            lines.append(f"  ! {w}")
+        return "\n".join(lines)
+
     def to_dict(self) -> dict:
         s = self.structure
         out = {
@@ -237,7 +314,8 @@ class StructureResult:
             out[key] = self.criteria[key]
         for key in ("holdout_lpd", "holdout_rmse", "holdout_lpd_pointwise", "holdout_omega"):
             if key in self.criteria:
-                out[key] = self.criteria[key]
+                value = self.criteria[key]
+                out[key] = list(value) if isinstance(value, tuple) else value
         out.update(
             rhat_max=post.rhat_max, ess_min=post.ess_min, ess_bulk_min=post.ess_bulk_min,
             ess_tail_min=post.ess_tail_min, converged=post.converged, tau_max=float(np.max(post.tau)),
@@ -248,12 +326,20 @@ class StructureResult:
             importance=None if self.criteria.get("importance") is None else {
                 k: v for k, v in self.criteria["importance"].items() if k != "seconds"},
             adequacy=None if self.adequacy is None else self.adequacy.to_dict(),
-            warnings=self.criteria["warnings"],
-            optimum={"parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
-                     "rmse": self.fit.rmse, "starts": self.fit.n_starts,
-                     "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible},
+            warnings=list(self.criteria["warnings"]),
+            optimum=None if self.fit is None else {
+                "parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
+                "rmse": self.fit.rmse, "starts": self.fit.n_starts,
+                "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible},
         )
         return out
+
+
+def _fmt(value, spec: str) -> str:
+    """``value`` formatted by ``spec``, ``-`` for None and NaN."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    return format(value, spec)
 
 
 def _parent(structure) -> str | None:
@@ -320,59 +406,49 @@ class Comparison:
                 return r
         raise KeyError(name)
 
-    def table(self) -> list[dict]:
-        """One row per structure, best first (failed structures last), for printing or CSV."""
-        order = {n: i for i, n in enumerate(self.ranking)}
-        rows = []
-        ok = [r for r in self.results if r.error is None]
-        best_loo = max((r.criteria["loo"] for r in ok if math.isfinite(r.criteria["loo"])),
-                       default=math.nan)
-        evs = [r.criteria["evidence"].log_z for r in ok if r.criteria.get("evidence") is not None]
-        best_z = max(evs, default=math.nan)
-        ranks = {}
-        for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
-            # An undefined criterion (NaN, with its reason among the warnings) ranks last.
-            ordered = sorted(ok, key=lambda r, c=crit, g=sign: (
-                not math.isfinite(r.criteria[c]),
-                g * r.criteria[c] if math.isfinite(r.criteria[c]) else 0))
-            ranks[crit] = {r.name: i + 1 for i, r in enumerate(ordered)}
-        for r in sorted(self.results, key=lambda r: order.get(r.name, len(order))):
-            if r.error is not None:
-                rows.append({"rank": None, "structure": r.name, "n_params": r.structure.n_params,
-                             "error": r.error})
+    def __repr__(self) -> str:
+        ranking = self.ranking
+        best = ""
+        if ranking:
+            prob = self[ranking[0]].criteria.get("posterior_probability")
+            best = f"; best {ranking[0]}" + ("" if prob is None else f" (P = {prob:.3f})")
+        failed = sum(r.error is not None for r in self.results)
+        return (f"<Comparison of {len(self.results)} structure(s) on '{self.data.label}' "
+                f"({self.data.n_frequencies} frequencies, {self.data.kind}){best}"
+                + (f"; {failed} failed" if failed else "") + ">")
+
+    def summary(self) -> str:
+        """The ranking in a few lines: per structure ln Z ± error, Δln Z, the posterior
+        probability P, whether its posterior is certified and whether it fits the data
+        (posterior predictive checks); the structures that failed with their reason.
+        ``print(result.summary())``; per structure, :meth:`StructureResult.summary`."""
+        d = self.data
+        held = "" if self.holdout is None else f", {self.holdout.n_frequencies} held out"
+        lines = [f"{d.label}: {d.n_frequencies} frequencies{held} "
+                 f"({d.omega.min():.4g} to {d.omega.max():.4g} rad/s), {d.kind}; seed "
+                 f"{self.seed}; ranked by ln Z",
+                 f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
+                 f"{'certified':>9} {'fits':>5}"]
+        for row in self.table():
+            if row.get("error"):
+                lines.append(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  failed: "
+                             f"{row['error']}")
                 continue
-            c, p = r.criteria, r.posterior
-            q = p.summary.get("q") or p.summary.get("beta")
-            ev = c.get("evidence")
-            log_z = None if ev is None else ev.log_z
-            rows.append({
-                "rank": order[r.name] + 1, "structure": r.name, "n_params": r.structure.n_params,
-                "parent": _parent(r.structure), "log_evidence": log_z, "log_evidence_err": None if ev is None else ev.log_z_err,
-                "evidence_method": None if ev is None else ev.method,
-                "delta_log_evidence": None if ev is None else log_z - best_z,
-                "bayes_factor": None if ev is None else math.exp(log_z - best_z),
-                "posterior_probability": c.get("posterior_probability"),
-                "evidence_agree": c.get("evidence_agree"),
-                **{f"rank_{k}": v[r.name] for k, v in ranks.items()},
-                "loo": c["loo"], "loo_se": c["loo_se"], "delta_loo": c["loo"] - best_loo,
-                "waic": c["waic"], "aic": c["aic"], "aicc": c["aicc"], "bic": c["bic"],
-                "max_log_likelihood": c["max_log_likelihood"], "rmse": c["rmse"],
-                "holdout_lpd": c.get("holdout_lpd"), "holdout_rmse": c.get("holdout_rmse"),
-                "q_mean": None if q is None else q.mean, "q_sd": None if q is None else q.sd,
-                "pareto_k_max": c["pareto_k_max"], "rhat_max": p.rhat_max, "ess_min": p.ess_min,
-                "converged": p.converged, "sampler": getattr(p, "sampler", "emcee"),
-                "fits": r.fits, "adequate": None if r.adequacy is None else r.adequacy.adequate,
-                "adequacy_p_min": None if r.adequacy is None else min(r.adequacy.p_values.values()),
-                "max_phase_error_deg": None if r.adequacy is None
-                else r.adequacy.max_phase_error_deg,
-                "max_log10_magnitude_error": None if r.adequacy is None
-                else r.adequacy.max_log10_magnitude_error,
-                "error": "",
-                # Posterior medians of the physical parameters, with units, as one text cell.
-                "physical_parameters": "" if r.physical is None
-                else physical_text(r.physical["physical"]),
-            })
-        return rows
+            z = ("-" if row["log_evidence"] is None else
+                 f"{_fmt(row['log_evidence'], '.2f')} ± {_fmt(row['log_evidence_err'], '.2f')}")
+            lines.append(
+                f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} "
+                f"{_fmt(row['delta_log_evidence'], '.2f'):>8} "
+                f"{_fmt(row['posterior_probability'], '.3f'):>6} "
+                f"{'yes' if row['converged'] else 'NO':>9} {(row['fits'] or '-'):>5}")
+        for w in self.data_warnings:
+            lines.append(f"! {w}")
+        return "\n".join(lines)
+
+    def table(self) -> list[dict]:
+        """One row per structure, best first (failed structures last), for printing or CSV
+        (:func:`ranking_rows` of the structures' ``summary.json`` records)."""
+        return ranking_rows([r.to_dict() for r in self.results], self.ranking)
 
     def to_dataframe(self):
         """The ranking table as a ``pandas.DataFrame`` with a ``data`` column naming the data
@@ -463,6 +539,101 @@ class Comparison:
                                                    for m in members)),
             })
         return sorted(out, key=lambda f: -f["log_evidence"])
+
+
+def order_parameter(parameters) -> str | None:
+    """The name of the fractional order among ``parameters`` (names or a dict by name): ``q``,
+    else ``beta`` (the generalised Maxwell model), else None."""
+    return next((k for k in ("q", "beta") if k in parameters), None)
+
+
+def _finite_or_none(value) -> bool:
+    return value is not None and math.isfinite(value)
+
+
+def ranking_rows(structures, ranking) -> list[dict]:
+    """The rows of the ranking table (:data:`RANKING_FIELDS`), one per structure, best first
+    and structures that could not be run last: the one definition of a ranking row, used by
+    :meth:`Comparison.table` and by ``bayesfo batch`` (from a stored ``summary.json``).
+
+    Parameters
+    ----------
+    structures : sequence of dict
+        Each structure's record as ``summary.json`` holds it (:meth:`StructureResult.to_dict`,
+        in the order the structures were run). Missing entries are None in the row; a number
+        that is None (JSON's null for NaN or infinity) ranks last, like NaN.
+    ranking : sequence of str
+        The structure names, best first (:attr:`Comparison.ranking`).
+
+    Returns
+    -------
+    list of dict
+        Failed structures: ``rank`` None, ``structure``, ``n_params``, ``error``.
+    """
+    order = {n: i for i, n in enumerate(ranking)}
+    ok = [s for s in structures if "error" not in s]
+    loos = [s.get("loo") for s in ok if _finite_or_none(s.get("loo"))]
+    best_loo = max(loos, default=math.nan)
+    best_z = max((s["log_evidence"] for s in ok if s.get("log_evidence") is not None),
+                 default=math.nan)
+    ranks = {}
+    for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
+        # An undefined criterion (NaN, with its reason among the warnings) ranks last.
+        ordered = sorted(ok, key=lambda s, c=crit, g=sign: (
+            not _finite_or_none(s.get(c)), g * s[c] if _finite_or_none(s.get(c)) else 0))
+        ranks[crit] = {s["name"]: i + 1 for i, s in enumerate(ordered)}
+    rows = []
+    for s in sorted(structures, key=lambda s: order.get(s["name"], len(order))):
+        name = s["name"]
+        if "error" in s:
+            rows.append({"rank": None, "structure": name, "n_params": s.get("n_params"),
+                         "error": s["error"]})
+            continue
+        params = s.get("parameters") or {}
+        q_name = order_parameter(params)
+        q = params[q_name] if q_name is not None else None
+        log_z = s.get("log_evidence")
+        loo = s.get("loo")
+        adequacy = s.get("adequacy")
+        if adequacy is None:
+            fits = None
+        else:
+            fits = ("yes" if adequacy.get("adequate")
+                    else "small" if adequacy.get("misfit_small") else "no")
+        p_values = None if adequacy is None else [
+            math.nan if v is None else v for v in adequacy.get("p_values", {}).values()]
+        rows.append({
+            "rank": order[name] + 1 if name in order else None, "structure": name,
+            "n_params": s.get("n_params"), "parent": s.get("parent"), "log_evidence": log_z,
+            "log_evidence_err": s.get("log_evidence_err"),
+            "evidence_method": s.get("evidence_method"),
+            "delta_log_evidence": None if log_z is None else log_z - best_z,
+            "bayes_factor": None if log_z is None else math.exp(log_z - best_z),
+            "posterior_probability": s.get("posterior_probability"),
+            "evidence_agree": s.get("evidence_agree"),
+            **{f"rank_{k}": v[name] for k, v in ranks.items()},
+            "loo": loo, "loo_se": s.get("loo_se"),
+            "delta_loo": None if loo is None else loo - best_loo,
+            "waic": s.get("waic"), "aic": s.get("aic"), "aicc": s.get("aicc"),
+            "bic": s.get("bic"), "max_log_likelihood": s.get("max_log_likelihood"),
+            "rmse": s.get("rmse"),
+            "holdout_lpd": s.get("holdout_lpd"), "holdout_rmse": s.get("holdout_rmse"),
+            "q_mean": None if q is None else q.get("mean"),
+            "q_sd": None if q is None else q.get("sd"),
+            "pareto_k_max": s.get("pareto_k_max"), "rhat_max": s.get("rhat_max"),
+            "ess_min": s.get("ess_min"), "converged": s.get("converged"),
+            "sampler": s.get("sampler"), "fits": fits,
+            "adequate": None if adequacy is None else adequacy.get("adequate"),
+            "adequacy_p_min": None if not p_values else min(p_values),
+            "max_phase_error_deg": None if adequacy is None
+            else adequacy.get("max_phase_error_deg"),
+            "max_log10_magnitude_error": None if adequacy is None
+            else adequacy.get("max_log10_magnitude_error"),
+            "error": "",
+            # Posterior medians of the physical parameters, with units, as one text cell.
+            "physical_parameters": physical_text(s.get("parameters_physical")),
+        })
+    return rows
 
 
 RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "log_evidence_err",

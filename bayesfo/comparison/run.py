@@ -42,6 +42,7 @@ from ..options import EVIDENCE_ROUTES, SAMPLERS
 from ..parallel import available_cpus, process_pool
 from ..structures import Structure, resolve_structures
 from .criteria import _criteria, _evidence, _evidence_check, _holdout, _model_probabilities
+from .criteria_types import Criteria
 from .results import Comparison, StructureResult, data_problems
 
 
@@ -165,7 +166,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         results.append(result)
     if all(r.error is not None for r in results):
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
-    _model_probabilities(results, prior_odds or {})
+    results = _model_probabilities(results, prior_odds or {})
     return Comparison(data, tuple(results), seed, holdout=test)
 
 
@@ -465,7 +466,7 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
                 criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
             if test is not None:
                 criteria.update(_holdout(lik, post, test))
-            result = StructureResult(s, fit, post, criteria)
+            result = StructureResult(s, fit, post, Criteria.from_dict(criteria))
         except InputError as exc:
             result = StructureResult(s, error=str(exc))
     seen = set()

@@ -1,0 +1,350 @@
+"""A comparison read back from its output directory (:func:`load`), and what
+:func:`~bayesfo.comparison.output.write_outputs` stores in each structure's NetCDF so that it can
+be (:func:`netcdf_for`).
+
+``summary.json`` holds every number of the contract; each ``<structure>.nc`` holds the draws,
+the pointwise log-likelihood, the posterior predictive and the data. Besides arviz' groups, each
+NetCDF carries these attributes (format :data:`NETCDF_FORMAT`):
+
+``posterior``
+    ``bayesfo_format``; the sampler's ``n_steps``, ``burn``, ``thin``, ``acceptance`` and
+    ``tau`` (per parameter); the evidence's ``evidence_n_likelihood``, ``evidence_seconds``
+    and, for a tempered ladder, ``evidence_reached_log_likelihood``.
+``log_likelihood``
+    ``pareto_k`` and ``loo_pointwise``: PSIS-LOO's Pareto k̂ and elpd per frequency.
+``observed_data``
+    ``sigma`` (per frequency) when the data carry σ; with held-out frequencies their
+    ``holdout_omega``, ``holdout_real``, ``holdout_imag`` (and ``holdout_sigma``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..errors import InputError
+from ..identify.optimize import FitResult
+from ..inference import PosteriorResult
+from ..inference.adequacy import Adequacy
+from ..inference.evidence import Evidence
+from ..inference.results import ParameterSummary
+from ..structures import Scaling
+from .criteria_types import Criteria
+from .results import Comparison, StructureResult
+
+#: Version of the attributes :func:`netcdf_for` adds (``posterior.attrs["bayesfo_format"]``).
+NETCDF_FORMAT = 1
+
+#: Criteria that summary.json holds as plain numbers (null where not finite).
+_NUMBERS = ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
+            "pareto_k_max", "rmse")
+_HOLDOUT = ("holdout_lpd", "holdout_rmse", "holdout_lpd_pointwise", "holdout_omega")
+
+
+# ---------------------------------------------------------------------- writing
+def netcdf_for(comparison: Comparison, result: StructureResult):
+    """The InferenceData of ``result`` as its NetCDF stores it: a shallow copy of
+    ``result.posterior.idata`` (the result is left as it was) with the attributes
+    :func:`load` needs (see the module's docstring)."""
+    from ..inference._arviz import arviz
+
+    post = result.posterior
+    idata = post.idata
+    groups = {g: idata[g].copy(deep=False) for g in idata.groups()}
+    copy = arviz().InferenceData(attrs=dict(getattr(idata, "attrs", {}) or {}), **groups)
+    stats = {"bayesfo_format": NETCDF_FORMAT, "n_steps": int(post.n_steps),
+             "burn": int(post.burn), "thin": int(post.thin),
+             "acceptance": float(post.acceptance),
+             "tau": np.asarray(post.tau, dtype=float).ravel()}
+    ev = result.criteria.get("evidence")
+    if ev is not None:
+        for key, value in (("n_likelihood", ev.n_likelihood), ("seconds", ev.seconds),
+                           ("reached_log_likelihood", ev.reached_log_likelihood)):
+            if value is not None:
+                stats[f"evidence_{key}"] = value
+    copy.posterior.attrs.update(stats)
+    loo = {k: np.asarray(result.criteria[k], dtype=float)
+           for k in ("pareto_k", "loo_pointwise") if k in result.criteria}
+    copy.log_likelihood.attrs.update(loo)
+    data, held = comparison.data, comparison.holdout
+    observed = {}
+    if data.sigma is not None:
+        observed["sigma"] = np.asarray(data.sigma, dtype=float)
+    if held is not None:
+        observed.update(holdout_omega=held.omega, holdout_real=held.response.real,
+                        holdout_imag=held.response.imag)
+        if held.sigma is not None:
+            observed["holdout_sigma"] = np.asarray(held.sigma, dtype=float)
+    copy.observed_data.attrs.update(observed)
+    return copy
+
+
+# ---------------------------------------------------------------------- reading
+def load(directory, *, models=()) -> Comparison:
+    """The :class:`Comparison` that wrote ``directory`` (``bf.write_outputs`` or
+    ``bayesfo compare --out DIR``), read from its ``summary.json`` and NetCDF files without
+    running anything.
+
+    Everything comes from those files: the data (frequencies, response, σ, held-out points,
+    kind, units, name, source and notes), each structure's posterior (the draws, the
+    pointwise log-likelihood and the InferenceData as stored; summaries, diagnostics, noise
+    model and sampler details), its criteria (with the evidence, the nested-sampling check,
+    the noise-model record, the adequacy checks and the warnings) and the optimiser's optimum.
+    ``load(d).to_summary()`` is the ``summary.json`` of ``d``, and ``load(d).table()`` the
+    rows of the comparison that wrote it. Numbers that ``summary.json`` holds as null (not
+    finite) come back as NaN.
+
+    What is not stored is None: ``FitResult.theta_scaled``, ``chi2``, ``weighting``,
+    ``n_admissible`` and ``optima`` (the optimiser's details; its ``scaling`` is recomputed
+    from the data, as ``compare`` computes it); ``PosteriorResult.samples_scaled`` (the draws on
+    the scaled problem). The evidence's ``n_likelihood``, ``seconds`` and
+    ``reached_log_likelihood`` are None when the NetCDF does not hold them.
+
+    Parameters
+    ----------
+    directory : path
+        The output directory.
+    models : sequence of path, optional
+        Card files or directories of structures that are not packaged (``--models``).
+
+    Raises
+    ------
+    InputError
+        A missing directory, ``summary.json`` or NetCDF file, or one that cannot be read or is
+        not what ``compare`` writes: the message names the file and what is wrong.
+    """
+    from ..structures import default_library, load_library
+
+    d = Path(directory)
+    if not d.is_dir():
+        raise InputError(f"'{d}': " + ("not a directory" if d.exists() else "no such directory")
+                         + "; give the output directory of bayesfo compare")
+    path = d / "summary.json"
+    if not path.is_file():
+        raise InputError(f"'{path}': missing, so '{d}' holds no complete output of bayesfo "
+                         "compare")
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise InputError(f"'{path}': not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except ValueError as exc:
+        raise InputError(f"'{path}': not valid JSON ({exc})") from None
+    except OSError as exc:
+        raise InputError(f"'{path}': cannot be read ({exc.strerror or exc})") from None
+    library = load_library(extra=list(models)) if models else default_library()
+    try:
+        return _comparison(summary, d, library)
+    except InputError:
+        raise
+    except KeyError as exc:
+        raise InputError(f"'{path}': entry {exc} is missing: not a summary.json of bayesfo "
+                         "compare") from None
+    except (TypeError, ValueError, AttributeError, IndexError) as exc:
+        raise InputError(f"'{path}': unexpected content ({exc}): not a summary.json of "
+                         "bayesfo compare") from None
+
+
+def _num(value) -> float:
+    """A number of summary.json: null (not finite when written) is NaN."""
+    return math.nan if value is None else float(value)
+
+
+def _read_netcdf(path: Path, name: str):
+    from ..inference._arviz import arviz
+
+    if not path.is_file():
+        raise InputError(f"'{path}': missing (summary.json lists structure '{name}' with a "
+                         "posterior)")
+    az = arviz()
+    try:
+        with az.rc_context({"data.load": "eager"}), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            idata = az.from_netcdf(path)
+    except Exception as exc:  # h5py, h5netcdf and xarray raise many kinds on a damaged file
+        raise InputError(f"'{path}': cannot be read as NetCDF ({type(exc).__name__}: "
+                         f"{exc})") from None
+    missing = [g for g in ("posterior", "log_likelihood", "observed_data")
+               if g not in idata.groups()]
+    if missing:
+        raise InputError(f"'{path}': no '{missing[0]}' group: not a NetCDF of bayesfo compare")
+    if idata.posterior.attrs.get("bayesfo_format") is None:
+        raise InputError(f"'{path}': written by an earlier version of bayesfo, without what "
+                         "load needs (burn-in, thinning, σ, PSIS-LOO per frequency); run "
+                         "compare again")
+    return idata
+
+
+def _data(summary: dict, idata, path: Path) -> tuple[FrequencyResponse, FrequencyResponse | None]:
+    meta = summary["data"]
+    obs = idata.observed_data
+    omega = np.asarray(obs["omega"].values, dtype=float)
+    response = np.empty(omega.shape, dtype=complex)
+    response.real = obs["G_real"].values
+    response.imag = obs["G_imag"].values
+    # NetCDF gives an attribute of one element back as a scalar.
+    attrs = {k: np.atleast_1d(v) if k == "sigma" or k.startswith("holdout_") else v
+             for k, v in obs.attrs.items()}
+    common = dict(kind=meta["kind"], units=meta.get("units") or "", name=meta["name"],
+                  source=meta.get("path") or "")
+    data = FrequencyResponse(omega, response, attrs.get("sigma"), notes=tuple(meta["notes"]),
+                             **common)
+    if data.n_frequencies != meta["n_frequencies"]:
+        raise InputError(f"'{path}': {data.n_frequencies} frequencies, but summary.json says "
+                         f"{meta['n_frequencies']}")
+    if "holdout_omega" not in meta:
+        return data, None
+    if "holdout_omega" not in attrs:
+        raise InputError(f"'{path}': summary.json names held-out frequencies, but the NetCDF "
+                         "does not hold them")
+    held = np.empty(np.size(attrs["holdout_omega"]), dtype=complex)
+    held.real = attrs["holdout_real"]
+    held.imag = attrs["holdout_imag"]
+    holdout = FrequencyResponse(attrs["holdout_omega"], held,
+                                attrs.get("holdout_sigma"), notes=data.notes, **common)
+    return data, holdout
+
+
+def _comparison(summary: dict, d: Path, library) -> Comparison:
+    from ..structures import get_structure
+
+    entries = summary["structures"]
+    files = {}
+    for s in entries:
+        if "error" not in s:
+            files[s["name"]] = _read_netcdf(d / f"{s['name']}.nc", s["name"])
+    if not files:
+        raise InputError(f"'{d / 'summary.json'}': no structure has a posterior")
+    first = next(iter(files))
+    data, holdout = _data(summary, files[first], d / f"{first}.nc")
+    results = []
+    for s in entries:
+        name = s["name"]
+        try:
+            structure = get_structure(name, library)
+        except InputError as exc:
+            raise InputError(f"'{d / 'summary.json'}': structure '{name}' is not in the "
+                             f"library ({exc}); give its card with models=") from None
+        if structure.n_params != s["n_params"] or structure.formula != s["formula"]:
+            raise InputError(f"'{d / 'summary.json'}': the card of '{name}' differs from the "
+                             "one the run used (parameters or formula)")
+        if "error" in s:
+            results.append(StructureResult(structure, error=s["error"]))
+            continue
+        path = d / f"{name}.nc"
+        idata = files[name]
+        if not np.array_equal(np.asarray(idata.observed_data["omega"].values), data.omega):
+            raise InputError(f"'{path}': its frequencies differ from those of '{first}.nc'")
+        post = _posterior(s, idata, data, path)
+        results.append(StructureResult(structure, _fit(s, data), post,
+                                       _criteria(s, idata)))
+    return Comparison(data, tuple(results), int(summary["seed"]),
+                      ranked_by=summary.get("ranked_by", "log_evidence"), holdout=holdout)
+
+
+def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> PosteriorResult:
+    params = s["parameters"]
+    names = tuple(params)
+    draws = idata.posterior
+    missing = [n for n in names if n not in draws]
+    if missing:
+        raise InputError(f"'{path}': no draws of parameter '{missing[0]}'")
+    samples = np.column_stack([np.asarray(draws[n].values, dtype=float).reshape(-1)
+                               for n in names])
+    if samples.shape[0] != s["n_draws"]:
+        raise InputError(f"'{path}': {samples.shape[0]} draws, but summary.json says "
+                         f"{s['n_draws']}")
+    pointwise = np.asarray(idata.log_likelihood["G"].values, dtype=float)
+    loglik = pointwise.reshape(-1, data.n_frequencies).sum(axis=1)
+    fields = [f.name for f in dataclasses.fields(ParameterSummary)]
+    summary = {n: ParameterSummary(**{
+        f: bool(params[n][f]) if f in ("poorly_determined", "multimodal") else _num(params[n][f])
+        for f in fields}) for n in names}
+    attrs = draws.attrs
+    return PosteriorResult(
+        structure=s["name"], param_names=names, noise=s["noise"], noise_reason=s["noise_reason"],
+        samples=samples, samples_scaled=None, log_likelihood=loglik, summary=summary,
+        map_theta=np.array([_num(params[n]["map"]) for n in names]),
+        max_log_likelihood=float(loglik.max()),
+        tau=np.atleast_1d(np.asarray(attrs["tau"], dtype=float)), n_steps=int(s["n_steps"]),
+        burn=int(attrs["burn"]), thin=int(attrs["thin"]), n_walkers=int(draws.sizes["chain"]),
+        acceptance=float(attrs["acceptance"]), rhat_max=_num(s["rhat_max"]),
+        ess_bulk_min=_num(s["ess_bulk_min"]), ess_tail_min=_num(s["ess_tail_min"]),
+        converged=bool(s["converged"]), messages=tuple(s["messages"]), idata=idata,
+        sampler=s["sampler"])
+
+
+def _fit(s: dict, data: FrequencyResponse) -> FitResult:
+    opt = s["optimum"]
+    return FitResult(
+        structure=s["name"], param_names=tuple(opt["parameters"]),
+        theta=np.array([_num(v) for v in opt["parameters"].values()]), theta_scaled=None,
+        rmse=_num(opt["rmse"]), chi2=None, weighting=None, admissible=bool(opt["admissible"]),
+        n_starts=int(opt["starts"]), n_admissible=None, n_at_best=int(opt["starts_at_optimum"]),
+        optima=None, scaling=Scaling.from_data(data))
+
+
+def _evidence(block: dict | None, attrs=None) -> Evidence | None:
+    if block is None:
+        return None
+    attrs = attrs or {}
+
+    def extra(key, cast):
+        value = block.get(key, attrs.get(f"evidence_{key}"))
+        return None if value is None else cast(value)
+
+    return Evidence(log_z=_num(block["log_z"]), log_z_err=_num(block["log_z_err"]),
+                    method=block["method"], log_support=_num(block["log_support"]),
+                    n_likelihood=extra("n_likelihood", int), seconds=extra("seconds", float),
+                    reached_log_likelihood=extra("reached_log_likelihood", float))
+
+
+def _adequacy(block: dict | None) -> Adequacy | None:
+    if block is None:
+        return None
+    return Adequacy(
+        adequate=bool(block["adequate"]),
+        p_values={k: _num(v) for k, v in block["p_values"].items()},
+        statistics={k: _num(v) for k, v in block["statistics"].items()},
+        level=_num(block["level"]), max_phase_error_deg=_num(block["max_phase_error_deg"]),
+        max_phase_error_omega=_num(block["max_phase_error_omega"]),
+        max_log10_magnitude_error=_num(block["max_log10_magnitude_error"]),
+        max_log10_magnitude_error_omega=_num(block["max_log10_magnitude_error_omega"]),
+        systematic_at_omega=tuple(_num(w) for w in block["systematic_at_omega"]),
+        systematic_bands=tuple((_num(b["omega_low"]), _num(b["omega_high"]), b["description"])
+                               for b in block["systematic_bands"]),
+        outside_band_omega=tuple(_num(w) for w in block["outside_band_omega"]),
+        noise=block["noise"],
+        noise_scale=None if block["noise_scale"] is None else float(block["noise_scale"]),
+        noise_scale_implausible=bool(block["noise_scale_implausible"]),
+        misfit_small=bool(block["misfit_small"]), reasons=tuple(block["reasons"]),
+        summary=block["summary"], n_draws=int(block["n_draws"]),
+        n_reference=int(block["n_reference"]), seed=int(block["seed"]))
+
+
+def _criteria(s: dict, idata) -> Criteria:
+    values = {k: _num(s[k]) for k in _NUMBERS}
+    loo = idata.log_likelihood.attrs
+    for key in ("pareto_k", "loo_pointwise"):
+        if key in loo:
+            values[key] = tuple(float(v) for v in np.atleast_1d(loo[key]))
+    method = s.get("evidence_method")
+    main = None if method is None else {
+        "log_z": s["log_evidence"], "log_z_err": s["log_evidence_err"], "method": method,
+        "log_support": s["log_prior_support"]}
+    values.update(
+        priors=s["priors"], warnings=tuple(s["warnings"]), importance=s.get("importance"),
+        evidence=_evidence(main, idata.posterior.attrs),
+        evidence_check=_evidence(s.get("evidence_check")),
+        evidence_agree=s.get("evidence_agree"), noise_models=s.get("noise_models"),
+        adequacy=_adequacy(s.get("adequacy")),
+        posterior_probability=s.get("posterior_probability"))
+    for key in _HOLDOUT:
+        if key in s:
+            values[key] = _num(s[key]) if key in ("holdout_lpd", "holdout_rmse") else s[key]
+    return Criteria.from_dict(values)

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from bayesfo.comparison.results import summarise_draws
+from bayesfo.comparison.parameters import summarise_draws
 from bayesfo.inference.posterior import _snooker_move
 
 

@@ -35,7 +35,7 @@ except PackageNotFoundError:  # run from a source tree that is not installed
 
 from .data import FrequencyResponse, read, read_csv  # noqa: E402
 from .errors import BayesfoError, InputError, NonlinearityWarning, OutputError, StructureError  # noqa: E402
-from .structures import get_structure, resolve_structures  # noqa: E402
+from .structures import get_structure, list_structures, resolve_structures  # noqa: E402
 
 #: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
 #: ``import bayesfo`` and ``bayesfo --help`` stay fast.
@@ -43,11 +43,18 @@ _LAZY = {"compare": "comparison", "write_outputs": "comparison", "load": "compar
          "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison"}
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        import importlib
+#: Subpackages reachable as attributes without an import of their own (``bf.plotting``), loaded
+#: on first use: matplotlib is imported only by a program that draws.
+_LAZY_MODULES = ("plotting", "inference", "identify", "batch")
 
+
+def __getattr__(name):
+    import importlib
+
+    if name in _LAZY:
         return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    if name in _LAZY_MODULES:
+        return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module 'bayesfo' has no attribute {name!r}")
 
 __all__ = [
@@ -66,6 +73,7 @@ __all__ = [
     "StructureError",
     "__version__",
     "get_structure",
+    "list_structures",
     "read_csv",
     "resolve_structures",
 ]

@@ -82,6 +82,7 @@ from .cards import (
                     card_paths,
                     default_library,
                     get_structure,
+                    list_structures,
                     load_library,
                     picture_for,
                     resolve_structures,
@@ -106,7 +107,7 @@ from .variants import fix_parameters, integer_variant, inverted_variant
 __all__ = ["CARD_KEYS", "MAX_DEGREE", "MODEL_PATH_ENV", "N_MAX_DEFAULT", "Exponent", "Inequality",
            "Library", "Parameter", "Picture", "Scaling", "Structure", "Term", "card_paths",
            "coefficient_units", "coefficients_from_physical", "default_library",
-           "fix_parameters", "get_structure", "integer_variant", "inverted_variant",
+           "fix_parameters", "get_structure", "integer_variant", "inverted_variant", "list_structures",
            "load_library", "parameter_forms", "physical_dimensions", "physical_parameters", "physical_units",
            "picture_for", "picture_of", "resolve_structures", "stress_unit",
            "structures_from_card"]

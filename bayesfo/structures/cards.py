@@ -361,6 +361,45 @@ def default_library() -> Library:
     return _DEFAULT_LIBRARY
 
 
+def list_structures(models=()):
+    """The structures available to :func:`~bayesfo.comparison.compare`, one row each.
+
+    Parameters
+    ----------
+    models : sequence of path-like, optional
+        Additional card files or directories (a user's own structures), as ``--models``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``name``, ``title``, ``formula`` (compliance form of the card), ``n_params``,
+        ``parameters`` (comma list), ``family``, ``integer`` and ``inverted`` (the variants of
+        a card), ``aliases`` (other names ``compare`` accepts, comma list) and ``picture`` (the
+        mechanical model of its physical parameters; empty without one).
+
+    Examples
+    --------
+    >>> import bayesfo as bf
+    >>> table = bf.list_structures()
+    >>> table.set_index("name").loc["fractional_kelvin_voigt", "aliases"]
+    'fkv, fractional_kelvin_voigt_model'
+    >>> bool((table["name"] == "maxwell-int").any())
+    True
+    """
+    import pandas as pd
+
+    lib = load_library(extra=models) if models else default_library()
+    rows = []
+    for s in lib.values():
+        rows.append({
+            "name": s.name, "title": s.title, "formula": s.formula, "n_params": s.n_params,
+            "parameters": ", ".join(s.param_names), "family": s.family, "integer": s.integer,
+            "inverted": s.inverted, "aliases": ", ".join(s.aliases),
+            "picture": s.pictures[0].title if s.pictures else "",
+        })
+    return pd.DataFrame(rows)
+
+
 def get_structure(name: str, library: dict[str, Structure] | None = None) -> Structure:
     """The structure called ``name`` (e.g. ``"zener"``, ``"max-n2m1"``, ``"zener-inv-int"``)
     or one of its aliases (``"fractional_kelvin_voigt"``, ``"fzss"``)."""

@@ -28,7 +28,7 @@ Examples
 >>> from bayesfo.structures import get_structure
 >>> voigt = get_structure("voigt")
 >>> phys = physical_parameters(voigt, {"a1": 0.5, "b0": 1e-3, "q": 0.4}, "modulus", "Pa")
->>> phys["G_e"], phys["V"]
+>>> phys["G_e"], phys["c_q"]
 ((array(1000.), 'Pa'), (array(500.), 'Pa s^q'))
 """
 

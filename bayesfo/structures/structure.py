@@ -45,6 +45,7 @@ class Structure:
     Examples
     --------
     >>> import numpy as np
+    >>> from bayesfo.structures import get_structure
     >>> voigt = get_structure("voigt")
     >>> voigt.param_names
     ('a1', 'b0', 'q')

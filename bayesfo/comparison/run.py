@@ -265,9 +265,9 @@ def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dic
         try:
             post, ev, info = importance_posterior(lik, modes, seed=seed)
         except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
-            post = ev = None
+            post, ev, info = None, None, {}
         if post is None and options["evidence"] == "auto" and not options["sampler_kwargs"]:
-            post, ev, runs = _ladder_first(lik, seed)
+            post, ev, runs = _ladder_first(lik, seed, info.get("proposal_draws"))
     if post is None:
         post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
                                 fit=fit, progress=False,
@@ -286,7 +286,7 @@ def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dic
     return {"lik": lik, "post": post, "criteria": criteria}
 
 
-def _ladder_first(lik, seed: int):
+def _ladder_first(lik, seed: int, guide=None):
     """Where importance sampling does not certify the posterior (ridges, several regions), the
     tempered ladder's two independent runs: their final particles are the posterior when the
     runs agree (R-hat < 1.01, ESS ≥ 400; see
@@ -298,9 +298,14 @@ def _ladder_first(lik, seed: int):
     either springpot vanishes), where emcee's walkers stop uncertified after 3 250 steps and a
     guided ladder followed: the ladder alone certifies it on six seeds out of six, with 1.6
     million likelihood evaluations in large batches (5–10 s on the loaded 2-core machine, where
-    the emcee route took 12–15 s)."""
+    the emcee route took 12–15 s).
+
+    ``guide``: the importance proposal's draws (sampling coordinates), which cover every optimum
+    found; the ladder's independence moves propose from them too, so that a narrow mode with
+    little prior mass that the optimiser found is not lost (see
+    :func:`~bayesfo.inference.smc.ladder_run`)."""
     try:
-        ev, runs = ladder_runs(lik, seed=seed)
+        ev, runs = ladder_runs(lik, seed=seed, guide=guide)
     except InputError:
         return None, None, None
     post = posterior_from_particles(lik, runs, seed=seed)

@@ -213,10 +213,13 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
 
 
 def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_runs: int = 2,
-                guide: PosteriorResult | None = None, **ladder_kwargs) -> tuple:
+                guide: PosteriorResult | np.ndarray | None = None, **ladder_kwargs) -> tuple:
     """:func:`ladder_evidence` and the runs it came from (their final particles are
     independent sets of posterior draws: see
     :func:`~bayesfo.inference.posterior.posterior_from_particles`).
+
+    ``guide`` is a posterior result (e.g. emcee's, converged or not) or draws in the sampling
+    coordinates (e.g. the importance proposal's, which cover every optimum).
 
     Returns
     -------
@@ -227,7 +230,10 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
         raise ValueError("n_runs must be at least 2 (their spread is part of the error)")
     children = np.random.SeedSequence(seed).spawn(n_runs)
     values, errors, calls, reached, runs = [], [], 0, [], []
-    guide_u = None if guide is None else _Transform(lik).to_u(guide.samples_scaled)
+    if guide is None or isinstance(guide, np.ndarray):
+        guide_u = guide
+    else:
+        guide_u = _Transform(lik).to_u(guide.samples_scaled)
     for i, child in enumerate(children):
         run = ladder_run(lik, np.random.default_rng(child), n_particles=n_particles,
                          guide=guide_u, **ladder_kwargs)

@@ -186,6 +186,11 @@ def _mvt(factors, means, log_weights, n: int, rng: np.random.Generator):
     return x, log_pdf
 
 
+#: Proposal draws handed on as the guide of the tempered ladder where the weights do not certify
+#: the posterior.
+GUIDE_DRAWS = 2000
+
+
 def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
                          n_proposals: int = 20_000, n_draws: int = 2000, chains: int = 4,
                          predictive: bool = True):
@@ -209,7 +214,9 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     -------
     (PosteriorResult, Evidence or None, dict) or (None, None, dict)
         The dict states the certificate (``k_hat``, ``ess`` of the weights, ``n_modes``,
-        ``seconds``) or, when the route does not apply, ``reason``. The evidence is None when
+        ``seconds``) or, when the route does not apply, ``reason`` (and, where the weights
+        were computed but do not certify, ``proposal_draws``: up to :data:`GUIDE_DRAWS` draws
+        of the proposal in the sampling coordinates, a guide for the tempered ladder). The evidence is None when
         0.5 ≤ k̂ < 0.7 (see :data:`K_HAT_EVIDENCE`). The posterior's ESS is that of the
         resampled draws, 1/(1/ESS_weights + 1/n_draws).
     """
@@ -242,6 +249,10 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     if not (k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE):
         info["reason"] = (f"importance weights not certified (Pareto k {k_hat:.2f}, ESS "
                           f"{ess:.0f})")
+        # The proposal's draws cover every optimum: they guide the samplers that take over
+        # (an array, so only on this path: a certified run's info goes into summary.json).
+        xs = x[finite]
+        info["proposal_draws"] = xs[rng.permutation(len(xs))[:GUIDE_DRAWS]]
         return None, None, info
     # Evidence: the mean of the raw weights over every proposal draw (zero outside the
     # support), with the standard error of a mean. That error needs weights of finite

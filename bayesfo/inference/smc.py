@@ -79,6 +79,56 @@ class _Target:
         self.calls += int(np.count_nonzero(np.isfinite(log_prior)))
         return log_prior, log_lik
 
+    def unchecked(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As a call, but without the structure's constraints (stability, dissipation,
+        inequalities): only the prior box. :func:`_accept` checks them where a move would
+        be accepted."""
+        lik, tr = self.lik, self.tr
+        log_prior = np.full(u.shape[0], -np.inf)
+        log_lik = np.full(u.shape[0], -np.inf)
+        rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
+        if rows.size:
+            theta = tr.to_theta(u[rows])
+            lp = np.full(rows.size, tr.flat_const)
+            for i, prior in tr.other:
+                lp = lp + prior.log_prob(theta[:, i])
+            log_prior[rows] = lp
+            # Outside the constraints a response may overflow: such values are -inf anyway.
+            with np.errstate(all="ignore"):
+                log_lik[rows] = lik(theta)
+            self.calls += rows.size
+        return log_prior, log_lik
+
+    def holds(self, u: np.ndarray) -> np.ndarray:
+        """The structure's constraints at points of the prior box."""
+        k = self.lik.structure.n_params
+        return self.lik.structure.constraints_hold(self.tr.to_theta(u)[:, :k],
+                                                   self.lik.data.kind, self.lik.grid)
+
+
+def _accept(target: _Target, prop, u, log_prior, log_lik, beta: float, log_uniform,
+            log_q_prop=0.0, log_q_cur=0.0) -> np.ndarray:
+    """Metropolis–Hastings acceptance (in place) of ``prop`` for prior · L^β, with the proposal
+    densities ``log_q_prop`` at the proposals and ``log_q_cur`` at the current points (both 0
+    for a symmetric proposal); returns the accepted rows.
+
+    The constraints are part of the prior (its indicator): a proposal outside them has ratio 0.
+    They are checked only where the rest of the ratio would accept, which gives the same
+    decisions from the same uniforms as checking them first, without the dense-grid
+    dissipation check of every rejected proposal (most of them at the acceptance rates of the
+    later rungs).
+    """
+    lp_new, ll_new = target.unchecked(prop)
+    with np.errstate(invalid="ignore"):
+        log_ratio = ((lp_new + beta * ll_new - log_q_prop)
+                     - (log_prior + beta * log_lik - log_q_cur))
+    ok = log_uniform < np.where(np.isfinite(log_ratio), log_ratio, -np.inf)
+    rows = np.flatnonzero(ok)
+    if rows.size:
+        ok[rows] = target.holds(prop[rows])
+    u[ok], log_prior[ok], log_lik[ok] = prop[ok], lp_new[ok], ll_new[ok]
+    return ok
+
 
 def _prior_particles(target: _Target, n: int, rng: np.random.Generator,
                      max_draws: int = 5_000_000) -> np.ndarray:
@@ -181,11 +231,7 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
             b = (a + rng.integers(1, n, size=n)) % n
             g = np.where(rng.random(n) < jump_fraction, 1.0, gamma)
             prop = u + g[:, None] * (snapshot[a] - snapshot[b])
-            lp_new, ll_new = target(prop)
-            log_ratio = (lp_new + beta * ll_new) - (log_prior + beta * log_lik)
-            ok = np.log(rng.random(n)) < np.where(np.isfinite(log_ratio), log_ratio, -np.inf)
-            u[ok], log_prior[ok], log_lik[ok] = prop[ok], lp_new[ok], ll_new[ok]
-            accepted += ok
+            accepted += _accept(target, prop, u, log_prior, log_lik, beta, np.log(rng.random(n)))
             steps += 1
         acceptance.append(accepted.mean() / max(steps, 1))
     else:
@@ -223,9 +269,5 @@ def _guided_moves(target: _Target, guide_mix: _GaussianMixture | None, u, log_pr
         else:
             from_guide = rng.random(n) < 0.5
             prop = np.where(from_guide[:, None], guide_mix.sample(n, rng), own.sample(n, rng))
-        lp_new, ll_new = target(prop)
-        with np.errstate(invalid="ignore"):
-            log_ratio = ((lp_new + beta * ll_new - log_q(prop))
-                         - (log_prior + beta * log_lik - log_q(u)))
-        ok = np.log(rng.random(n)) < np.where(np.isfinite(log_ratio), log_ratio, -np.inf)
-        u[ok], log_prior[ok], log_lik[ok] = prop[ok], lp_new[ok], ll_new[ok]
+        _accept(target, prop, u, log_prior, log_lik, beta, np.log(rng.random(n)), log_q(prop),
+                log_q(u))

@@ -76,7 +76,7 @@ EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
 SAMPLERS = ("auto", "emcee")
 
 
-NOISE_MODELS = ("auto", "known", "constant", "proportional")
+NOISE_MODELS = ("auto", "known", "constant", "proportional", "relative_parts")
 
 
 def check_options(options: dict, where: str) -> dict:

@@ -141,3 +141,83 @@ def test_polystyrene_master_curve_three_springpot_zener():
     # orders agree with the published ones within 0.06.
     for name in ("alpha", "beta", "kappa"):
         assert est[name] == pytest.approx(PS[name], abs=0.06), name
+
+
+# ---------------------------------------------------------------------- pyRheo's own cost
+# Under noise="relative_parts" (σ_rel·|G'| and σ_rel·|G''|) the likelihood's maximum over the
+# structure parameters, at any σ_rel and with σ_rel profiled out, minimises pyRheo's cost
+# Σ((G' − Ĝ')/G')² + Σ((G'' − Ĝ'')/G'')²: the optimum reproduces the published fits, and the
+# posterior means lie within a small fraction of a posterior sd of them.
+
+
+def _relative_parts(data, name, published):
+    """(posterior means, sds, the maximum-likelihood parameters, its cost) of ``name`` under
+    relative_parts noise, all physical; the optimum maximises bayesfo's likelihood from the
+    posterior's best draw, with σ_rel at its maximum-likelihood value for every θ."""
+    from scipy import optimize
+
+    from bayesfo.inference.likelihood import Likelihood
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # predictive (Pareto k) warnings are flags here
+        result = compare(data, name, seed=1, noise="relative_parts", progress=False, workers=1)
+    post = result[name].posterior
+    assert post.noise == "relative_parts" and post.converged
+    s = get_structure(name)
+    k = s.n_params
+
+    def physical(theta):
+        draws = {n: np.atleast_2d(theta)[:, i] for i, n in enumerate(s.param_names)}
+        return {n: v for n, (v, _) in physical_parameters(s, draws, "modulus", "Pa").items()
+                if n in published}
+
+    lik = Likelihood(s, data, noise="relative_parts")
+
+    def negative_profile(t):
+        t = t[None]
+        return -lik(np.column_stack([t, lik.noise_estimate(t)]))[0]
+
+    start = lik.to_scaled(post.map_theta)[0, :k]
+    best = optimize.minimize(negative_profile, start, method="Nelder-Mead",
+                             options={"xatol": 1e-10, "fatol": 1e-12, "maxfev": 40_000})
+    assert best.success
+    theta = lik.to_physical(np.r_[best.x, 0.1])[0, :k]
+    draws = physical(post.samples[:, :k])
+    mean = {n: float(np.mean(v)) for n, v in draws.items()}
+    sd = {n: float(np.std(v, ddof=1)) for n, v in draws.items()}
+    optimum = {n: float(v[0]) for n, v in physical(theta).items()}
+    return mean, sd, optimum, _relative_rss(s, theta, data)
+
+
+def test_chia_relative_parts_noise_reproduces_pyrheo_fit():
+    data = _saos("pyrheo_chia_pudding", "oscillation_chia_data.csv", ",")
+    mean, sd, optimum, cost = _relative_parts(data, "fractional_kelvin_voigt", CHIA)
+    # Measured: cost 0.3297641767 (pyRheo's parameters give 0.3297641767 + 6e-11), parameters
+    # within 4.1e-6 (c_alpha), 3.2e-6 (beta), 7.5e-7 (alpha), 1e-8 (c_beta) of the published.
+    assert cost == pytest.approx(0.32976, abs=5e-5)
+    for name, published in CHIA.items():
+        assert optimum[name] == pytest.approx(published, rel=1e-4), name
+    # Posterior sds (seed 1): c_alpha 0.70 Pa·s^α (14 %), c_beta 1.3 Pa·s^β (2 %), alpha 0.031,
+    # beta 0.0050; the means lie within 0.06 sd of the published fit (0.2 % at most; within
+    # 0.06 sd on seeds 2-4 too), where proportional noise moves alpha to about 0.73 (2 sd).
+    for name, published in CHIA.items():
+        assert abs(mean[name] - published) < 0.25 * sd[name], (name, mean[name], sd[name])
+        assert mean[name] == pytest.approx(published, rel=0.10), name
+
+
+def test_metal_network_relative_parts_noise_reproduces_pyrheo_fit():
+    data = _saos("pyrheo_metal_network_epstein", "epstein.csv", "\t")
+    mean, sd, optimum, cost = _relative_parts(data, "maxwell", METAL)
+    # Measured: cost 0.1024529546 (pyRheo's parameters give 3e-10 more), parameters within
+    # 2.3e-5 (c_delta), 1.7e-5 (delta), 7.3e-6 (c_beta), 2.5e-6 (beta) of the published: the
+    # Powell fit of the notebook, not the Bayesian optimisation's β = 0.23.
+    assert cost == pytest.approx(0.102453, abs=5e-6)
+    for name, published in METAL.items():
+        assert optimum[name] == pytest.approx(published, rel=1e-4), name
+    # Posterior sds (seed 1): c_beta 7.1 Pa·s^β (3 %), beta 0.0088, c_delta 163 Pa·s^δ (13 %),
+    # delta 0.025; the means lie within 0.07 sd of the published fit (0.6 % at most; within
+    # 0.08 sd on seeds 2-4). delta's
+    # posterior (0.286 ± 0.025) puts the Bayesian-optimisation notebook's 0.23 2.2 sd away.
+    for name, published in METAL.items():
+        assert abs(mean[name] - published) < 0.25 * sd[name], (name, mean[name], sd[name])
+        assert mean[name] == pytest.approx(published, rel=0.10), name

@@ -78,7 +78,9 @@ def add_comparison_options(p, each: str = "the fit"):
                    help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
     p.add_argument("--noise", default="auto", choices=NOISE_MODELS,
                    help="noise model (default: known if the data give sigma, else constant or "
-                        "proportional, whichever has the larger evidence for each structure)")
+                        "proportional, whichever has the larger evidence for each structure; "
+                        "relative_parts, the relative errors of the real and imaginary parts "
+                        "that pyRheo fits, only when asked for)")
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1; "
                         "one per parameter")

@@ -57,12 +57,13 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     data : FrequencyResponse
     structures : str or sequence of Structure or str
         Structures, names or comma lists of names (``"voigt,zener"``, ``"max3"``).
-    noise : {"auto", "known", "constant", "proportional"}
+    noise : {"auto", "known", "constant", "proportional", "relative_parts"}
         ``auto``: ``known`` when the data carry σ; else every structure runs under
         ``constant`` and ``proportional`` noise and keeps the one with the larger ln Z
         (:data:`SCREEN_MARGIN` lets a quick estimate set aside a model that trails far behind);
         both are stated in the result (``criteria["noise_models"]``). Any other value forces
-        that model.
+        that model; ``relative_parts`` (relative errors σ_rel·|Re G| and σ_rel·|Im G| of each
+        part, pyRheo's cost) is only used when forced, never by ``auto``.
     seed : int
         The same seed gives the same numbers.
     priors : dict, optional
@@ -133,6 +134,11 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         raise InputError(f"{data.where()}: the response is exactly 0 at omega = "
                          f"{data.omega[data.response == 0][0]:.4g} rad/s, where relative noise "
                          "has no scale; remove the point or give sigma")
+    if noise == "relative_parts":
+        # The relative error of a real or imaginary part that is exactly 0 has no scale either.
+        from ..inference.likelihood import zero_part
+        if (why := zero_part(data)) is not None:
+            raise InputError(why)
     test = None
     if holdout is not None and len(holdout):
         data, test = data.split(holdout)

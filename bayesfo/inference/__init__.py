@@ -26,7 +26,9 @@ def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: in
     ----------
     structure : Structure
     data : FrequencyResponse
-    noise : {"auto", "known", "constant", "proportional"}
+    noise : {"auto", "known", "constant", "proportional", "relative_parts"}
+        See :mod:`bayesfo.inference.likelihood`; ``auto`` (:func:`choose_noise`) never chooses
+        ``relative_parts``.
     priors : dict, optional
         Prior overrides ``{name: Prior}`` (structure or noise parameters).
     seed : int

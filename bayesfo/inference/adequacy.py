@@ -22,6 +22,13 @@ complex noise both parts are independent standard normal whatever θ, because σ
 likelihood uses (``known``: from the data; ``constant``: σ; ``proportional``: σ_rel·|G_k| with
 the data's |G_k|) and a rotation keeps circular noise circular.
 
+``relative_parts`` noise is not circular (σ_rel·|Re G_k| and σ_rel·|Im G_k| on the two parts),
+so a rotation would mix parts of different variance: its residuals are the relative residuals of
+the parts themselves, a_k = ΔRe_k / (σ_rel Re G_k) and b_k = ΔIm_k / (σ_rel Im G_k), again
+independent standard normal under the model (positive where the data's part is larger in
+magnitude than the fit's), and the statistics below apply to them unchanged, with "magnitude
+part" and "phase part" read as "real part" and "imaginary part".
+
 Statistics
 ----------
 ``chi2``
@@ -159,8 +166,8 @@ class Adequacy:
     noise : str
         The noise model of the likelihood.
     noise_scale : float or None
-        Posterior median of σ_rel (``proportional``) or of σ / median |G| (``constant``); None
-        when σ is known.
+        Posterior median of σ_rel (``proportional``, ``relative_parts``) or of σ / median |G|
+        (``constant``); None when σ is known.
     noise_scale_implausible : bool
         ``noise_scale`` above ``max_noise_scale``.
     misfit_small : bool
@@ -297,15 +304,27 @@ def _normalised(y, model, sd) -> tuple[np.ndarray, np.ndarray]:
     return z.real, z.imag
 
 
+def _normalised_parts(y, model, sd) -> tuple[np.ndarray, np.ndarray]:
+    """(real part, imaginary part) of the residuals under ``relative_parts`` noise: each part's
+    residual over its own standard deviation ``sd`` (complex: Re, Im), signed by the data's part
+    so that positive means larger in magnitude than the fit."""
+    d = y - model
+    return (d.real / sd.real * np.sign(y.real), d.imag / sd.imag * np.sign(y.imag))
+
+
 def _noise_sd(lik: Likelihood, theta: np.ndarray) -> np.ndarray:
     """σ_k of every draw on the scaled problem, shape (n_sets, n_freq), as the likelihood forms
-    it."""
+    it. Under ``relative_parts`` a complex array: the standard deviation of the real part in its
+    real part, that of the imaginary part in its imaginary part."""
     n = lik.g_scaled.size
     if lik.noise == "known":
         return np.broadcast_to(lik.data.sigma / lik.scaling.g_ref, (theta.shape[0], n))
     s = theta[:, -1:]
     if lik.noise == "constant":
         return np.broadcast_to(s, (theta.shape[0], n))
+    if lik.noise == "relative_parts":
+        g = lik.g_scaled[None, :]
+        return s * np.abs(g.real) + 1j * (s * np.abs(g.imag))
     return s * np.abs(lik.g_scaled)[None, :]
 
 
@@ -371,7 +390,9 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
         draws = draws[np.sort(rng.choice(draws.shape[0], n_draws, replace=False))]
     model = lik.model(draws)[:, order]
     sd = _noise_sd(lik, draws)[:, order]
-    ok = np.all(np.isfinite(model), axis=1) & np.all(np.isfinite(sd) & (sd > 0), axis=1)
+    parts = lik.noise == "relative_parts"
+    sd_ok = ((sd.real > 0) & (sd.imag > 0)) if parts else (sd > 0)
+    ok = np.all(np.isfinite(model), axis=1) & np.all(np.isfinite(sd) & sd_ok, axis=1)
     if not ok.any():
         raise InputError(f"argument 'post': no posterior draw of '{post.structure}' gives a finite "
                          "response and noise scale")
@@ -383,7 +404,7 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
     # reference of every statistic is simulated from those draws directly (n_reference data
     # sets), and y_rep itself is formed only for the predictive band (REPLICATES_PER_DRAW each).
     a_rep, b_rep = rng.normal(size=(2, n_reference, n))
-    a_obs, b_obs = _normalised(g[None, :], model, sd)
+    a_obs, b_obs = (_normalised_parts if parts else _normalised)(g[None, :], model, sd)
 
     p_values, statistics, reference = {}, {}, {}
     for name in STATISTICS:
@@ -414,13 +435,17 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
 
     which = np.repeat(np.arange(n_used), REPLICATES_PER_DRAW)
     eps = rng.normal(size=(2, which.size, n)) / math.sqrt(2.0)
-    y_rep = model[which] + sd[which] * (eps[0] + 1j * eps[1])
+    if parts:  # each part with its own standard deviation (eps carries 1/√2)
+        y_rep = model[which] + math.sqrt(2.0) * (sd[which].real * eps[0]
+                                                 + 1j * sd[which].imag * eps[1])
+    else:
+        y_rep = model[which] + sd[which] * (eps[0] + 1j * eps[1])
     outside = _outside_band(g, y_rep, m_map)
     adequate = not failed and not implausible
     bands = ()
     if not adequate:
         crit = float(np.quantile(reference["scan"], 1.0 - per_stat))
-        bands = _bands(a_obs, b_obs, omega, crit)
+        bands = _bands(a_obs, b_obs, omega, crit, parts)
     systematic = tuple(float(w) for lo, hi, _ in bands for w in omega[(omega >= lo) & (omega <= hi)])
     systematic = tuple(sorted(set(systematic)))
     reasons = _reasons(failed, p_values, statistics, n, bands, implausible, noise_scale,
@@ -499,7 +524,7 @@ def _outside_band(g, y_rep, m_ref) -> np.ndarray:
     return out
 
 
-def _bands(a_obs, b_obs, omega, crit: float) -> tuple:
+def _bands(a_obs, b_obs, omega, crit: float, parts: bool = False) -> tuple:
     """Separate windows of systematic misfit, strongest first: the windows whose posterior
     median scan statistic exceeds ``crit``, greedily without overlaps, at most MAX_BANDS. The
     strongest window is kept even below ``crit`` (called only when the check has failed, it is
@@ -523,7 +548,10 @@ def _bands(a_obs, b_obs, omega, crit: float) -> tuple:
             break
     bands = []
     for part, lo, hi, value in chosen:
-        if part == 0:
+        if parts:  # relative_parts noise: the residuals are those of the real and imaginary parts
+            text = (f"the data's {('real', 'imaginary')[part]} part is "
+                    + ("larger" if value > 0 else "smaller") + " in magnitude than the fit's")
+        elif part == 0:
             text = "the data's magnitude lies " + ("above" if value > 0 else "below") + " the fit"
         else:
             text = "the data's phase lies " + ("above" if value > 0 else "below") + " the fit's"
@@ -556,7 +584,7 @@ def _reasons(failed, p, stats, n, bands, implausible, noise_scale, noise,
         out.append(f"residuals are larger than the noise model allows (Σ|r|²/σ² = "
                    f"{stats['chi2']:.0f} for {n} points, expected about {n}; {_p_text(p['chi2'])})")
     if implausible:
-        what = "σ_rel" if noise == "proportional" else "σ / median |G|"
+        what = "σ_rel" if noise in ("proportional", "relative_parts") else "σ / median |G|"
         out.append(f"the fitted noise scale is implausibly large ({what} = {noise_scale:.3g}, above "
                    f"{max_scale:g}): the structure's misfit is being absorbed as noise"
                    + (f", most clearly at {where}" if where and not failed else ""))

@@ -16,6 +16,21 @@ models:
 ``proportional``
     σ_k = σ_rel·|G_k| (data magnitude), σ_rel sampled with a log-uniform prior: relative errors,
     suited to data spanning decades.
+``relative_parts``
+    Not circular: the real and imaginary parts are independent Gaussians with standard
+    deviations σ_rel·|Re G_k| and σ_rel·|Im G_k| (data values), σ_rel sampled with the prior of
+    ``proportional``. σ_rel is then the relative error of each part, and E|ΔG_k|² =
+    σ_rel²·|G_k|² at every point, the convention of ``proportional`` (with which it coincides
+    where |Re G_k| = |Im G_k|). The pointwise log-likelihood is
+
+        ln p(G_k | θ) = −ln(2π σ_rel² |Re G_k|·|Im G_k|)
+                        − [(ΔRe_k / Re G_k)² + (ΔIm_k / Im G_k)²] / (2 σ_rel²),
+
+    so for a fixed σ_rel the maximum-likelihood structure parameters minimise
+    Σ_k (ΔRe_k / Re G_k)² + (ΔIm_k / Im G_k)², the cost that pyRheo and RheoJAX minimise on
+    storage and loss moduli. It weights each part by itself where one is much smaller than the
+    other (G' ≪ G'' or G' ≫ G''), where ``proportional`` weights both by |G|. Data with a part
+    exactly 0 cannot use it. Opt-in: ``auto`` never chooses it.
 
 Everything is evaluated on the scaled data (ω/ω_ref, G/g_ref) and vectorised over parameter sets;
 the log-likelihood is reported in physical units (the scaling adds −2·ln g_ref per point).
@@ -34,13 +49,28 @@ from ..priors import LogUniform, Prior
 from ..response import dissipation_grid
 from ..structures import Scaling, Structure
 
-NOISE_MODELS = ("known", "constant", "proportional")
+NOISE_MODELS = ("known", "constant", "proportional", "relative_parts")
 
 #: Priors of the noise scale on the scaled data (|G|/g_ref is of order one).
 NOISE_PRIORS = {
     "constant": ("sigma", LogUniform(1e-6, 10.0)),
     "proportional": ("sigma_rel", LogUniform(1e-5, 1.0)),
+    "relative_parts": ("sigma_rel", LogUniform(1e-5, 1.0)),
 }
+
+
+def zero_part(data: FrequencyResponse) -> str | None:
+    """Why ``relative_parts`` noise cannot be used on ``data`` (a real or imaginary part exactly
+    0 at some frequency, where the relative error of that part has no scale), or None."""
+    zero = (data.response.real == 0) | (data.response.imag == 0)
+    if not zero.any():
+        return None
+    k = int(np.flatnonzero(zero)[0])
+    part = "real" if data.response.real[k] == 0 else "imaginary"
+    return (f"{data.where()}: the {part} part of the response is exactly 0 at omega = "
+            f"{data.omega[k]:.4g} rad/s, where noise model 'relative_parts' (relative errors of "
+            "the real and imaginary parts) has no scale; use noise 'constant' (or "
+            "'proportional'), give sigma, or remove the point")
 
 
 def choose_noise(data: FrequencyResponse, noise: str = "auto") -> tuple[str, str]:
@@ -62,6 +92,8 @@ def choose_noise(data: FrequencyResponse, noise: str = "auto") -> tuple[str, str
         raise InputError(f"noise model must be auto, {', '.join(NOISE_MODELS)}; got {noise!r}")
     if noise == "known" and data.sigma is None:
         raise InputError(f"noise model 'known' needs sigma in {data.where()}")
+    if noise == "relative_parts" and (why := zero_part(data)) is not None:
+        raise InputError(why)
     if noise != "auto":
         return noise, "chosen by the user"
     if data.sigma is not None:
@@ -83,7 +115,8 @@ class Likelihood:
     ----------
     structure : Structure
     data : FrequencyResponse
-    noise : {"auto", "known", "constant", "proportional"}
+    noise : {"auto", "known", "constant", "proportional", "relative_parts"}
+        ``auto`` follows :func:`choose_noise` (never ``relative_parts``).
     priors : dict, optional
         Overrides of structure or noise priors, ``{name: Prior}``.
     scaling : Scaling, optional
@@ -134,6 +167,12 @@ class Likelihood:
             s2 = (self.data.sigma / scaling.g_ref) ** 2
             object.__setattr__(self, "_var", s2)
             object.__setattr__(self, "_log_norm", -np.log(np.pi * s2))
+        elif noise == "relative_parts":
+            # ln p = −ln(2π σ_rel² |Re g|·|Im g|) − [ρ_re² + ρ_im²] / (2 σ_rel²), ρ the relative
+            # residual of each part: the σ-free terms and the weights are fixed by the data.
+            object.__setattr__(self, "_log_parts", -np.log(2.0 * np.pi * np.abs(g.real * g.imag)))
+            object.__setattr__(self, "_w_re", 1.0 / g.real ** 2)
+            object.__setattr__(self, "_w_im", 1.0 / g.imag ** 2)
         else:
             object.__setattr__(self, "_abs_g2", np.abs(g) ** 2)
         object.__setattr__(self, "_unit_shift", -2.0 * math.log(scaling.g_ref))
@@ -173,6 +212,13 @@ class Likelihood:
         """
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         model = self.model(theta)
+        if self.noise == "relative_parts":
+            s2 = theta[:, -1:] ** 2
+            rho2 = self._relative_parts2(model)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out = self._log_parts - np.log(s2) - rho2 / (2.0 * s2)
+            out = out + self._unit_shift
+            return np.where(np.isfinite(out), out, -np.inf)
         r2 = np.abs(self.g_scaled - model) ** 2
         if self.noise == "known":
             out = self._log_norm - r2 / self._var
@@ -183,6 +229,11 @@ class Likelihood:
                 out = -np.log(np.pi * var) - r2 / var
         out = out + self._unit_shift
         return np.where(np.isfinite(out), out, -np.inf)
+
+    def _relative_parts2(self, model) -> np.ndarray:
+        """(ΔRe/Re g)² + (ΔIm/Im g)² per point, the summand of pyRheo's cost."""
+        d = self.g_scaled - model
+        return d.real ** 2 * self._w_re + d.imag ** 2 * self._w_im
 
     def in_support(self, theta) -> np.ndarray:
         """True where θ lies in the support of the prior: every prior range, the structure's
@@ -232,9 +283,12 @@ class Likelihood:
 
     def noise_estimate(self, theta_structure) -> np.ndarray:
         """The noise parameter that maximises the likelihood for given structure parameters
-        (scaled): sqrt(mean |r|²) or sqrt(mean |r|²/|G|²)."""
+        (scaled): sqrt(mean |r|²) (``constant``), sqrt(mean |r|²/|G|²) (``proportional``) or the
+        root mean square of the relative residuals of the 2n parts (``relative_parts``)."""
         theta_structure = np.atleast_2d(theta_structure)
         model = self.structure.response(theta_structure, self.omega_scaled, self.data.kind)
+        if self.noise == "relative_parts":
+            return np.sqrt(0.5 * self._relative_parts2(model).mean(axis=1))
         r2 = np.abs(self.g_scaled - model) ** 2
         if self.noise == "constant":
             return np.sqrt(r2.mean(axis=1))

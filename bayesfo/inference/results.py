@@ -295,12 +295,19 @@ def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kep
     )
     if rng is not None:
         model = lik.model(flat_scaled) * lik.scaling.g_ref
-        if lik.noise == "known":
-            sd = np.broadcast_to(lik.data.sigma, model.shape)
+        z = rng.normal(size=model.shape) + 1j * rng.normal(size=model.shape)
+        if lik.noise == "relative_parts":
+            # Not circular: each part has its own standard deviation σ_rel·|part of G|.
+            rel = flat_scaled[:, -1:]
+            noise = rel * (np.abs(g.real) * z.real + 1j * np.abs(g.imag) * z.imag)
         else:
-            s = flat_scaled[:, -1:] * lik.scaling.g_ref
-            sd = s * np.ones(model.shape) if lik.noise == "constant" else flat_scaled[:, -1:] * np.abs(g)
-        noise = sd / math.sqrt(2.0) * (rng.normal(size=model.shape) + 1j * rng.normal(size=model.shape))
+            if lik.noise == "known":
+                sd = np.broadcast_to(lik.data.sigma, model.shape)
+            elif lik.noise == "constant":
+                sd = flat_scaled[:, -1:] * lik.scaling.g_ref * np.ones(model.shape)
+            else:
+                sd = flat_scaled[:, -1:] * np.abs(g)
+            noise = sd / math.sqrt(2.0) * z
         rep = model + noise
         groups["posterior_predictive"] = {"G_real": rep.real.reshape(shape), "G_imag": rep.imag.reshape(shape)}
         groups["posterior"] = dict(post, model_real=model.real.reshape(shape), model_imag=model.imag.reshape(shape))

@@ -6,11 +6,12 @@ STAMP  := $(VENV)/.installed-stamp
 DOCS_STAMP := $(VENV)/.docs-stamp
 DEMO_OUT ?= demo-output
 
-.PHONY: help venv test test-slow test-all demo bench docs clean
+.PHONY: help venv test test-unit test-slow test-all demo bench docs clean
 
 help:
 	@echo "make demo       create $(VENV), install bayesfo, run a model comparison on bundled data"
 	@echo "make test       create $(VENV), install bayesfo, run the default test suite"
+	@echo "make test-unit  the unit tier alone (tests/unit: no sampling, under a minute)"
 	@echo "make test-slow  the long validation runs (thesis tables in full, GPL reference data)"
 	@echo "make bench      run the benchmarks in benchmarks/"
 	@echo "make docs       build the documentation site into docs/_build/html (index.html)"
@@ -26,6 +27,9 @@ venv: $(STAMP)
 test: $(STAMP)
 	$(BIN)/ruff check bayesfo tests benchmarks examples
 	MPLBACKEND=Agg $(BIN)/python -m pytest -m "not slow" -q --durations=15
+
+test-unit: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m pytest -m "not slow" -q --durations=10 tests/unit
 
 test-slow: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -m slow -q

@@ -1,4 +1,11 @@
-"""Shared test helpers."""
+"""Shared test helpers.
+
+The tests come in two tiers: ``tests/unit`` (no sampling: readers, structures, responses,
+identification, input errors; seconds in all) and ``tests/integration`` (comparisons,
+posteriors, evidence, the command line, batch runs, figures, reports, examples). Long
+validation runs in either are marked ``slow`` (``make test-slow``); ``make test-unit`` runs the
+first tier alone.
+"""
 
 from __future__ import annotations
 

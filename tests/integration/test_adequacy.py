@@ -26,7 +26,7 @@ from bayesfo.inference import ConvergenceWarning, Likelihood, run_posterior
 from bayesfo.inference.adequacy import LEVEL, STATISTICS, Adequacy, check_adequacy
 from bayesfo.structures import get_structure
 
-EXAMPLES = Path(__file__).parents[1] / "examples" / "data"
+EXAMPLES = Path(__file__).parents[2] / "examples" / "data"
 W = np.logspace(-1, 2, 30)
 ZENER_TRUE = [10.0, 1.0, 0.1, 0.6]  # a1, b0, b1, q: compliance from 1 to 0.01, q = 0.6
 REL = 0.015  # proportional noise, σ_k = 1.5 % of |G_k|

@@ -17,7 +17,7 @@ import pytest
 
 import bayesfo as bf
 
-GPL = Path(__file__).parents[2] / "shared" / "data" / "reference-gpl"
+GPL = Path(__file__).parents[3] / "shared" / "data" / "reference-gpl"
 
 pytestmark = pytest.mark.slow
 

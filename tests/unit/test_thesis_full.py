@@ -56,7 +56,9 @@ def test_n2m2_global_optimum_is_at_least_as_good_as_any_q_one_half_fit():
 
 
 def test_example_runs_quick(tmp_path, monkeypatch, capsys):
-    script = Path(__file__).parents[1] / "examples" / "thesis_simulation.py"
+    script = Path(__file__).parents[2] / "examples" / "thesis_simulation.py"
+    # As when the script is run, its directory is on sys.path (for the shared _common module).
+    monkeypatch.syspath_prepend(str(script.parent))
     monkeypatch.setattr(sys, "argv", [str(script), "--quick", "--out", str(tmp_path)])
     with pytest.raises(SystemExit) as info:
         runpy.run_path(str(script), run_name="__main__")

@@ -251,7 +251,7 @@ def test_dissipation_violations_follow_kind():
 
 def test_cli_inspect_reports_negative_loss_of_bundled_glassy_isotherm(run_cli):
     # The -40 °C isotherm of the 3M 468MP data has one negative G'' (a known artefact).
-    path = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tm040C.csv"
+    path = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tm040C.csv"
     status, out, _ = run_cli("inspect", path, "--json")
     info = json.loads(out)
     assert status == 0 and info["n_frequencies"] == 17 and info["kind"] == "modulus"

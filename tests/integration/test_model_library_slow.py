@@ -16,7 +16,7 @@ from bayesfo.structures import coefficients_from_physical, get_structure, physic
 
 pytestmark = pytest.mark.slow
 
-REFERENCE = Path(__file__).parents[2] / "shared/data/reference-gpl"
+REFERENCE = Path(__file__).parents[3] / "shared/data/reference-gpl"
 
 #: The thesis' structures, their integer baselines and the named models: what a rheologist
 #: would try on a soft solid or a transient network.

@@ -16,7 +16,7 @@ from bayesfo.inference._arviz import arviz
 from bayesfo.structures import get_structure, resolve_structures
 
 W = np.logspace(np.log10(0.6), np.log10(300), 25)
-ADHESIVE = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
+ADHESIVE = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
 CONTRACT = {"name", "inverted", "integer", "n_params", "parameters", "log_evidence",
             "log_evidence_err", "evidence_method", "max_log_likelihood", "aic", "aicc", "bic",
             "waic", "loo", "loo_se", "pareto_k_max", "rhat_max", "ess_min", "converged", "rmse",
@@ -36,7 +36,7 @@ def voigt_comparison(tmp_path_factory):
     assert all("voigt-int" in str(w.message) for w in record if w.category is PredictiveWarning)
     assert result["voigt-int"].criteria["pareto_k_max"] > 0.7
     out = tmp_path_factory.mktemp("cmp")
-    write_outputs(result, out, figures=False)  # figures: tests/test_plotting.py and the CLI test
+    write_outputs(result, out, figures=False)  # figures: tests/integration/test_plotting.py and the CLI test
     return result, out
 
 
@@ -267,7 +267,7 @@ def test_data_problems_are_warned_and_stated(tmp_path):
     from bayesfo.errors import DataWarning
     from bayesfo.report import verdict
 
-    lines = (Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" /
+    lines = (Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" /
              "Tp150C.csv").read_text().splitlines()
     first = next(i for i, line in enumerate(lines) if line and line[0].isdigit())
     cells = lines[first + 2].split(",")

@@ -37,7 +37,7 @@ from bayesfo.plotting.captions import figure_caption, trace_caption  # noqa: E40
 from bayesfo.plotting.style import FLAG_COLOR, structure_styles  # noqa: E402
 from bayesfo.structures import get_structure  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
 #: Posterior medians of the demo comparison (Tp020C, seed 0): Voigt and Zener predict the same.
 DEMO_THETA = {

@@ -13,8 +13,8 @@ import pytest
 
 import bayesfo as bf
 
-ROOT = Path(__file__).parents[1]
-STORED = Path(__file__).parent / "data" / "stored_run_Tp150C.json"
+ROOT = Path(__file__).parents[2]
+STORED = Path(__file__).parents[1] / "data" / "stored_run_Tp150C.json"
 
 
 def _diff(a, b, where="") -> list[str]:

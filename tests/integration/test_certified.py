@@ -25,7 +25,7 @@ import pytest
 import bayesfo as bf
 from bayesfo.errors import CertifiedWarning, ConvergenceWarning, PredictiveWarning
 
-DATA = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
+DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
 
 
 @pytest.fixture(scope="module")

@@ -30,8 +30,8 @@ from bayesfo.cli.batch import add_parser
 from bayesfo.cli.batch import run as cmd_batch
 from bayesfo.errors import InputError
 
-ADHESIVE = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp"
-NREL = Path(__file__).parents[1] / "examples" / "data" / "nrel_dma_master.csv"
+ADHESIVE = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+NREL = Path(__file__).parents[2] / "examples" / "data" / "nrel_dma_master.csv"
 STRUCTURES = "voigt,zener"
 GOOD = ("Tm010C", "Tp150C")
 BAD_TEXT = "omega,real,imag\n1,2,3\n2,x,4\n"
@@ -226,7 +226,7 @@ def test_temperatures_from_comments_stems_and_names(tmp_path):
     g.write_text("# temperature: warm\nomega,real,imag\n1,1,1\n")
     with pytest.raises(InputError, match=r"sample.csv', line 1: '# temperature:' expects"):
         temperature_of_file(g)
-    # In a batch, that data set alone is an input error (tests/test_reliability.py).
+    # In a batch, that data set alone is an input error (tests/integration/test_reliability.py).
     assert re.search(r"sample.csv', line 1: '# temperature:' expects",
                      expand_inputs([g])[0].error)
     # The bundled isotherms: -40 °C to 150 °C in steps of 10 from their file names; the NREL

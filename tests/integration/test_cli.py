@@ -11,7 +11,7 @@ import pytest
 from bayesfo.data import FrequencyResponse
 from bayesfo.studies import OMEGA, g_spec
 
-EXAMPLES = Path(__file__).parents[1] / "examples" / "data"
+EXAMPLES = Path(__file__).parents[2] / "examples" / "data"
 
 
 @pytest.fixture
@@ -111,7 +111,7 @@ def test_identify_max_order_loop(run_cli, gspec_csv):
 
 
 def test_models_option_before_or_after_the_command(tmp_path, run_cli):
-    card = (Path(__file__).parents[1] / "models" / "voigt.toml").read_text()
+    card = (Path(__file__).parents[2] / "models" / "voigt.toml").read_text()
     (tmp_path / "kv.toml").write_text(card.replace('name = "voigt"', 'name = "kv2"'))
     for argv in (["--models", tmp_path, "structures"], ["structures", "--models", tmp_path]):
         status, out, _ = run_cli(*argv)

@@ -21,8 +21,8 @@ from bayesfo.data import read, read_csv, read_isotherms
 
 pytestmark = pytest.mark.slow
 
-ROOT = Path(__file__).parents[1]
-SHARED = Path(__file__).parents[2] / "shared" / "data"
+ROOT = Path(__file__).parents[2]
+SHARED = Path(__file__).parents[3] / "shared" / "data"
 REAL = SHARED / "real"
 GPL = SHARED / "reference-gpl"
 RTOL = 1e-9

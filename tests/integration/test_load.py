@@ -24,7 +24,7 @@ from bayesfo.comparison import Criteria, ranking_csv
 from bayesfo.comparison.output import _finite
 from bayesfo.errors import InputError
 
-DATA = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp" / "Tp150C.csv"
+DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp150C.csv"
 
 
 def _json(obj):

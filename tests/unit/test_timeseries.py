@@ -588,7 +588,7 @@ def test_bundled_example_records():
     # offset and drift on the output, 6.6 periods of 32 samples (make_records.py there)
     from pathlib import Path
 
-    folder = Path(__file__).resolve().parents[1] / "examples" / "data" / "sine_records"
+    folder = Path(__file__).resolve().parents[2] / "examples" / "data" / "sine_records"
     fr, analyses = extract_frequency_response(sorted(folder.glob("*.csv")))
     np.testing.assert_allclose(fr.omega, [0.1, 0.3, 1.0, 3.0, 10.0], rtol=1e-12)
     g = g_true(fr.omega)

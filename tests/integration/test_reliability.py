@@ -1,7 +1,7 @@
 """Reliability and security of the outputs: nothing outside the output directory is touched,
 each output directory holds the complete output of one run, faults end with one line.
 
-The comparisons are small (the simulated Voigt compliance of tests/test_compare.py, two
+The comparisons are small (the simulated Voigt compliance of tests/integration/test_compare.py, two
 structures, no figures) so the fault tests stay fast; the signal tests run the command line in a
 child process on a bundled isotherm and signal it while it samples and while it writes.
 """
@@ -31,7 +31,7 @@ from bayesfo.data import FrequencyResponse
 from bayesfo.errors import OutputError
 from bayesfo.structures import get_structure, resolve_structures
 
-ROOT = Path(__file__).parents[1]
+ROOT = Path(__file__).parents[2]
 ADHESIVE = ROOT / "examples" / "data" / "adhesive_468mp"
 W = np.logspace(np.log10(0.6), np.log10(300), 25)
 

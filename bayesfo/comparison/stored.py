@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..data import FrequencyResponse
-from ..errors import InputError
+from ..errors import InputError, StructureError
 from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.adequacy import Adequacy
@@ -230,6 +230,12 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
         except InputError as exc:
             raise InputError(f"'{d / 'summary.json'}': structure '{name}' is not in the "
                              f"library ({exc}); give its card with models=") from None
+        if s.get("picture") and structure.pictures:
+            # The picture the run reported (an alias such as fpt chooses one).
+            try:
+                structure = structure.with_picture(s["picture"])
+            except StructureError as exc:
+                raise InputError(f"'{d / 'summary.json'}': {exc}") from None
         if structure.n_params != s["n_params"] or structure.formula != s["formula"]:
             raise InputError(f"'{d / 'summary.json'}': the card of '{name}' differs from the "
                              "one the run used (parameters or formula)")

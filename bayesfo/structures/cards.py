@@ -470,9 +470,18 @@ def resolve_structures(spec: str | list[str], library: dict[str, Structure] | No
                 and (s.degrees[1] if inv else s.degrees[0]) <= limit
             ]
         else:
-            chosen = [get_structure(name, library)]
+            s = get_structure(name, library)
+            # An alias that names a picture (fpt: the Poynting–Thomson picture of zener)
+            # reports the physical parameters of that picture.
+            picture = picture_for(name, library)
+            chosen = [s if picture is None else s.with_picture(picture)]
         for s in chosen:
-            if s not in out:
+            same = next((o for o in out if o.name == s.name), None)
+            if same is None:
                 out.append(s)
+            elif same != s:
+                raise StructureError(
+                    f"'{name}' and an earlier name in {spec!r} are the same structure "
+                    f"'{s.name}' with different pictures; give it once")
     return out
 

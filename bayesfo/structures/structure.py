@@ -140,6 +140,17 @@ class Structure:
             out["pictures"] = [p.describe() for p in self.pictures]
         return out
 
+    def with_picture(self, name: str) -> Structure:
+        """A copy whose default picture (the physical parameters it reports) is the one called
+        ``name`` or with that alias; the model, its parameters and its priors are unchanged."""
+        for i, p in enumerate(self.pictures):
+            if name == p.name or name in p.aliases:
+                if i == 0:
+                    return self
+                return replace(self, pictures=(p,) + self.pictures[:i] + self.pictures[i + 1:])
+        raise StructureError(f"structure '{self.name}' has no picture {show(str(name))}; its "
+                             f"pictures are {', '.join(p.name for p in self.pictures) or 'none'}")
+
     def with_priors(self, priors: dict[str, Prior]) -> Structure:
         """A copy with some priors replaced (``{name: Prior}``)."""
         unknown = [k for k in priors if k not in self.param_names]

@@ -212,3 +212,14 @@ def test_repr_and_summary_of_a_comparison_and_a_structure(written):
     assert "failed: nothing admissible (test)" in failed.summary()
     both = dataclasses.replace(result, results=(r, failed))
     assert "1 failed" in repr(both) and "failed: nothing admissible" in both.summary()
+
+
+def test_the_picture_an_alias_chose_is_read_back(tmp_path):
+    data = bf.read(DATA)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = bf.compare(data, "fpt", workers=1, progress=False, seed=1)
+    bf.write_outputs(result, tmp_path, figures=False)
+    stored = json.loads((tmp_path / "summary.json").read_text())
+    assert stored["structures"][0]["picture"] == "fractional_poynting_thomson"
+    assert _diff(_json(bf.load(tmp_path).to_summary()), stored) == []

@@ -474,3 +474,24 @@ def test_docs_table_names_every_model():
             assert f"`{name}`" in text, name
     for alias in LIB.aliases:
         assert f"`{alias}`" in text, alias
+
+
+def test_an_alias_naming_a_picture_reports_that_picture():
+    from bayesfo.errors import StructureError
+    from bayesfo.structures import picture_of, resolve_structures
+
+    (fpt,) = resolve_structures("fpt")
+    (zener,) = resolve_structures("zener")
+    assert fpt.name == zener.name == "zener"
+    assert picture_of(fpt).name == "fractional_poynting_thomson"
+    assert picture_of(zener).name == "fractional_zener_ss"
+    # The same model: responses and priors are those of the card.
+    theta = np.array([0.3, 2.0, 0.5, 0.6])
+    w = np.logspace(-2, 2, 9)
+    assert np.array_equal(fpt.response(theta, w, "modulus"), zener.response(theta, w, "modulus"))
+    assert [p.prior for p in fpt.parameters] == [p.prior for p in zener.parameters]
+    assert resolve_structures("zener,fzss") == [zener]  # the default picture twice is one
+    with pytest.raises(StructureError, match="same structure 'zener' with different pictures"):
+        resolve_structures("zener,fpt")
+    with pytest.raises(StructureError, match="has no picture"):
+        zener.with_picture("burgers")

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ._io import parse_number, show
+from .data.frequency_response import KINDS  # noqa: F401  (the kinds an option may name)
 from .errors import InputError
 
 DEFAULT_STRUCTURES = "voigt,zener,maxwell,fractional_kelvin_voigt,voigt-int,zener-int,maxwell-int"
@@ -67,10 +68,6 @@ DEFAULT_OPTIONS = {
     "models": (),            # extra structure cards (paths)
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
 }
-
-
-KINDS = ("compliance", "modulus", "generic")
-
 
 EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
 SAMPLERS = ("auto", "emcee")

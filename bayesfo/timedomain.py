@@ -476,6 +476,9 @@ def _realisation(scaled: _Scaled) -> tuple[np.ndarray, np.ndarray, np.ndarray, f
     b = np.zeros((n, 1))
     b[0, 0] = 1.0
     c = (num[1:] - d * den[1:]).reshape(1, n)
+    # LAPACK directly, not scipy.linalg.matrix_balance: that casts the scale factors to int for
+    # its permutation output, which overflows (a RuntimeWarning, an error under the tests) on
+    # the three-term model of tests/unit/test_timedomain.py, whose factors pass 2**63.
     ab, _, _, scale, info = lapack.dgebal(a, scale=1, permute=0)
     if info != 0:  # pragma: no cover - LAPACK argument error, cannot happen with these inputs
         raise RuntimeError(f"LAPACK dgebal failed with info={info}")

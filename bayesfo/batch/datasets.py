@@ -115,14 +115,11 @@ def _jsonable(obj):
 
 
 def _sha256(path) -> str | None:
-    digest = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
-            for chunk in iter(lambda: fh.read(1 << 20), b""):
-                digest.update(chunk)
+            return hashlib.file_digest(fh, "sha256").hexdigest()
     except OSError:
         return None
-    return digest.hexdigest()
 
 
 def _temperature_or_error(path) -> tuple[float | None, str | None]:

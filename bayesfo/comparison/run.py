@@ -263,7 +263,7 @@ def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dic
     own = {k: v for k, v in (options["priors"] or {}).items()
            if k in s.param_names or k == NOISE_PRIORS.get(noise, ("",))[0]}
     lik = Likelihood(s, data, noise=noise, priors=own)
-    post = ev = None
+    post = ev = tried = None
     # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
     if options["sampler"] == "auto" and options["evidence"] != "bridge" and fit.optima.size:
         modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling),
@@ -273,12 +273,16 @@ def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dic
         except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
             post, ev, info = None, None, {}
         if post is None and options["evidence"] == "auto" and not options["sampler_kwargs"]:
-            post, ev, runs = _ladder_first(lik, seed, info.get("proposal_draws"))
+            post, ev, tried = _ladder_first(lik, seed, info.get("proposal_draws"))
     if post is None:
         post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
                                 fit=fit, progress=False,
                                 **{"give_up": True, **options["sampler_kwargs"]})
     criteria = _criteria(lik, fit, post)
+    if post.sampler == "emcee" and tried:
+        # Why the ladder tried first did not give the posterior (the emcee route followed).
+        criteria["warnings"].append(f"{s.name}: the tempered-ladder runs tried first did not "
+                                    f"certify the posterior ({tried}); emcee ran instead")
     if post.sampler == "importance":
         criteria["importance"] = info
     # ln Z of the importance weights or of the ladder that gave the posterior.
@@ -297,7 +301,7 @@ def _ladder_first(lik, seed: int, guide=None):
     tempered ladder's two independent runs: their final particles are the posterior when the
     runs agree (R-hat < 1.01, ESS ≥ 400; see
     :func:`~bayesfo.inference.results.posterior_from_particles`), and their ln Z the evidence.
-    Returns (posterior, evidence, None), or (None, None, None) when the runs disagree or the
+    Returns (posterior, evidence, None), or (None, None, reason) when the runs disagree or the
     ladder fails: emcee then runs, and a ladder guided by its walkers.
 
     Measured on the Maxwell of the bundled 20 °C isotherm under constant noise (two arms where
@@ -312,11 +316,11 @@ def _ladder_first(lik, seed: int, guide=None):
     :func:`~bayesfo.inference.smc.ladder_run`)."""
     try:
         ev, runs = ladder_runs(lik, seed=seed, guide=guide)
-    except InputError:
-        return None, None, None
-    post = posterior_from_particles(lik, runs, seed=seed)
+        post = posterior_from_particles(lik, runs, seed=seed)
+    except (InputError, np.linalg.LinAlgError, FloatingPointError) as exc:  # to emcee
+        return None, None, str(exc)
     if not post.converged:
-        return None, None, None
+        return None, None, "; ".join(m.split(": ", 1)[-1] for m in post.messages)
     return post, ev, None
 
 

@@ -145,3 +145,25 @@ def test_mode_shares_of_a_max_order_member_agree_between_independent_runs():
                         math.sqrt(max(p2 * (1 - p2), 1 / n2) / n2))
         assert abs(p1 - p2) < 4 * se
         assert abs(z1.log_z - z2.log_z) < 3 * math.hypot(z1.log_z_err, z2.log_z_err) + 0.02
+
+
+def test_a_ladder_that_fails_first_hands_over_to_emcee_and_says_why(monkeypatch):
+    # Importance sampling and the ladder tried first both made to fail: emcee gives the
+    # posterior, and the criteria keep why the ladder did not (a linear-algebra failure in its
+    # mixture fit is a reason to hand over, not an error of the comparison).
+    import bayesfo.comparison.run as run
+
+    monkeypatch.setattr(run, "importance_posterior",
+                        lambda *a, **k: (None, None, {"reason": "forced"}))
+
+    def failing(*args, **kwargs):
+        raise np.linalg.LinAlgError("Matrix is not positive definite")
+
+    monkeypatch.setattr(run, "ladder_runs", failing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PredictiveWarning)
+        r = bf.compare(bf.read(DATA), "zener", seed=1, workers=1, progress=False,
+                       noise="constant")["zener"]
+    assert r.posterior.sampler == "emcee" and r.posterior.converged
+    assert ("zener: the tempered-ladder runs tried first did not certify the posterior (Matrix "
+            "is not positive definite); emcee ran instead") in r.criteria["warnings"]

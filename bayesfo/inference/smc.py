@@ -72,6 +72,7 @@ class _Target:
         self.lik = lik
         self.tr = _Transform(lik)
         self._parts = _log_parts_fn(lik, self.tr)
+        self._box_parts = _log_parts_fn(lik, self.tr, constraints=False)
         self.calls = 0
 
     def __call__(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -83,20 +84,8 @@ class _Target:
         """As a call, but without the structure's constraints (stability, dissipation,
         inequalities): only the prior box. :func:`_accept` checks them where a move would
         be accepted."""
-        lik, tr = self.lik, self.tr
-        log_prior = np.full(u.shape[0], -np.inf)
-        log_lik = np.full(u.shape[0], -np.inf)
-        rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
-        if rows.size:
-            theta = tr.to_theta(u[rows])
-            lp = np.full(rows.size, tr.flat_const)
-            for i, prior in tr.other:
-                lp = lp + prior.log_prob(theta[:, i])
-            log_prior[rows] = lp
-            # Outside the constraints a response may overflow: such values are -inf anyway.
-            with np.errstate(all="ignore"):
-                log_lik[rows] = lik(theta)
-            self.calls += rows.size
+        log_prior, log_lik = self._box_parts(u)
+        self.calls += int(np.count_nonzero(np.isfinite(log_prior)))
         return log_prior, log_lik
 
     def holds(self, u: np.ndarray) -> np.ndarray:

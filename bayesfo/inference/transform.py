@@ -4,6 +4,8 @@ ladder, importance sampling, bridge sampling)."""
 
 from __future__ import annotations
 
+from contextlib import nullcontext
+
 import numpy as np
 
 from ..priors import LogUniform, Uniform
@@ -35,9 +37,12 @@ class _Transform:
             return np.where(self.log, np.log(np.abs(theta)), theta)
 
 
-def _log_parts_fn(lik: Likelihood, tr: _Transform):
+def _log_parts_fn(lik: Likelihood, tr: _Transform, *, constraints: bool = True):
     """(log prior density in u, log-likelihood) of a batch of points in u, both −inf outside
-    the support; the tempered ladder weighs the two parts differently."""
+    the support; the tempered ladder weighs the two parts differently. With
+    ``constraints=False`` only the prior box bounds the support: the structure's constraints
+    (stability, dissipation, inequalities) are left to the caller (the ladder checks them only
+    where a move would be accepted), and a response that overflows outside them is −inf."""
     k = lik.structure.n_params
     kind, grid = lik.data.kind, lik.grid
 
@@ -49,14 +54,16 @@ def _log_parts_fn(lik: Likelihood, tr: _Transform):
         if not rows.size:
             return log_prior, log_lik
         theta = tr.to_theta(u[rows])
-        ok = lik.structure.constraints_hold(theta[:, :k], kind, grid)
-        rows, theta = rows[ok], theta[ok]
+        if constraints:
+            ok = lik.structure.constraints_hold(theta[:, :k], kind, grid)
+            rows, theta = rows[ok], theta[ok]
         if rows.size:
             lp = np.full(rows.size, tr.flat_const)
             for i, prior in tr.other:
                 lp = lp + prior.log_prob(theta[:, i])
             log_prior[rows] = lp
-            log_lik[rows] = lik(theta)
+            with np.errstate(all="ignore") if not constraints else nullcontext():
+                log_lik[rows] = lik(theta)
         return log_prior, log_lik
 
     return log_parts

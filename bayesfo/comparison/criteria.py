@@ -177,14 +177,37 @@ def _evidence_check(lik, post, evidence, seed) -> dict:
     return out
 
 
+def delta_loo_se(results) -> dict[str, float]:
+    """``{name: se}``: the standard error of each structure's difference in PSIS-LOO elpd to
+    the structure with the highest elpd, sqrt(N·var(elpd_i,best − elpd_i)) over the N
+    frequencies, as ``arviz.compare`` computes its ``dse`` (0 for the best structure).
+
+    From the pointwise elpd the criteria keep (``loo_pointwise``): ``arviz.compare`` would give
+    the same numbers (tested) but runs PSIS again for every structure, 0.29 s against 0.4 ms
+    for the seven structures of the demo. Structures whose elpd is not finite are left out.
+    """
+    pointwise = {r.name: np.asarray(r.criteria["loo_pointwise"], float) for r in results
+                 if r.error is None and r.criteria.get("loo_pointwise") is not None}
+    pointwise = {k: v for k, v in pointwise.items() if np.all(np.isfinite(v))}
+    if not pointwise:
+        return {}
+    best = max(pointwise, key=lambda n: pointwise[n].sum())
+    return {name: float(np.sqrt(lpd.size * np.var(pointwise[best] - lpd)))
+            for name, lpd in pointwise.items()}
+
+
 def _model_probabilities(results, prior_odds: dict) -> list:
-    """The results with their posterior model probabilities (from ln Z and the prior odds) in
-    their criteria: new objects (``dataclasses.replace``); the structures without an evidence
-    are returned as they are."""
-    with_z = [r for r in results if r.error is None and r.criteria.get("evidence") is not None]
+    """The results with what is computed across structures in their criteria: the posterior
+    model probabilities (from ln Z and the prior odds) and the standard error of each
+    structure's Δelpd LOO (:func:`delta_loo_se`). New objects (``dataclasses.replace``); a
+    structure without an evidence has no probability."""
     unknown = set(prior_odds) - {r.name for r in results}
     if unknown:
         raise InputError(f"prior odds given for unknown structure '{sorted(unknown)[0]}'")
+    dse = delta_loo_se(results)
+    results = [replace(r, criteria=replace(r.criteria, delta_loo_se=dse[r.name]))
+               if r.name in dse else r for r in results]
+    with_z = [r for r in results if r.error is None and r.criteria.get("evidence") is not None]
     if not with_z:
         return list(results)
     log_w = np.array([r.criteria["evidence"].log_z + math.log(prior_odds.get(r.name, 1.0))

@@ -63,6 +63,10 @@ class Criteria:
         Log predictive density and RMSE on the held-out frequencies.
     holdout_lpd_pointwise, holdout_omega : tuple of float or None
         The log predictive density per held-out frequency, and those frequencies [rad/s].
+    delta_loo_se : float or None
+        Standard error of the difference in PSIS-LOO elpd to the structure of the comparison
+        with the highest elpd, from the pointwise differences (``arviz.compare``'s ``dse``;
+        0 for that structure; None when the elpd is undefined).
     posterior_probability : float or None
         Posterior model probability among the structures compared (from ln Z and the prior
         odds).
@@ -93,6 +97,7 @@ class Criteria:
     holdout_lpd_pointwise: tuple[float, ...] | None = None
     holdout_omega: tuple[float, ...] | None = None
     posterior_probability: float | None = None
+    delta_loo_se: float | None = None
 
     def __post_init__(self):
         for name in _SEQUENCES:

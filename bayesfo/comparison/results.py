@@ -207,6 +207,7 @@ class StructureResult:
             evidence_check=None if check is None else check.to_dict(),
             evidence_agree=self.criteria.get("evidence_agree"),
             posterior_probability=self.criteria.get("posterior_probability"),
+            delta_loo_se=self.criteria.get("delta_loo_se"),
         )
         for key in ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
                     "pareto_k_max", "rmse"):
@@ -229,7 +230,10 @@ class StructureResult:
             optimum=None if self.fit is None else {
                 "parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
                 "rmse": self.fit.rmse, "starts": self.fit.n_starts,
-                "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible},
+                "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible,
+                # The thesis' linear methods 1–5 at their best q, as the corner plot marks them.
+                "linear_methods": {k: dict(zip(self.fit.param_names, map(float, v)))
+                                   for k, v in self.fit.linear.items()}},
         )
         return out
 
@@ -513,6 +517,7 @@ def ranking_rows(structures, ranking) -> list[dict]:
             **{f"rank_{k}": v[name] for k, v in ranks.items()},
             "loo": loo, "loo_se": s.get("loo_se"),
             "delta_loo": None if loo is None else loo - best_loo,
+            "delta_loo_se": s.get("delta_loo_se"),
             "waic": s.get("waic"), "aic": s.get("aic"), "aicc": s.get("aicc"),
             "bic": s.get("bic"), "max_log_likelihood": s.get("max_log_likelihood"),
             "rmse": s.get("rmse"),
@@ -542,5 +547,5 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "holdout_lpd", "holdout_rmse", "q_mean",
                   "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
                   "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
-                  "max_log10_magnitude_error", "error", "physical_parameters")
+                  "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se")
 

@@ -292,7 +292,9 @@ def _fit(s: dict, data: FrequencyResponse) -> FitResult:
         theta=np.array([_num(v) for v in opt["parameters"].values()]), theta_scaled=None,
         rmse=_num(opt["rmse"]), chi2=None, weighting=None, admissible=bool(opt["admissible"]),
         n_starts=int(opt["starts"]), n_admissible=None, n_at_best=int(opt["starts_at_optimum"]),
-        optima=None, scaling=Scaling.from_data(data))
+        optima=None, scaling=Scaling.from_data(data),
+        linear={k: np.array([_num(v[n]) for n in opt["parameters"]])
+                for k, v in opt.get("linear_methods", {}).items()})
 
 
 def _evidence(block: dict | None, attrs=None) -> Evidence | None:
@@ -349,7 +351,8 @@ def _criteria(s: dict, idata) -> Criteria:
         evidence_check=_evidence(s.get("evidence_check")),
         evidence_agree=s.get("evidence_agree"), noise_models=s.get("noise_models"),
         adequacy=_adequacy(s.get("adequacy")),
-        posterior_probability=s.get("posterior_probability"))
+        posterior_probability=s.get("posterior_probability"),
+        delta_loo_se=s.get("delta_loo_se"))
     for key in _HOLDOUT:
         if key in s:
             values[key] = _num(s[key]) if key in ("holdout_lpd", "holdout_rmse") else s[key]

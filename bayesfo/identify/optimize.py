@@ -25,7 +25,7 @@ from ..structures import Scaling, Structure
 WEIGHTINGS = ("auto", "sigma", "relative", "none")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FitResult:
     """The outcome of :func:`fit_structure`.
 
@@ -55,6 +55,10 @@ class FitResult:
         Distinct admissible local optima (scaled), best first: the modes that seed the sampler.
     scaling : Scaling
         The units of the scaled problem (``theta_scaled``, ``optima``).
+    linear : dict of str to ndarray
+        The thesis' linear methods 1–5 at their best q (:func:`linear_fits`), in physical units,
+        kept so that figures mark them without fitting again; empty unless ``fit_structure``
+        ran with ``seed_methods=True``, and for structures not of the thesis form.
     """
 
     structure: str
@@ -70,6 +74,7 @@ class FitResult:
     n_at_best: int
     optima: np.ndarray = field(repr=False)
     scaling: Scaling = field(default_factory=Scaling, repr=False)
+    linear: dict = field(default_factory=dict, repr=False)
 
     def to_dict(self) -> dict:
         return {
@@ -82,6 +87,8 @@ class FitResult:
             "n_starts": self.n_starts,
             "n_admissible": self.n_admissible,
             "n_at_best": self.n_at_best,
+            "linear_methods": {k: dict(zip(self.param_names, map(float, v)))
+                               for k, v in self.linear.items()},
         }
 
 
@@ -176,7 +183,8 @@ def fit_structure(
         Extra starts in physical units.
     seed_methods : bool
         Also start from the linear methods 2 and 3 (thesis Table 3.1) on a coarse q grid, for
-        structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
+        structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`), and
+        keep the fits of methods 1–5 at their best q in ``FitResult.linear``.
     min_starts, stop_after : int
         Stop once at least ``min_starts`` starts have run and ``stop_after`` of them ended at
         the best admissible cost found so far (``stop_after=None`` runs every start). Given and
@@ -278,6 +286,7 @@ def fit_structure(
         n_at_best=at_best,
         optima=optima,
         scaling=prob.scaling,
+        linear=linear_fits(structure, data) if seed_methods else {},
     )
 
 

@@ -286,38 +286,6 @@ def _label(name: str, log: bool, unit: str = "") -> str:
     return (f"log$_{{10}}$ {sym}" if log else sym) + unit_suffix(unit)
 
 
-def loo_differences(results) -> dict[str, tuple[float, float]]:
-    """``{name: (Δelpd, se of Δelpd)}`` of PSIS-LOO relative to the structure with the highest
-    elpd, the standard error from the pointwise differences (as ``arviz.compare``'s ``dse``).
-
-    The draws are those of each result's InferenceData; all results must be on the same data.
-    Pareto-k warnings of arviz are not repeated here: :func:`bayesfo.comparison.compare` has
-    already reported them and flagged the structures.
-    """
-    import warnings
-
-    from ..inference._arviz import arviz
-
-    az = arviz()
-    pointwise = {}
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message="Estimated shape parameter of Pareto",
-                                category=UserWarning)
-        warnings.filterwarnings("ignore", category=RuntimeWarning)  # overflow in arviz' PSIS
-        for r in results:
-            stored = r.criteria.get("loo_pointwise")
-            pointwise[r.name] = (np.asarray(stored) if stored is not None else
-                                 np.asarray(az.loo(r.posterior.idata, pointwise=True).loo_i))
-    if not pointwise:
-        return {}
-    best = max(pointwise, key=lambda n: pointwise[n].sum())
-    out = {}
-    for name, lpd in pointwise.items():
-        diff = pointwise[best] - lpd
-        out[name] = (float(-diff.sum()), float(np.sqrt(diff.size * np.var(diff))))
-    return out
-
-
 #: Two curves that differ by less than this fraction of their axis' span at every point are
 #: drawn within a line width of each other (a 1.2 pt line on an axes of about 150 pt).
 COINCIDE_FRACTION = 0.008

@@ -7,7 +7,6 @@ import tempfile
 from pathlib import Path
 
 from ..errors import InputError
-from ..identify.optimize import linear_fits
 from ._compute import ok_results, order_parameter
 from .captions import file_stem
 from .posterior import plot_corner, plot_q_posteriors, plot_trace
@@ -65,11 +64,10 @@ def _combined_makers(comparison, seed: int) -> dict:
     return makers
 
 
-def _structure_makers(result, data, color) -> dict:
+def _structure_makers(result, color) -> dict:
     stem = _file_stem(result.name)
     return {
-        f"corner_{stem}": lambda: plot_corner(result, color=color,
-                                              linear=linear_fits(result.structure, data)),
+        f"corner_{stem}": lambda: plot_corner(result, color=color, linear=result.fit.linear),
         f"trace_{stem}": lambda: plot_trace(result, color=color),
     }
 
@@ -80,7 +78,7 @@ def figure_jobs(comparison, *, seed: int = 0) -> list[tuple[str, object]]:
     jobs = list(_combined_makers(comparison, seed).items())
     styles = comparison_styles(comparison)
     for r in ok_results(comparison):
-        jobs.extend(_structure_makers(r, comparison.data, styles[r.name].color).items())
+        jobs.extend(_structure_makers(r, styles[r.name].color).items())
     return jobs
 
 
@@ -108,7 +106,7 @@ def _save_all(makers: dict, out_dir: Path, formats) -> dict[str, list[Path]]:
 
 def _draw_in_worker(task: tuple, out_dir: Path, formats, seed: int) -> dict[str, list[Path]]:
     """One task of a worker process: ``("combined", comparison, names)`` or
-    ``("structure", result, data, color)``."""
+    ``("structure", result, color)``."""
     import matplotlib
 
     matplotlib.use("agg")  # a worker never shows a window
@@ -116,8 +114,8 @@ def _draw_in_worker(task: tuple, out_dir: Path, formats, seed: int) -> dict[str,
         _, comparison, names = task
         makers = {k: v for k, v in _combined_makers(comparison, seed).items() if k in names}
     else:
-        _, result, data, color = task
-        makers = _structure_makers(result, data, color)
+        _, result, color = task
+        makers = _structure_makers(result, color)
     return _save_all(makers, out_dir, formats)
 
 
@@ -166,7 +164,7 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
     combined = list(_combined_makers(comparison, seed))
     styles = comparison_styles(comparison)
     # Per-structure tasks carry one result only; the combined figures need all of them.
-    tasks = [("structure", r, comparison.data, styles[r.name].color)
+    tasks = [("structure", r, styles[r.name].color)
              for r in ok_results(comparison)]
     tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
     futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed) for t in reversed(tasks)]

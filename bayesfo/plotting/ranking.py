@@ -6,7 +6,6 @@ import numpy as np
 
 from ..errors import InputError
 from ._base import Drawn, new_figure
-from ._compute import loo_differences
 from .style import COLUMN_WIDTH, FLAG_COLOR, comparison_styles, style
 
 #: Below this Δ (nats) the Δ axes switch to a symmetric-log scale, linear within ±SYMLOG_LINEAR.
@@ -129,7 +128,6 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         raise InputError("the comparison has no structure that ran")
     n = len(rows)
     names = [row["structure"] for row in rows]
-    dse = loo_differences([comparison[name] for name in names])
     y = np.arange(n - 1, -1, -1, dtype=float)
     best_aic = min(row["aic"] for row in rows)
     best_bic = min(row["bic"] for row in rows)
@@ -139,7 +137,7 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         "log_evidence_err": np.array([_nan(r["log_evidence_err"]) for r in rows]),
         "posterior_probability": np.array([_nan(r["posterior_probability"]) for r in rows]),
         "delta_loo": np.array([r["delta_loo"] for r in rows], float),
-        "delta_loo_se": np.array([dse[n][1] for n in names], float),
+        "delta_loo_se": np.array([_nan(r.get("delta_loo_se")) for r in rows]),
         "delta_aic_half": np.array([-(r["aic"] - best_aic) / 2 for r in rows], float),
         "delta_bic_half": np.array([-(r["bic"] - best_bic) / 2 for r in rows], float),
         "converged": np.array([bool(r["converged"]) for r in rows]),

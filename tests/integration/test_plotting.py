@@ -271,8 +271,11 @@ def test_ranking_loo_error_is_that_of_the_difference(comparison):
         warnings.filterwarnings("ignore", message="Estimated shape parameter of Pareto")
         warnings.filterwarnings("ignore", message="The inplace keyword")
         ref = arviz().compare(idata, ic="loo")
+    rows = {row["structure"]: row for row in comparison.table()}
     for name, se in zip(drawn.values["structures"], drawn.values["delta_loo_se"]):
         assert se == pytest.approx(float(ref.loc[name, "dse"]), rel=1e-6, abs=1e-9)
+        # Computed once, with the criteria: the table and summary.json hold the same number.
+        assert rows[name]["delta_loo_se"] == se == comparison[name].criteria["delta_loo_se"]
 
 
 def test_ranking_flags_a_posterior_that_did_not_converge(comparison):
@@ -324,6 +327,10 @@ def test_corner_marks_the_linear_methods(comparison):
     r = comparison["zener"]
     fits = linear_fits(r.structure, comparison.data)
     assert sorted(fits) == [f"method {k}" for k in range(1, 6)]
+    # compare() keeps them with the optimum, so figures need not fit again.
+    assert sorted(r.fit.linear) == sorted(fits)
+    for label, theta in fits.items():
+        np.testing.assert_array_equal(r.fit.linear[label], theta)
     # Method 2 at a fixed q is an independent linear least-squares problem: check one entry.
     assert 0.0 < fits["method 2"][-1] <= 1.0
     drawn = plot_corner(r, linear=fits)

@@ -138,7 +138,7 @@ def test_the_parameters_block_is_unchanged_and_gains_units(zener_run):
 def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_run):
     result, out = zener_run
     assert RANKING_FIELDS[: len(OLD_RANKING_FIELDS)] == OLD_RANKING_FIELDS
-    assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == ("physical_parameters",)
+    assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == ("physical_parameters", "delta_loo_se")
     with (out / "ranking.csv").open(newline="") as fh:
         (row,) = list(csv.DictReader(fh))
     text = row["physical_parameters"]

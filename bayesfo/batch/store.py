@@ -128,7 +128,7 @@ def summary_rows(summary: dict) -> list[dict]:
     the rows of ``Comparison.table`` and ``ranking.csv``), with what a batch adds: whether it
     is the best, the order parameter's HDI and MAP, the noise model, the data's kind and size
     and the warnings."""
-    from ..comparison.results import order_parameter, ranking_rows
+    from ..comparison.table import order_parameter, ranking_rows
 
     structures = {s["name"]: s for s in summary["structures"]}
     ranking = list(summary.get("ranking", []))

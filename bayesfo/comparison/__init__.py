@@ -9,9 +9,10 @@ rank them, and write the output directory; read it back.
 from .criteria import LADDER_SHORTFALL, PARETO_K_WARN
 from .criteria_types import Criteria
 from .output import ranking_csv, write_outputs
-from .results import RANKING_FIELDS, Comparison, StructureResult, ranking_rows
+from .results import Comparison, StructureResult
 from .run import compare
 from .stored import load
+from .table import RANKING_FIELDS, ranking_rows
 
 __all__ = ["LADDER_SHORTFALL", "PARETO_K_WARN", "RANKING_FIELDS", "Comparison", "Criteria",
            "StructureResult", "compare", "load", "ranking_csv", "ranking_rows", "write_outputs"]

@@ -14,8 +14,9 @@ import numpy as np
 from .._io import atomic_write_text
 from ..inference import save_netcdf
 from ..outdir import final_path, staged_run
-from .results import RANKING_FIELDS, Comparison
+from .results import Comparison
 from .stored import netcdf_for
+from .table import RANKING_FIELDS
 
 
 def ranking_csv(comparison: Comparison) -> str:

@@ -24,6 +24,7 @@ from .parameters import (  # noqa: F401  (re-exported: the names results offered
     physical_text,
     summarise_draws,
 )
+from .table import RANKING_FIELDS, order_parameter, ranking_rows  # noqa: F401  (re-exported)
 
 
 @dataclass(frozen=True, eq=False)
@@ -442,110 +443,3 @@ class Comparison:
                                                    for m in members)),
             })
         return sorted(out, key=lambda f: -f["log_evidence"])
-
-
-def order_parameter(parameters) -> str | None:
-    """The name of the fractional order among ``parameters`` (names or a dict by name): ``q``,
-    else ``beta`` (the generalised Maxwell model), else None."""
-    return next((k for k in ("q", "beta") if k in parameters), None)
-
-
-def _finite_or_none(value) -> bool:
-    return value is not None and math.isfinite(value)
-
-
-def ranking_rows(structures, ranking) -> list[dict]:
-    """The rows of the ranking table (:data:`RANKING_FIELDS`), one per structure, best first
-    and structures that could not be run last: the one definition of a ranking row, used by
-    :meth:`Comparison.table` and by ``bayesfo batch`` (from a stored ``summary.json``).
-
-    Parameters
-    ----------
-    structures : sequence of dict
-        Each structure's record as ``summary.json`` holds it (:meth:`StructureResult.to_dict`,
-        in the order the structures were run). Missing entries are None in the row; a number
-        that is None (JSON's null for NaN or infinity) ranks last, like NaN.
-    ranking : sequence of str
-        The structure names, best first (:attr:`Comparison.ranking`).
-
-    Returns
-    -------
-    list of dict
-        Failed structures: ``rank`` None, ``structure``, ``n_params``, ``error``.
-    """
-    order = {n: i for i, n in enumerate(ranking)}
-    ok = [s for s in structures if "error" not in s]
-    loos = [s.get("loo") for s in ok if _finite_or_none(s.get("loo"))]
-    best_loo = max(loos, default=math.nan)
-    best_z = max((s["log_evidence"] for s in ok if s.get("log_evidence") is not None),
-                 default=math.nan)
-    ranks = {}
-    for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
-        # An undefined criterion (NaN, with its reason among the warnings) ranks last.
-        ordered = sorted(ok, key=lambda s, c=crit, g=sign: (
-            not _finite_or_none(s.get(c)), g * s[c] if _finite_or_none(s.get(c)) else 0))
-        ranks[crit] = {s["name"]: i + 1 for i, s in enumerate(ordered)}
-    rows = []
-    for s in sorted(structures, key=lambda s: order.get(s["name"], len(order))):
-        name = s["name"]
-        if "error" in s:
-            rows.append({"rank": None, "structure": name, "n_params": s.get("n_params"),
-                         "error": s["error"]})
-            continue
-        params = s.get("parameters") or {}
-        q_name = order_parameter(params)
-        q = params[q_name] if q_name is not None else None
-        log_z = s.get("log_evidence")
-        loo = s.get("loo")
-        adequacy = s.get("adequacy")
-        if adequacy is None:
-            fits = None
-        else:
-            fits = ("yes" if adequacy.get("adequate")
-                    else "small" if adequacy.get("misfit_small") else "no")
-        p_values = None if adequacy is None else [
-            math.nan if v is None else v for v in adequacy.get("p_values", {}).values()]
-        rows.append({
-            "rank": order[name] + 1 if name in order else None, "structure": name,
-            "n_params": s.get("n_params"), "parent": s.get("parent"), "log_evidence": log_z,
-            "log_evidence_err": s.get("log_evidence_err"),
-            "evidence_method": s.get("evidence_method"),
-            "delta_log_evidence": None if log_z is None else log_z - best_z,
-            "bayes_factor": None if log_z is None else math.exp(log_z - best_z),
-            "posterior_probability": s.get("posterior_probability"),
-            "evidence_agree": s.get("evidence_agree"),
-            **{f"rank_{k}": v[name] for k, v in ranks.items()},
-            "loo": loo, "loo_se": s.get("loo_se"),
-            "delta_loo": None if loo is None else loo - best_loo,
-            "delta_loo_se": s.get("delta_loo_se"),
-            "waic": s.get("waic"), "aic": s.get("aic"), "aicc": s.get("aicc"),
-            "bic": s.get("bic"), "max_log_likelihood": s.get("max_log_likelihood"),
-            "rmse": s.get("rmse"),
-            "holdout_lpd": s.get("holdout_lpd"), "holdout_rmse": s.get("holdout_rmse"),
-            "q_mean": None if q is None else q.get("mean"),
-            "q_sd": None if q is None else q.get("sd"),
-            "pareto_k_max": s.get("pareto_k_max"), "rhat_max": s.get("rhat_max"),
-            "ess_min": s.get("ess_min"), "converged": s.get("converged"),
-            "sampler": s.get("sampler"), "fits": fits,
-            "adequate": None if adequacy is None else adequacy.get("adequate"),
-            "adequacy_p_min": None if not p_values else min(p_values),
-            "max_phase_error_deg": None if adequacy is None
-            else adequacy.get("max_phase_error_deg"),
-            "max_log10_magnitude_error": None if adequacy is None
-            else adequacy.get("max_log10_magnitude_error"),
-            "error": "",
-            # Posterior medians of the physical parameters, with units, as one text cell.
-            "physical_parameters": physical_text(s.get("parameters_physical")),
-        })
-    return rows
-
-
-RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "log_evidence_err",
-                  "evidence_method", "delta_log_evidence", "bayes_factor", "posterior_probability", "evidence_agree",
-                  "loo", "loo_se", "delta_loo", "rank_loo", "waic", "rank_waic", "aic", "rank_aic",
-                  "aicc", "rank_aicc", "bic", "rank_bic", "max_log_likelihood", "rmse",
-                  "holdout_lpd", "holdout_rmse", "q_mean",
-                  "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
-                  "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
-                  "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se")
-

@@ -130,19 +130,43 @@ def _into_support(lik: Likelihood, tr: _Transform, theta, anchor, *, steps: int 
 
 
 def _snooker_move():
-    """emcee's DE snooker move, with the proposal through a walker's own position made a null move.
+    """The DE snooker move of ter Braak & Vrugt (2008), on emcee's four-way split of the walkers.
 
-    emcee divides by the distance between the walker and the chosen point ``z``; when walkers
-    coincide (all of them pinned in a corner of the prior box, as the integer Voigt is on the
-    26-decade NREL curve), that proposal is NaN and emcee raises. Staying put instead is a
-    rejected proposal, which leaves the target invariant.
+    For walker x, three walkers z, z1, z2 of the complementary sets (in random roles): with e the
+    unit vector of x − z, the proposal is x' = x + γ·e·eᵀ(z1 − z2) (γ = 1.7), accepted with the
+    extra factor (|x' − z| / |x − z|)^(d−1).
+
+    emcee's own DESnookerMove (3.1.6, its latest release) is not used: it divides x − z by
+    √|x − z| instead of |x − z| (the step is then the projection times |x − z|) and takes half
+    the exponent d − 1, so it does not leave the target invariant (fixed upstream by
+    dfm/emcee#531, not released). Measured: on a 5-D normal of sd 1 (0.03) alone it keeps walkers
+    with sd 0.83 (0.61) of the truth; in bayesfo's mixture (a fifth of the moves) the Zener's
+    posterior sds on the bundled 20 °C isotherm came out 2–5 % below those of importance
+    sampling and of random-walk Metropolis (mean of 20 converged runs: a1 −2.4 %, q −3.4 %,
+    σ −2.1 %, b1 −6.6 %); with this move they agree within 1 % (+0.2 %, +0.2 %, +1.1 %, +1.6 %,
+    each ± 0.5–1.4 %).
+
+    A proposal through a walker's own position (z = x: walkers that coincide, all of them
+    pinned in a corner of the prior box, as the integer Voigt is on the 26-decade NREL curve)
+    is not defined; it is made a null move (staying put is a rejected proposal, which leaves
+    the target invariant).
     """
     import emcee
 
     class _SnookerMove(emcee.moves.DESnookerMove):
         def get_proposal(self, s, c, random):
+            ns, ndim = s.shape
+            # One walker from each of the three complementary sets, in random roles.
+            picks = np.stack([cj[random.randint(len(cj), size=ns)] for cj in c[:3]], axis=1)
+            roles = np.argsort(random.rand(ns, 3), axis=1)
+            picks = np.take_along_axis(picks, roles[:, :, None], axis=1)
+            z, z1, z2 = picks[:, 0], picks[:, 1], picks[:, 2]
             with np.errstate(invalid="ignore", divide="ignore"):
-                q, factors = super().get_proposal(s, c, random)
+                delta = s - z
+                norm = np.linalg.norm(delta, axis=1)
+                e = delta / norm[:, None]
+                q = s + self.gammas * np.sum(e * (z1 - z2), axis=1)[:, None] * e
+                factors = (ndim - 1.0) * (np.log(np.linalg.norm(q - z, axis=1)) - np.log(norm))
             bad = ~np.all(np.isfinite(q), axis=1) | ~np.isfinite(factors)
             q[bad] = s[bad]
             factors = np.where(bad, 0.0, factors)

@@ -1,7 +1,13 @@
-"""The same seed gives the same summary.json: a comparison against a run stored before the
-layout of the package changed (tests/data/stored_run_Tp150C.json, written by
-``bayesfo compare examples/data/adhesive_468mp/Tp150C.csv --structures voigt,zener-int
---no-figures --workers 1 --seed 3``)."""
+"""The same seed gives the same summary.json: a comparison against a stored run
+(tests/data/stored_run_Tp150C.json, written by ``bayesfo compare
+examples/data/adhesive_468mp/Tp150C.csv --structures voigt,zener-int --no-figures --workers 1
+--seed 3 --sampler emcee --noise constant``).
+
+Stored again when the DE snooker move became ter Braak & Vrugt's (emcee's own is not invariant,
+tests/integration/test_emcee_spread.py): with it, the Voigt's emcee walkers no longer pass as
+converged on a posterior with a long tail in a1, and the tempered ladder certifies it instead
+(a1 sd 521; the run stored before had 82 from walkers that had not seen the tail, and its seeds
+4 and 5 gave 7 and 14). ln Z moved from −244.33 (bridge) to −244.24 ± 0.03 (ladder)."""
 
 from __future__ import annotations
 
@@ -34,8 +40,11 @@ def _diff(a, b, where="") -> list[str]:
     return [] if a == b else [f"{where}: {a!r} != {b!r}"]
 
 
-# zener-int has a Pareto k above 0.7 at one frequency on these data (stored in the summary).
+# zener-int has a Pareto k above 0.7 at one frequency on these data (stored in the summary);
+# the Voigt's emcee walkers do not converge (the ladder's posterior is reported, and said so).
 @pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.ConvergenceWarning")
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.CertifiedWarning")
 def test_the_same_seed_gives_the_stored_summary(tmp_path):
     stored = json.loads(STORED.read_text())
     data = bf.read(ROOT / "examples" / "data" / "adhesive_468mp" / "Tp150C.csv")

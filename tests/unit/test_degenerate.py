@@ -23,15 +23,23 @@ def test_snooker_proposal_through_a_walkers_own_position_stays_put():
     assert np.all(factors == 0.0)
 
 
-def test_snooker_proposal_is_emcees_where_walkers_differ():
-    import emcee
-
+def test_snooker_proposal_is_ter_braak_vrugts_where_walkers_differ():
+    # emcee 3.1.6's DESnookerMove divides x - z by sqrt|x - z| and halves the exponent, so the
+    # move is ter Braak & Vrugt's own (its invariance: tests/integration/test_emcee_spread.py).
     rng = np.random.default_rng(1)
     s, c = rng.normal(size=(8, 3)), [rng.normal(size=(8, 3)) for _ in range(3)]
-    ours = _snooker_move().get_proposal(s, c, np.random.RandomState(4))
-    theirs = emcee.moves.DESnookerMove().get_proposal(s, c, np.random.RandomState(4))
-    np.testing.assert_array_equal(ours[0], theirs[0])
-    np.testing.assert_array_equal(ours[1], theirs[1])
+    q, factors = _snooker_move().get_proposal(s, c, np.random.RandomState(4))
+    r = np.random.RandomState(4)  # the same draws: one walker per set, then their roles
+    picks = np.stack([cj[r.randint(len(cj), size=8)] for cj in c], axis=1)
+    picks = np.take_along_axis(picks, np.argsort(r.rand(8, 3), axis=1)[:, :, None], axis=1)
+    z, z1, z2 = picks[:, 0], picks[:, 1], picks[:, 2]
+    e = (s - z) / np.linalg.norm(s - z, axis=1)[:, None]
+    expected = s + 1.7 * np.sum(e * (z1 - z2), axis=1)[:, None] * e
+    np.testing.assert_allclose(q, expected, rtol=1e-12)
+    # The step lies along x - z: the proposal, the walker and z are on one line.
+    np.testing.assert_allclose(np.cross(q - z, s - z), 0.0, atol=1e-12)
+    ratio = np.linalg.norm(q - z, axis=1) / np.linalg.norm(s - z, axis=1)
+    np.testing.assert_allclose(factors, 2.0 * np.log(ratio), rtol=1e-12)  # (d - 1) = 2
 
 
 def test_moments_that_overflow_are_undefined_not_a_warning():

@@ -12,8 +12,9 @@ dynesty nested sampling, flagged when the two disagree by more than twice their 
 and the posterior predictive adequacy checks (:mod:`bayesfo.inference.adequacy`). Structures are
 ranked by ln Z; posterior model probabilities assume equal prior odds unless given.
 
-Structures run one after the other or side by side in worker processes (``workers``); each runs
-with the same seed, so the numbers do not depend on how many.
+Structures run one after the other or side by side in worker processes (``workers``), where
+the posteriors of a structure's two noise models run side by side too (:mod:`.schedule`); each
+step runs with the same seed, so the numbers do not depend on how many.
 
 Outputs (:func:`~bayesfo.comparison.output.write_outputs`, staged and swapped in as one run by
 :mod:`bayesfo.outdir`): one ``<structure>.nc`` (arviz InferenceData) per structure,
@@ -114,6 +115,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     """
     from tqdm.auto import tqdm
 
+    from .schedule import run_in_pool
+
     structures = _as_structures(structures)
     _check_sampler_options(sampler_kwargs)
     if not structures:
@@ -157,12 +160,12 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
             outcomes.append(_run_structure(s, data, options))
             bar.update()
     elif pool is not None:
-        outcomes = _run_in_pool(pool, structures, data, options, bar)
+        outcomes = run_in_pool(pool, structures, data, options, bar)
     else:
         # Each structure gets the same seed whatever the worker count, so the numbers do not
         # depend on it.
         with process_pool(n_proc) as own:
-            outcomes = _run_in_pool(own, structures, data, options, bar)
+            outcomes = run_in_pool(own, structures, data, options, bar)
     bar.close()
     results = []
     for result, caught in outcomes:
@@ -198,15 +201,6 @@ def _check_sampler_options(options: dict) -> None:
         if name not in known:
             raise InputError(f"compare: unknown sampler option {name!r}; the options are "
                              + ", ".join(known))
-
-
-def _run_in_pool(pool, structures, data, options, bar) -> list:
-    # Larger structures first (they take longest); results keep the order given.
-    order = sorted(range(len(structures)), key=lambda i: -structures[i].n_params)
-    futures = {i: pool.submit(_run_structure, structures[i], data, options) for i in order}
-    for f in futures.values():
-        f.add_done_callback(lambda _: bar.update())
-    return [futures[i].result() for i in range(len(structures))]
 
 
 def remedy(lik) -> str:
@@ -436,64 +430,81 @@ NOISE_DECISIVE = 0.99
 
 
 def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
-    """Optimisation, posterior, criteria and evidence of one structure (runs in a worker process
-    when ``compare`` has several). Returns the result and the warnings raised on the way."""
-    seed, test = options["seed"], options["test"]
+    """Optimisation, posterior, criteria and evidence of one structure, in three steps:
+    :func:`_fit_and_screen`, :func:`_sample_held` per noise model still in the running, and
+    :func:`_conclude` (a pool runs the steps as separate tasks, :mod:`.schedule`). Returns the
+    result and the warnings raised on the way."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            candidates = _noise_candidates(data, options["noise"])
-            structure = Likelihood(s, data, noise=candidates[0], priors={
-                k: v for k, v in (options["priors"] or {}).items() if k in s.param_names
-            }).structure
-            fit = fit_structure(structure, data, rng=seed, seed_methods=True)
-            screened = _screen(s, data, candidates, fit, options)
-            runs = []
-            for noise in candidates:
-                if screened is not None and noise != screened["leader"]:
-                    continue
-                # Warnings of each noise model's run are held back: only the chosen one's
-                # reach the user (the other's are kept in its record).
-                with warnings.catch_warnings(record=True) as held:
-                    warnings.simplefilter("always")
-                    runs.append(_sample(s, data, noise, fit, options))
-                runs[-1]["caught"] = held
-            if len(candidates) > 1:
-                run, record = _choose_noise(s.name, runs, screened)
-            else:
-                run, record = runs[0], None
-            lik, post, criteria = run["lik"], run["post"], run["criteria"]
-            for w in run["caught"]:
-                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-            for other in runs:
-                if other is not run:
-                    record["models"][other["lik"].noise]["warnings"] = list(
-                        dict.fromkeys(str(w.message) for w in other["caught"]))
-            criteria["noise_models"] = record
-            if options["evidence_check"] and criteria["evidence"] is not None:
-                check = _evidence_check(lik, post, criteria["evidence"], seed)
-                criteria["warnings"].extend(check.pop("warnings"))
-                criteria.update(check)
-            try:
-                criteria["adequacy"] = check_adequacy(lik, post, seed=seed)
-            except InputError as exc:  # e.g. too few frequencies for the statistics
-                criteria["adequacy"] = None
-                criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
-            if test is not None:
-                criteria.update(_holdout(lik, post, test))
-            result = StructureResult(s, fit, post, Criteria.from_dict(criteria))
+            fit, screened, noises = _fit_and_screen(s, data, options)
+            runs = [_sample_held(s, data, noise, fit, options) for noise in noises]
+            result = _conclude(s, data, fit, screened, runs, options)
         except InputError as exc:
             result = StructureResult(s, error=str(exc))
-    seen = set()
-    kept = []
-    for w in caught:
-        text = str(w.message)
-        if not text.startswith(f"{s.name}:"):  # a library's warning: say which structure
-            text = f"{s.name}: {text}"
-        key = (w.category, text)
-        if key not in seen and not issubclass(w.category, (DeprecationWarning, PendingDeprecationWarning)):
-            seen.add(key)
-            kept.append(key)
-    return result, kept
+    return result, _kept(s.name, [(w.category, str(w.message)) for w in caught])
 
 
+def _fit_and_screen(s: Structure, data: FrequencyResponse, options: dict):
+    """Step 1: the optimisation and the noise screen (:func:`_screen`). Returns the fit, the
+    screen's record (None when it did not decide) and the noise models to sample."""
+    candidates = _noise_candidates(data, options["noise"])
+    structure = Likelihood(s, data, noise=candidates[0], priors={
+        k: v for k, v in (options["priors"] or {}).items() if k in s.param_names
+    }).structure
+    fit = fit_structure(structure, data, rng=options["seed"], seed_methods=True)
+    screened = _screen(s, data, candidates, fit, options)
+    return fit, screened, [n for n in candidates if screened is None or n == screened["leader"]]
+
+
+def _sample_held(s: Structure, data: FrequencyResponse, noise: str, fit, options: dict) -> dict:
+    """Step 2: :func:`_sample` under one noise model, its warnings held back in
+    ``run["caught"]`` (category, message, file, line): only the chosen model's reach the user
+    (:func:`_conclude`; the other's are kept in its record)."""
+    with warnings.catch_warnings(record=True) as held:
+        warnings.simplefilter("always")
+        run = _sample(s, data, noise, fit, options)
+    run["caught"] = [(w.category, str(w.message), w.filename, w.lineno) for w in held]
+    return run
+
+
+def _conclude(s: Structure, data: FrequencyResponse, fit, screened, runs: list[dict],
+              options: dict) -> StructureResult:
+    """Step 3, once the runs of step 2 are in: the noise model chosen by evidence, the chosen
+    run's warnings issued, the evidence check, the adequacy checks, the held-out points."""
+    seed, test = options["seed"], options["test"]
+    if len(_noise_candidates(data, options["noise"])) > 1:
+        run, record = _choose_noise(s.name, runs, screened)
+    else:
+        run, record = runs[0], None
+    lik, post, criteria = run["lik"], run["post"], run["criteria"]
+    for category, message, filename, lineno in run["caught"]:
+        warnings.warn_explicit(message, category, filename, lineno)
+    for other in runs:
+        if other is not run:
+            record["models"][other["lik"].noise]["warnings"] = list(
+                dict.fromkeys(message for _, message, _, _ in other["caught"]))
+    criteria["noise_models"] = record
+    if options["evidence_check"] and criteria["evidence"] is not None:
+        check = _evidence_check(lik, post, criteria["evidence"], seed)
+        criteria["warnings"].extend(check.pop("warnings"))
+        criteria.update(check)
+    try:
+        criteria["adequacy"] = check_adequacy(lik, post, seed=seed)
+    except InputError as exc:  # e.g. too few frequencies for the statistics
+        criteria["adequacy"] = None
+        criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
+    if test is not None:
+        criteria.update(_holdout(lik, post, test))
+    return StructureResult(s, fit, post, Criteria.from_dict(criteria))
+
+
+def _kept(name: str, caught) -> list[tuple]:
+    """The warnings (category, message) of a structure's run, each once, said of the structure
+    (a library's gets its name in front; deprecations are dropped)."""
+    kept = {}
+    for category, text in caught:
+        text = text if text.startswith(f"{name}:") else f"{name}: {text}"
+        if not issubclass(category, (DeprecationWarning, PendingDeprecationWarning)):
+            kept.setdefault((category, text))
+    return list(kept)

@@ -1,0 +1,130 @@
+"""A comparison's steps as pool tasks (bayesfo.comparison.schedule): a structure's two noise
+models are sampled side by side, with the numbers, the warnings and the errors of the serial
+path."""
+
+from __future__ import annotations
+
+import json
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+import bayesfo as bf
+import bayesfo.comparison.run as run
+from bayesfo.errors import InputError
+
+DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
+#: On this isotherm the screen decides neither structure's noise model: both are sampled (by
+#: importance sampling, about half a second each).
+BOTH = "zener-int,maxwell-int"
+
+
+def _compare(structures=BOTH, **kw):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = bf.compare(bf.read(DATA), structures, seed=2, progress=False, **kw)
+    return result, [(w.category, str(w.message)) for w in caught]
+
+
+def _numbers(results) -> dict:
+    out = {}
+    for r in results:
+        c = r.criteria
+        out[r.name] = (c["evidence"].log_z, c["evidence"].log_z_err, c["loo"], c["waic"],
+                       c["noise_models"]["chosen"],
+                       {k: m["log_evidence"] for k, m in c["noise_models"]["models"].items()},
+                       r.posterior.samples.mean(axis=0).tolist())
+    return out
+
+
+def test_one_and_two_workers_give_the_same_numbers():
+    one, caught_one = _compare(workers=1)
+    two, caught_two = _compare(workers=2)
+    for r in one.results:  # both noise models sampled: the case the schedule splits
+        models = r.criteria["noise_models"]["models"]
+        assert set(models) == {"constant", "proportional"}
+        assert all(m["log_evidence_err"] is not None for m in models.values())
+    assert _numbers(one.results) == _numbers(two.results)
+    assert json.dumps(one.to_summary(), sort_keys=True, default=str) == \
+        json.dumps(two.to_summary(), sort_keys=True, default=str)
+    assert caught_one == caught_two
+
+
+class _Recorder:
+    """An executor (one thread, in this process: monkeypatches apply) that records which step
+    each task runs."""
+
+    def __init__(self):
+        self.pool = ThreadPoolExecutor(1)
+        self.steps = []
+
+    def submit(self, fn, *args):
+        self.steps.append((args[0].__name__, args[1].name,
+                           args[3] if args[0].__name__ == "_sample_held" else None))
+        return self.pool.submit(fn, *args)
+
+
+@pytest.fixture
+def noisy_sampler(monkeypatch):
+    """Each posterior warns which noise model it ran under."""
+    sample = run._sample
+
+    def warning_sample(s, data, noise, fit, options):
+        warnings.warn(f"{s.name}: sampled under {noise} noise", UserWarning, stacklevel=1)
+        return sample(s, data, noise, fit, options)
+
+    monkeypatch.setattr(run, "_sample", warning_sample)
+
+
+def test_a_pool_keeps_the_warnings_of_the_serial_path(noisy_sampler):
+    serial, caught_serial = _compare(workers=1)
+    recorder = _Recorder()
+    pooled, caught_pooled = _compare(pool=recorder)
+    recorder.pool.shutdown()
+    assert _numbers(serial.results) == _numbers(pooled.results)
+    assert caught_serial == caught_pooled
+    for r in pooled.results:
+        record = r.criteria["noise_models"]
+        other = next(n for n in record["models"] if n != record["chosen"])
+        # Only the chosen model's warning reaches the user; the other's is in its record.
+        assert (UserWarning, f"{r.name}: sampled under {record['chosen']} noise") in caught_pooled
+        assert (UserWarning, f"{r.name}: sampled under {other} noise") not in caught_pooled
+        assert record["models"][other]["warnings"][0] == f"{r.name}: sampled under {other} noise"
+    assert sorted(recorder.steps) == sorted(
+        [("_first", s, None) for s in ("zener-int", "maxwell-int")]
+        + [("_sample_held", s, n) for s in ("zener-int", "maxwell-int")
+           for n in ("constant", "proportional")]
+        + [("_conclude", s, None) for s in ("zener-int", "maxwell-int")])
+
+
+def test_an_input_error_in_a_step_ends_that_structure_alone(monkeypatch):
+    fit_structure, sample = run.fit_structure, run._sample
+
+    def failing_fit(structure, *args, **kwargs):
+        if structure.name == "zener-int":
+            raise InputError("no fit here")
+        return fit_structure(structure, *args, **kwargs)
+
+    def failing_sample(s, data, noise, fit, options):
+        if s.name == "maxwell-int" and noise == "proportional":
+            raise InputError("no posterior here")
+        return sample(s, data, noise, fit, options)
+
+    monkeypatch.setattr(run, "fit_structure", failing_fit)
+    monkeypatch.setattr(run, "_sample", failing_sample)
+    structures = BOTH + ",voigt-int"
+    serial, _ = _compare(structures, workers=1)
+    recorder = _Recorder()
+    pooled, _ = _compare(structures, pool=recorder)
+    recorder.pool.shutdown()
+    for result in (serial, pooled):
+        assert result["zener-int"].error == "no fit here"
+        assert result["maxwell-int"].error == "no posterior here"
+        assert result["voigt-int"].error is None
+    assert _numbers([serial["voigt-int"]]) == _numbers([pooled["voigt-int"]])
+    # A structure whose fit failed has no posterior to wait for; one whose posterior failed
+    # has no conclusion.
+    assert [st for st in recorder.steps if st[1] == "zener-int"] == [("_first", "zener-int", None)]
+    assert ("_conclude", "maxwell-int", None) not in recorder.steps

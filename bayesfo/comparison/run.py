@@ -452,7 +452,8 @@ def _fit_and_screen(s: Structure, data: FrequencyResponse, options: dict):
     structure = Likelihood(s, data, noise=candidates[0], priors={
         k: v for k, v in (options["priors"] or {}).items() if k in s.param_names
     }).structure
-    fit = fit_structure(structure, data, rng=options["seed"], seed_methods=True)
+    fit = fit_structure(structure, data, rng=options["seed"], seed_methods=True,
+                        linear_methods=True)
     screened = _screen(s, data, candidates, fit, options)
     return fit, screened, [n for n in candidates if screened is None or n == screened["leader"]]
 

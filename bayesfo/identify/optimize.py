@@ -58,7 +58,8 @@ class FitResult:
     linear : dict of str to ndarray
         The thesis' linear methods 1–5 at their best q (:func:`linear_fits`), in physical units,
         kept so that figures mark them without fitting again; empty unless ``fit_structure``
-        ran with ``seed_methods=True``, and for structures not of the thesis form.
+        ran with ``linear_methods=True`` (as ``compare`` runs it), and for structures not of
+        the thesis form.
     """
 
     structure: str
@@ -161,6 +162,7 @@ def fit_structure(
     weighting: str = "auto",
     starts=None,
     seed_methods: bool = False,
+    linear_methods: bool = False,
     min_starts: int = 12,
     stop_after: int | None = 4,
     scaling: Scaling | None = None,
@@ -183,8 +185,10 @@ def fit_structure(
         Extra starts in physical units.
     seed_methods : bool
         Also start from the linear methods 2 and 3 (thesis Table 3.1) on a coarse q grid, for
-        structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`), and
-        keep the fits of methods 1–5 at their best q in ``FitResult.linear``.
+        structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
+    linear_methods : bool
+        Keep the fits of the linear methods 1–5 at their best q in ``FitResult.linear``
+        (:func:`linear_fits`, which figures mark; 20–60 ms per structure of the thesis form).
     min_starts, stop_after : int
         Stop once at least ``min_starts`` starts have run and ``stop_after`` of them ended at
         the best admissible cost found so far (``stop_after=None`` runs every start). Given and
@@ -286,7 +290,7 @@ def fit_structure(
         n_at_best=at_best,
         optima=optima,
         scaling=prob.scaling,
-        linear=linear_fits(structure, data) if seed_methods else {},
+        linear=linear_fits(structure, data) if linear_methods else {},
     )
 
 

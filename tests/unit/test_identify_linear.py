@@ -47,6 +47,35 @@ def test_lawrence_rogers_with_tiny_epsilon_equals_batch_levy_with_squared_weight
     np.testing.assert_allclose(lawrence_rogers(S, y, w), batch, atol=1e-6 * np.abs(batch).max())
 
 
+
+@pytest.mark.parametrize("n, m", [(1, 1), (2, 2), (3, 2)])
+def test_lawrence_rogers_estimate_is_the_minimiser_the_recursion_ends_at(n, m):
+    # One pass of the recursion ends at argmin Σ 2w²|E|² + ε·s·|p − p_0|²; here that minimiser
+    # is computed independently by lstsq on the stacked, augmented rows, on a batch of orders
+    # with unequal weights (as in method 5). The closed form matches it to rounding; the
+    # recursion itself, one frequency at a time from H_0 = I/(ε·s), keeps about 7 digits.
+    from bayesfo.identify.linear import _lawrence_rogers_recursion
+
+    rng = np.random.default_rng(2)
+    G = g_spec() + thesis_noise(rng, 1)[0]
+    qs = np.linspace(0.3, 0.9, 7)
+    S, y, _ = regressors(OMEGA, G, qs, n, m)
+    w = vinagre_weights(OMEGA) * rng.uniform(0.5, 2.0, size=(qs.size, OMEGA.size))
+    got = lawrence_rogers(S, y, w, passes=1)
+    rec = _lawrence_rogers_recursion(S, y, w, passes=1)
+    for i in range(qs.size):
+        sw = np.sqrt(2.0) * np.r_[w[i], w[i]]
+        M = np.vstack([S[i].real, S[i].imag]) * sw[:, None]
+        reg = 1e-9 * np.sum(M**2) / M.shape[1]
+        d = np.sqrt(np.sum(M**2, axis=0))  # column scaling for lstsq's conditioning
+        Ma = np.vstack([M / d, np.sqrt(reg) * np.diag(1.0 / d)])
+        rhs = np.r_[np.r_[y[i].real, y[i].imag] * sw, np.zeros(M.shape[1])]
+        ref = np.linalg.lstsq(Ma, rhs, rcond=None)[0] / d
+        scale = np.abs(ref).max()
+        np.testing.assert_allclose(got[i], ref, rtol=0, atol=1e-9 * scale)
+        np.testing.assert_allclose(rec[i], ref, rtol=0, atol=1e-6 * scale)
+
+
 @pytest.mark.parametrize("method", [1, 2, 3, 4, 5])
 @pytest.mark.parametrize("q, a, b", [(0.5, [1, 1.0], [1.0]), (0.7, [1, 0.8, 0.15], [1.0, 0.1]),
                                      (0.35, [1, 0.5, 0.3, 0.05], [2.0, 0.4, 0.1])])

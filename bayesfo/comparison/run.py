@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import sys
 import warnings
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 
 import numpy as np
@@ -87,10 +88,12 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         density and the RMSE on them are reported next to the in-sample figures.
     workers : int
         Processes running structures side by side (0: one per CPU). The numbers do not depend
-        on it: every structure runs with ``seed``.
+        on it: every structure runs with ``seed``. This process takes tasks too while the
+        workers start (see :func:`~bayesfo.comparison.schedule.run_in_pool`).
     pool : concurrent.futures.Executor, optional
         Run the structures in this pool instead (from :func:`process_pool`; ``workers`` is then
-        ignored).
+        ignored). This process helps a :class:`~concurrent.futures.ProcessPoolExecutor` with the
+        tasks still queued; any other executor (e.g. a Dask client's) runs all of them.
     sampler : {"auto", "emcee"}
         How each posterior is computed. ``"auto"``: importance sampling from the optima where
         its weights certify it (Pareto k̂ < 0.7, ESS ≥ 1000; well-posed structures, a fraction
@@ -160,12 +163,15 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
             outcomes.append(_run_structure(s, data, options))
             bar.update()
     elif pool is not None:
-        outcomes = run_in_pool(pool, structures, data, options, bar)
+        # This process helps a pool of processes on this machine (see run_in_pool), not the
+        # executor of a cluster, whose work stays on the cluster.
+        outcomes = run_in_pool(pool, structures, data, options, bar,
+                               parent_helps=isinstance(pool, ProcessPoolExecutor))
     else:
         # Each structure gets the same seed whatever the worker count, so the numbers do not
         # depend on it.
         with process_pool(n_proc) as own:
-            outcomes = run_in_pool(own, structures, data, options, bar)
+            outcomes = run_in_pool(own, structures, data, options, bar, parent_helps=True)
     bar.close()
     results = []
     for result, caught in outcomes:

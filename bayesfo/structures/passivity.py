@@ -1,5 +1,5 @@
-"""Stability and passivity of structures that are not of commensurate order: sums and series of
-springpots and general power sums.
+"""Stability and passivity of structures: the exact dissipation check of commensurate structures;
+for the others, sums and series of springpots and general power sums.
 
 A side of a transfer function is a power sum D(s) = Σ d_k s^(e_k) (a pseudo-polynomial in one
 s^q when commensurate; Matignon's theorem then decides, :func:`bayesfo.response.matignon_stable`).
@@ -26,6 +26,19 @@ has these exact sufficient conditions before the dense-grid check of the definit
   s^(α_k − β); with a_k/b ≥ 0 and α_k − β ∈ [0, 2] every term has Im ≥ 0.
 * **Series–parallel networks** declared in the card (:mod:`bayesfo.structures.network`): all
   coefficients positive and all orders in [0, 1].
+
+For commensurate structures, G(s) = N(λ)/D(λ) with λ = s^q, passivity is decided exactly
+(:func:`commensurate_passive`). With x = ω^q, λ = (jω)^q = x e^{jqπ/2} and
+
+    Im[N(λ) conj D(λ)] = Σ_k Σ_l n_k d_l x^(k+l) sin((k − l) qπ/2) =: P(x),
+
+a real polynomial in x (the *dissipation polynomial*, :func:`dissipation_polynomial`) whose sign
+is that of Im G(jω) = P(x)/|D(λ)|². A compliance dissipates iff P(x) ≤ 0 for every x > 0, and so
+does its reciprocal, a modulus (Im(1/G) = −P(x)/|N(λ)|²): the condition on the parameters is the
+same for both kinds. Deciding the sign of a polynomial on the positive axis is exact
+(:func:`nonnegative_on_positive_axis`): by the sign pattern of its coefficients, and otherwise
+by its values at the positive real critical points (the roots of P′), up to a relative rounding
+tolerance.
 """
 
 from __future__ import annotations
@@ -36,6 +49,15 @@ from ..response import HALF_PI, matignon_stable
 
 #: Exponents closer than this to an integer count as integers.
 INTEGER_TOL = 1e-12
+
+#: Relative rounding tolerance of the exact dissipation check: coefficients of the dissipation
+#: polynomial within this fraction of their scale are zero, and values within this fraction of
+#: Σ|n_k| x^k · Σ|d_l| x^l (a bound of |N(λ)| |D(λ)|) are of either sign.
+DISSIPATION_RTOL = 1e-12
+
+#: Use the exact dissipation check for commensurate structures (``Structure.passive``); False
+#: restores the dense-grid check of the definition.
+EXACT_COMMENSURATE = True
 
 #: Grid density and largest span (decades) of the argument-principle check.
 POINTS_PER_DECADE = 40
@@ -167,3 +189,215 @@ def springpot_sum_passive(num: tuple, den: tuple) -> np.ndarray | None:
             return None
         ok = np.isfinite(ratio) & (ratio >= 0) & (diff >= -INTEGER_TOL) & (diff <= 2 + INTEGER_TOL)
     return np.all(ok, axis=1) & np.any(ratio > 0, axis=1)
+
+
+# ---------------------------------------------------------------------- exact passivity
+def dissipation_polynomial(den, num, q) -> tuple[np.ndarray, np.ndarray]:
+    """The dissipation polynomial of commensurate transfer functions N(λ)/D(λ), λ = s^q.
+
+    Parameters
+    ----------
+    den : array_like, shape (n_sets, n+1)
+        Ascending coefficients d_l of D(λ).
+    num : array_like, shape (n_sets, m+1)
+        Ascending coefficients n_k of N(λ).
+    q : array_like, shape (n_sets,)
+
+    Returns
+    -------
+    coef : ndarray, shape (n_sets, n+m+1)
+        Ascending coefficients in x = ω^q of P(x) = Im[N(λ) conj D(λ)] at λ = (jω)^q,
+        c_j = Σ_{k+l=j} n_k d_l sin((k − l) qπ/2); c_0 = 0 always. Exact up to rounding: Im G(jω)
+        has the sign of P(x) at every ω > 0.
+    scale : ndarray, shape (n_sets, n+m+1)
+        s_j = Σ_{k+l=j} |n_k| |d_l|, the coefficients of Σ|n_k| x^k · Σ|d_l| x^l ≥ |N(λ)| |D(λ)|:
+        the size against which rounding of ``coef`` and of P(x) is judged.
+    """
+    den = np.atleast_2d(np.asarray(den, dtype=float))
+    num = np.atleast_2d(np.asarray(num, dtype=float))
+    q = np.atleast_1d(np.asarray(q, dtype=float))
+    n_sets = max(den.shape[0], num.shape[0], q.shape[0])
+    coef = np.zeros((n_sets, den.shape[1] + num.shape[1] - 1))
+    scale = np.zeros_like(coef)
+    with np.errstate(all="ignore"):
+        for k in range(num.shape[1]):
+            for j in range(den.shape[1]):
+                prod = num[:, k] * den[:, j]
+                scale[:, k + j] += np.abs(prod)
+                if k != j:
+                    coef[:, k + j] += prod * np.sin((k - j) * q * HALF_PI)
+    return coef, scale
+
+
+def _evaluate_ratio(p: np.ndarray, s: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """p(x)/s(x) for rows of ascending coefficients and candidate points x (rows, c) > 0,
+    without overflow: in powers of 1/x where x > 1 (p(x)/x^K = Σ p_j (1/x)^(K−j))."""
+    k = np.arange(p.shape[1])
+    big = x > 1.0
+    with np.errstate(all="ignore"):
+        t = np.where(big, 1.0 / x, x)[:, :, None]
+        e = np.where(big[:, :, None], k[-1] - k, k)  # (rows, c, K)
+        w = t ** e
+        num = np.sum(p[:, None, :] * w, axis=2)
+        den = np.sum(s[:, None, :] * w, axis=2)
+        return np.where(den > 0, num / den, 0.0)
+
+
+def nonnegative_on_positive_axis(coef, scale=None, *, rtol: float = DISSIPATION_RTOL
+                                 ) -> np.ndarray:
+    """Whether real polynomials are ≥ 0 at every x > 0 (exact up to a rounding tolerance).
+
+    Parameters
+    ----------
+    coef : array_like, shape (n_sets, K)
+        Ascending coefficients p_j.
+    scale : array_like, shape (n_sets, K), optional
+        Non-negative sizes s_j of the coefficients (default |p_j|): p_j with |p_j| ≤ rtol·s_j
+        count as 0, and p(x) ≥ −rtol·Σ s_j x^j counts as ≥ 0.
+    rtol : float
+
+    Returns
+    -------
+    ndarray of bool, shape (n_sets,)
+        False where a coefficient is not finite.
+
+    Notes
+    -----
+    The decision is exact, in three steps: every coefficient ≥ 0 → true; the lowest or the
+    highest non-zero coefficient < 0 → false (p takes its sign near 0 or near ∞); otherwise p is
+    positive at both ends of (0, ∞) and its minimum there is at a positive real root of p′,
+    found as the eigenvalues of the companion matrices of p′ (batched by degree). p is evaluated
+    at the modulus and the real part of every root of p′ (all positive points, so extra points
+    only add checks), in powers of 1/x beyond x = 1 to stay finite.
+    """
+    p = np.atleast_2d(np.asarray(coef, dtype=float))
+    s = np.abs(p) if scale is None else np.atleast_2d(np.asarray(scale, dtype=float))
+    n, k = p.shape
+    out = np.zeros(n, dtype=bool)
+    with np.errstate(all="ignore"):
+        finite = np.all(np.isfinite(p) & np.isfinite(s), axis=1)
+        top = np.max(np.where(finite[:, None], s, 0.0), axis=1)
+        norm = np.where(top > 0, top, 1.0)[:, None]
+        p = np.where(finite[:, None], p / norm, 0.0)
+        s = np.where(finite[:, None], s / norm, 0.0)
+    p = np.where(np.abs(p) <= rtol * s, 0.0, p)
+    nonzero = p != 0
+    any_nz = nonzero.any(axis=1)
+    j0 = np.argmax(nonzero, axis=1)
+    j1 = k - 1 - np.argmax(nonzero[:, ::-1], axis=1)
+    rows = np.arange(n)
+    all_pos = np.all(p >= 0, axis=1)
+    ends_bad = any_nz & ((p[rows, j0] < 0) | (p[rows, j1] < 0))
+    out[finite & all_pos] = True
+    rest = np.flatnonzero(finite & ~all_pos & ~ends_bad)
+    if rest.size == 0:
+        return out
+    # p'(x) = Σ_{j≥1} j p_j x^(j−1); trimmed to x^(j0−1) … x^(j1−1), a factor x^(j0−1) dropped.
+    for lo, hi in set(zip(j0[rest].tolist(), j1[rest].tolist())):
+        grp = rest[(j0[rest] == lo) & (j1[rest] == hi)]
+        deriv = p[grp, lo:hi + 1] * np.arange(lo, hi + 1)  # ascending coefficients of p'/x^(lo-1)
+        deg = hi - lo
+        lead = deriv[:, -1:]
+        comp = np.zeros((grp.size, deg, deg))
+        comp[:, 0, :] = -(deriv[:, -2::-1] / lead)
+        if deg > 1:
+            comp[:, np.arange(1, deg), np.arange(deg - 1)] = 1.0
+        roots = np.linalg.eigvals(comp)
+        cand = np.concatenate([np.abs(roots), np.where(roots.real > 0, roots.real, 1.0)], axis=1)
+        cand = np.where(cand > 0, cand, 1.0)
+        ratio = _evaluate_ratio(p[grp], s[grp], cand)
+        out[grp] = np.all(ratio >= -rtol, axis=1)
+    return out
+
+
+def commensurate_passive(den, num, q, *, rtol: float = DISSIPATION_RTOL) -> np.ndarray:
+    """Exact dissipation of commensurate transfer functions N(λ)/D(λ), λ = s^q, at every ω > 0.
+
+    True where the dissipation polynomial (:func:`dissipation_polynomial`) is ≤ 0 for every
+    x = ω^q > 0: Im G(jω) ≤ 0 (a dissipating compliance), equivalently Im(1/G(jω)) ≥ 0 (a
+    dissipating modulus). The decision is exact up to the relative rounding tolerance ``rtol``
+    (:func:`nonnegative_on_positive_axis`); it holds for any real q (λ = ω^q e^{jqπ/2}).
+
+    Parameters
+    ----------
+    den, num : array_like, shapes (n_sets, n+1) and (n_sets, m+1)
+        Ascending coefficients of D(λ) and N(λ).
+    q : array_like, shape (n_sets,)
+
+    Returns
+    -------
+    ndarray of bool, shape (n_sets,)
+        False where a coefficient or q is not finite.
+    """
+    coef, scale = dissipation_polynomial(den, num, q)
+    ok = nonnegative_on_positive_axis(-coef, scale, rtol=rtol)
+    return ok & np.isfinite(np.broadcast_to(np.atleast_1d(np.asarray(q, float)), ok.shape))
+
+
+def _live_indices(n_den: int, n_num: int) -> np.ndarray:
+    """Indices j of the dissipation polynomial that have a pair k + l = j with k ≠ l (the
+    others are 0 for every parameter set)."""
+    live = np.zeros(n_den + n_num - 1, dtype=bool)
+    for k in range(n_num):
+        for j in range(n_den):
+            live[k + j] |= k != j
+    return np.flatnonzero(live)
+
+
+def dissipation_shortfall(den, num, q, *, margin: float = 1e-8) -> np.ndarray:
+    """How far commensurate transfer functions are from dissipating with a small margin:
+    non-negative measures, all 0 inside the passive region (for the optimiser's penalty).
+
+    With p = −P (the dissipation polynomial, :func:`dissipation_polynomial`, with the sign that
+    must be ≥ 0) and S(x) = Σ s_j x^j its scale, the columns are
+
+    0. max(0, margin − p_lo/S(1)), p_lo the lowest coefficient that is not identically 0;
+    1. max(0, margin − p_hi/S(1)), p_hi the highest one;
+    2. max(0, margin − min p(x*)/S(x*)) over the positive real critical points x* of p.
+
+    They are continuous in the parameters (normalised by S(1) sin(qπ/2), not by each
+    coefficient's own scale), so least squares can drive them to 0. Zero shortfall implies
+    :func:`commensurate_passive` (the margin exceeds its rounding tolerance).
+
+    Returns
+    -------
+    ndarray, shape (n_sets, 3)
+    """
+    den = np.atleast_2d(np.asarray(den, dtype=float))
+    num = np.atleast_2d(np.asarray(num, dtype=float))
+    coef, scale = dissipation_polynomial(den, num, q)
+    live = _live_indices(den.shape[1], num.shape[1])
+    n = coef.shape[0]
+    out = np.zeros((n, 3))
+    if live.size == 0:
+        return out
+    with np.errstate(all="ignore"):
+        # Normalised by S(1) sin(qπ/2) (every coefficient has a factor sin(k qπ/2)), so that
+        # q → 0, where P vanishes identically, is no way out of the margin.
+        sin_q = np.abs(np.sin(np.atleast_1d(np.asarray(q, dtype=float)) * HALF_PI))
+        s1 = scale.sum(axis=1) * np.broadcast_to(np.maximum(sin_q, 1e-3), (n,))
+        s1 = np.where(np.isfinite(s1) & (s1 > 0), s1, 1.0)[:, None]
+        p, s = -coef / s1, scale / s1
+        finite = np.all(np.isfinite(p), axis=1)
+        p[~finite], s[~finite] = 0.0, 0.0
+        lo, hi = int(live[0]), int(live[-1])
+        out[:, 0] = np.maximum(0.0, margin - p[:, lo])
+        out[:, 1] = np.maximum(0.0, margin - p[:, hi])
+        if hi > lo:
+            deriv = p[:, lo:hi + 1] * np.arange(lo, hi + 1)
+            deg = hi - lo
+            lead = deriv[:, -1:]
+            lead = np.where(np.abs(lead) > 1e-300, lead, 1e-300)
+            comp = np.zeros((n, deg, deg))
+            comp[:, 0, :] = -(deriv[:, -2::-1] / lead)
+            if deg > 1:
+                comp[:, np.arange(1, deg), np.arange(deg - 1)] = 1.0
+            comp = np.where(np.isfinite(comp), comp, 0.0)
+            roots = np.linalg.eigvals(comp)
+            real = np.abs(roots.imag) <= 1e-6 * np.abs(roots)
+            cand = np.where(real & (roots.real > 0), roots.real, np.nan)
+            ratio = _evaluate_ratio(p, s, np.where(np.isnan(cand), 1.0, cand))
+            ratio = np.where(np.isnan(cand), np.inf, ratio)
+            out[:, 2] = np.maximum(0.0, margin - ratio.min(axis=1))
+        out[~finite] = 1.0
+    return out

@@ -19,7 +19,8 @@ from ..response import (
     matignon_stable,
     power_ratio,
 )
-from .passivity import side_stable, springpot_sum_passive
+from . import passivity
+from .passivity import commensurate_passive, side_stable, springpot_sum_passive
 from .scaling import ScalePlan, Scaling, scale_plan
 from .terms import Inequality, Term
 
@@ -196,12 +197,18 @@ class Structure:
 
     def _polynomial(self, terms, vals, n_sets):
         """Ascending coefficients of a side that is a polynomial in λ = s^q."""
-        degree = max(_degree(t) for t in terms)
-        out = np.zeros((n_sets, degree + 1))
+        plan = self._polynomial_plans.get(id(terms)) or _polynomial_plan(terms)
+        out = np.zeros((n_sets, plan[0] + 1))
         with np.errstate(all="ignore"):
-            for t in terms:
-                out[:, _degree(t)] += t.coefficient(vals, n_sets)
+            for degree, name, t in plan[1]:
+                # A coefficient that is one parameter (most terms) is its column as it is.
+                out[:, degree] += vals[name] if name is not None else t.coefficient(vals, n_sets)
         return out
+
+    @cached_property
+    def _polynomial_plans(self) -> dict:
+        """Per side (by identity): its degree and each term's (degree, parameter or None, term)."""
+        return {id(side): _polynomial_plan(side) for side in (self.numerator, self.denominator)}
 
     def polynomials(self, theta):
         """Pseudo-polynomial coefficients of a commensurate structure.
@@ -316,15 +323,22 @@ class Structure:
         return ok[0] if single else ok
 
     def passive(self, theta, kind: str, omega_grid) -> np.ndarray:
-        """Dissipation ≥ 0 of the response compared with ``kind`` data on ``omega_grid``.
+        """Dissipation ≥ 0 of the response compared with ``kind`` data, at every ω > 0.
 
-        Commensurate structures of degree ≤ 1 on both sides use the exact condition instead of
-        the grid: Im[(b0 + b1 λ)/(a0 + a1 λ)] = (b1 a0 − b0 a1) Im λ / |A|², and Im λ > 0 for
-        0 < q < 2, so a compliance (and its reciprocal, a modulus) dissipates iff
-        b1 a0 ≤ b0 a1, at every frequency. Otherwise parameter sets that satisfy an exact
+        Commensurate structures (N(λ)/D(λ), λ = s^q) are decided exactly, at every frequency,
+        without ``omega_grid``: with x = ω^q, Im G(jω) has the sign of the dissipation
+        polynomial P(x) = Σ_k Σ_l n_k d_l x^(k+l) sin((k − l) qπ/2), and a compliance (and its
+        reciprocal, a modulus) dissipates iff P(x) ≤ 0 for every x > 0, decided by the sign
+        pattern of P's coefficients and its values at the positive roots of P′
+        (:func:`~bayesfo.structures.passivity.commensurate_passive`, relative rounding
+        tolerance 1e-12). Degree ≤ 1 on both sides is the closed form of this rule:
+        Im[(b0 + b1 λ)/(a0 + a1 λ)] = (b1 a0 − b0 a1) Im λ / |A|², and Im λ > 0 for
+        0 < q < 2, so the structure dissipates iff b1 a0 ≤ b0 a1 (q outside (0, 2) is left to
+        the other constraints). Other structures: parameter sets that satisfy an exact
         sufficient condition (springpots in series or in parallel; a declared network with
         positive coefficients and orders in [0, 1]; see :mod:`bayesfo.structures.passivity`)
-        are passive at every frequency, and the rest are checked on the grid.
+        are passive at every frequency, and the rest are checked on ``omega_grid``.
+        Non-finite parameters are not passive.
         """
         theta2 = np.atleast_2d(np.asarray(theta, float))
         single = np.ndim(theta) != 2
@@ -338,6 +352,9 @@ class Structure:
             scale = np.abs(lhs) + np.abs(rhs)
             ok = (lhs <= rhs + 1e-12 * scale) | ~((q > 0) & (q < 2))
             ok &= np.all(np.isfinite(theta2), axis=1)
+        elif self.commensurate_order is not None and passivity.EXACT_COMMENSURATE:
+            den, num, q = self.polynomials(theta2)
+            ok = commensurate_passive(den, num, q) & np.all(np.isfinite(theta2), axis=1)
         else:
             ok = self._exactly_passive(theta2)
             rest = np.flatnonzero(~ok)
@@ -466,6 +483,14 @@ class Structure:
                     f"{where}: unknown constraint {c!r}; use 'stable', 'passive' or an inequality"
                 )
         _ = self.scale_plan  # units of the coefficients: raises for a card that cannot be scaled
+
+
+def _polynomial_plan(terms) -> tuple:
+    """(degree, ((degree, name or None, term), ...)) of a side that is a polynomial in λ: name is
+    the parameter when the term's coefficient is one parameter, else None."""
+    rows = tuple((_degree(t), t.coef if t.is_free and len(t.factors) == 1 else None, t)
+                 for t in terms)
+    return max(d for d, _, _ in rows), rows
 
 
 def _degree(t: Term) -> int:

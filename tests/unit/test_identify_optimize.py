@@ -58,3 +58,39 @@ def test_fit_checks_input():
         fit_structure(s, data, weighting="sigma")
     with pytest.raises(InputError, match="'n_starts' must be at least 1"):
         fit_structure(s, data, n_starts=0)
+
+
+def _g_spec_noisy():
+    """G_spec with complex noise of sd 0.005 (σ known), seed 3: the set-up of the posterior tests."""
+    from bayesfo.studies import OMEGA, g_spec
+
+    rng = np.random.default_rng(3)
+    noise = 5e-3 / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25))
+    return FrequencyResponse(OMEGA, g_spec() + noise, np.full(25, 5e-3), kind="compliance")
+
+
+def test_optima_on_the_passivity_boundary_are_found():
+    # On G_spec data the unconstrained max-n2m0 optima have a1 < 0 (q ≈ 0.25) or a2 < 0
+    # (q ≈ 0.5): dissipation turns negative decades outside the data, so no local optimum is
+    # admissible. The optimiser re-solves them onto the boundary a1 = 0 (resp. a2 = 0).
+    from bayesfo.structures.passivity import commensurate_passive
+
+    s = get_structure("max-n2m0")
+    fit = fit_structure(s, _g_spec_noisy(), rng=0, seed_methods=True)
+    assert fit.admissible and len(fit.optima) >= 2
+    assert commensurate_passive(*s.polynomials(fit.optima)).all()
+    qs = sorted(fit.optima[:, -1])
+    assert abs(qs[0] - 0.25) < 0.02 and abs(qs[-1] - 0.5) < 0.02
+    a1, a2 = fit.theta_scaled[0], fit.theta_scaled[1]
+    assert min(abs(a1), abs(a2)) < 1e-4 and min(a1, a2) >= 0
+
+
+def test_repair_is_off_without_the_exact_check(monkeypatch):
+    from bayesfo.identify import optimize
+    from bayesfo.structures import passivity
+
+    monkeypatch.setattr(passivity, "EXACT_COMMENSURATE", False)
+    calls = []
+    monkeypatch.setattr(optimize._Problem, "repair", lambda *a: calls.append(a))
+    fit_structure(get_structure("max-n2m0"), _g_spec_noisy(), rng=0, n_starts=4, min_starts=4)
+    assert not calls

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import sys
 import warnings
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 
 import numpy as np
@@ -88,12 +87,10 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         density and the RMSE on them are reported next to the in-sample figures.
     workers : int
         Processes running structures side by side (0: one per CPU). The numbers do not depend
-        on it: every structure runs with ``seed``. This process takes tasks too while the
-        workers start (see :func:`~bayesfo.comparison.schedule.run_in_pool`).
+        on it: every structure runs with ``seed``.
     pool : concurrent.futures.Executor, optional
         Run the structures in this pool instead (from :func:`process_pool`; ``workers`` is then
-        ignored). This process helps a :class:`~concurrent.futures.ProcessPoolExecutor` with the
-        tasks still queued; any other executor (e.g. a Dask client's) runs all of them.
+        ignored).
     sampler : {"auto", "emcee"}
         How each posterior is computed. ``"auto"``: importance sampling from the optima where
         its weights certify it (Pareto k̂ < 0.7, ESS ≥ 1000; well-posed structures, a fraction
@@ -163,15 +160,12 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
             outcomes.append(_run_structure(s, data, options))
             bar.update()
     elif pool is not None:
-        # This process helps a pool of processes on this machine (see run_in_pool), not the
-        # executor of a cluster, whose work stays on the cluster.
-        outcomes = run_in_pool(pool, structures, data, options, bar,
-                               parent_helps=isinstance(pool, ProcessPoolExecutor))
+        outcomes = run_in_pool(pool, structures, data, options, bar)
     else:
         # Each structure gets the same seed whatever the worker count, so the numbers do not
         # depend on it.
         with process_pool(n_proc) as own:
-            outcomes = run_in_pool(own, structures, data, options, bar, parent_helps=True)
+            outcomes = run_in_pool(own, structures, data, options, bar)
     bar.close()
     results = []
     for result, caught in outcomes:
@@ -223,7 +217,9 @@ def remedy(lik) -> str:
 def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
     """Where the emcee walkers did not converge, the final particles of the independent
     tempered-ladder runs (which gave ln Z) are the posterior, if the runs agree: summaries,
-    HDIs, figures, LOO and WAIC then come from them. Returns (posterior, criteria)."""
+    HDIs, figures, LOO and WAIC then come from them, and the warnings of emcee's draws are
+    replaced by one that says why they were set aside (:func:`_sample`). Returns
+    (posterior, criteria)."""
     ladder = posterior_from_particles(lik, runs, seed=seed)
     if not ladder.converged:
         note = (f"{lik.structure.name}: the tempered-ladder runs do not certify the posterior "
@@ -232,10 +228,11 @@ def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
         warnings.warn(note, ConvergenceWarning, stacklevel=3)
         criteria["warnings"].append(note)
         return post, criteria
+    why = "; ".join(m.split(": ", 1)[-1] for m in post.messages)
     note = (f"{lik.structure.name}: the posterior reported is that of {ladder.n_walkers} "
             f"independent tempered-ladder runs of {ladder.samples.shape[0] // ladder.n_walkers} "
             f"particles, which agree (R-hat {ladder.rhat_max:.3f}, ESS {ladder.ess_min:.0f}); "
-            "the emcee walkers did not converge")
+            "the emcee walkers did not converge" + (f" ({why})" if why else ""))
     criteria = _criteria(lik, fit, ladder)
     criteria["warnings"].append(note)
     warnings.warn(note, CertifiedWarning, stacklevel=3)
@@ -274,23 +271,35 @@ def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dic
             post, ev, info = None, None, {}
         if post is None and options["evidence"] == "auto" and not options["sampler_kwargs"]:
             post, ev, tried = _ladder_first(lik, seed, info.get("proposal_draws"))
-    if post is None:
-        post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
-                                fit=fit, progress=False,
-                                **{"give_up": True, **options["sampler_kwargs"]})
-    criteria = _criteria(lik, fit, post)
-    if post.sampler == "emcee" and tried:
-        # Why the ladder tried first did not give the posterior (the emcee route followed).
-        criteria["warnings"].append(f"{s.name}: the tempered-ladder runs tried first did not "
-                                    f"certify the posterior ({tried}); emcee ran instead")
-    if post.sampler == "importance":
-        criteria["importance"] = info
-    # ln Z of the importance weights or of the ladder that gave the posterior.
-    extra = _evidence(lik, post, seed, False, options["evidence"],
-                      best_log_likelihood=criteria["max_log_likelihood"], importance=ev)
-    runs = extra.pop("ladder_runs")
-    if runs is not None and not post.converged:
-        post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
+    # The warnings of emcee's draws (convergence, Pareto k) are held until it is known whether
+    # they are the posterior reported: a ladder that certifies it instead replaces them.
+    with warnings.catch_warnings(record=True) as held:
+        warnings.simplefilter("always")
+        if post is None:
+            post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
+                                    fit=fit, progress=False,
+                                    **{"give_up": True, **options["sampler_kwargs"]})
+        criteria = _criteria(lik, fit, post)
+        of_draws = len(held)
+        if post.sampler == "emcee" and tried:
+            # Why the ladder tried first did not give the posterior (the emcee route followed).
+            tried = (f"{s.name}: the tempered-ladder runs tried first did not certify the "
+                     f"posterior ({tried}); emcee ran instead")
+            criteria["warnings"].append(tried)
+        if post.sampler == "importance":
+            criteria["importance"] = info
+        # ln Z of the importance weights or of the ladder that gave the posterior.
+        extra = _evidence(lik, post, seed, False, options["evidence"],
+                          best_log_likelihood=criteria["max_log_likelihood"], importance=ev)
+        runs = extra.pop("ladder_runs")
+        replaced = False
+        if runs is not None and not post.converged:
+            post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
+            replaced = post.sampler == "ladder"
+            if replaced and tried:
+                criteria["warnings"].insert(0, tried)
+    for w in held[of_draws if replaced else 0:]:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     criteria["warnings"].extend(extra.pop("warnings"))
     criteria.update(extra)
     return {"lik": lik, "post": post, "criteria": criteria}

@@ -50,6 +50,10 @@ from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .transform import _log_parts_fn, _Transform
 
+#: A rung whose moves leave fewer distinct particles than this many per dimension (of the
+#: 1000) ends the run with an error: the population has collapsed (see :func:`ladder_run`).
+MIN_DISTINCT_PER_DIM = 10
+
 
 @dataclass(frozen=True)
 class LadderRun:
@@ -103,9 +107,10 @@ def _accept(target: _Target, prop, u, log_prior, log_lik, beta: float, log_unifo
 
     The constraints are part of the prior (its indicator): a proposal outside them has ratio 0.
     They are checked only where the rest of the ratio would accept, which gives the same
-    decisions from the same uniforms as checking them first, without the dense-grid
-    dissipation check of every rejected proposal (most of them at the acceptance rates of the
-    later rungs).
+    decisions from the same uniforms as checking them first, without the constraint checks of
+    every rejected proposal (most of them at the acceptance rates of the later rungs): the
+    stability test, and the dissipation check (exact for commensurate structures, on a dense
+    grid for the others).
     """
     lp_new, ll_new = target.unchecked(prop)
     with np.errstate(invalid="ignore"):
@@ -232,6 +237,17 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
             accepted += _accept(target, prop, u, log_prior, log_lik, beta, np.log(rng.random(n)))
             steps += 1
         acceptance.append(accepted.mean() / max(steps, 1))
+        distinct = len(np.unique(u, axis=0))
+        if distinct < min(MIN_DISTINCT_PER_DIM * d, n):
+            # Even the smallest rung put all the weight on a few particles, and the moves
+            # cannot spread copies of one point (their differences are 0): the likelihood is
+            # so peaked, relative to the prior, that no prior draw comes near its mass (e.g. a
+            # structure that cannot describe the data, log L of order -1e13). ln Z would be
+            # meaningless; the callers take emcee's draws (bridge sampling) instead.
+            raise InputError(
+                f"structure '{lik.structure.name}': the tempered ladder collapsed to {distinct} "
+                f"distinct particle(s) at β = {beta:.3g} (the likelihood is too peaked for the "
+                "particles drawn from the prior to follow)")
     else:
         raise InputError(f"structure '{lik.structure.name}': the tempered ladder did not reach "
                          f"the posterior in {max_rungs} rungs")

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.special import logsumexp
 
+from bayesfo.errors import InputError
 from bayesfo.inference.evidence import ladder_evidence
 from bayesfo.inference.smc import _next_beta, _systematic, ladder_run
 from bayesfo.priors import Uniform
@@ -101,3 +102,21 @@ def test_systematic_resampling_keeps_the_expected_counts():
     expected = 50 * w / w.sum()
     assert counts.sum() == 50
     assert np.all(counts >= np.floor(expected)) and np.all(counts <= np.ceil(expected))
+
+
+class _FarTooPeaked(_TwoModes):
+    """A likelihood of order −1e16 over the prior (a structure that cannot describe the data):
+    the smallest rung already puts all the weight on one particle."""
+
+    def __call__(self, theta):
+        return -1e16 * (1.0 + np.sum(np.atleast_2d(theta) ** 2, axis=1))
+
+
+def test_a_collapsed_ladder_is_an_error_not_an_evidence():
+    # Before: the run "reached" β = 1 with 1000 copies of one particle, and ln Z came out as
+    # about -1e14 ± 5e14 in the ranking.
+    with pytest.raises(InputError, match="collapsed to 1 distinct particle"):
+        ladder_run(_FarTooPeaked(), np.random.default_rng(0))
+    # The two-mode likelihood keeps its population (no false alarm).
+    run = ladder_run(_TwoModes(), np.random.default_rng(0))
+    assert len(np.unique(run.particles, axis=0)) >= 10 * 2

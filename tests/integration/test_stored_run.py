@@ -7,7 +7,13 @@ Stored again when the DE snooker move became ter Braak & Vrugt's (emcee's own is
 tests/integration/test_emcee_spread.py): with it, the Voigt's emcee walkers no longer pass as
 converged on a posterior with a long tail in a1, and the tempered ladder certifies it instead
 (a1 sd 521; the run stored before had 82 from walkers that had not seen the tail, and its seeds
-4 and 5 gave 7 and 14). ln Z moved from −244.33 (bridge) to −244.24 ± 0.03 (ladder)."""
+4 and 5 gave 7 and 14). ln Z moved from −244.33 (bridge) to −244.24 ± 0.03 (ladder).
+
+Stored again when (1) the note that the ladder's posterior replaces emcee's came to say why the
+walkers were set aside (its text alone changed), and (2) the Lawrence–Rogers estimate (linear
+methods 4 and 5 of the optimum's ``linear_methods``) came to be computed as the least-squares
+solution its recursion ends at: those values moved by 1e-11 to 3e-11 relative, the rounding of
+the recursion. Every other number is as stored."""
 
 from __future__ import annotations
 

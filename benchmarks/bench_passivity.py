@@ -23,7 +23,7 @@ import numpy as np
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
 from bayesfo.inference.smc import ladder_run
-from bayesfo.response import dissipation_grid, is_dissipative, polyval_ascending
+from bayesfo.response import dissipation_grid, is_dissipative
 from bayesfo.structures import get_structure, passivity
 from bayesfo.studies import OMEGA, g_spec
 
@@ -31,17 +31,8 @@ X = np.logspace(-30, 30, 20_000)
 STRUCTURES = ("max-n2m1", "max-n2m2", "max-n3m3")
 
 
-def grid_passive(den, num, q, rtol=1e-12, chunk=250):
-    out = []
-    for i in range(0, len(q), chunk):
-        lam = X * np.exp(1j * q[i:i + chunk, None] * np.pi / 2)
-        with np.errstate(all="ignore"):
-            n = polyval_ascending(num[i:i + chunk], lam)
-            d = polyval_ascending(den[i:i + chunk], lam)
-            size = (polyval_ascending(np.abs(num[i:i + chunk]), X[None]).real
-                    * polyval_ascending(np.abs(den[i:i + chunk]), X[None]).real)
-        out.append(np.all((n * d.conj()).imag <= rtol * size, axis=1))
-    return np.concatenate(out)
+def grid_passive(den, num, q):
+    return passivity.passive_on_grid(den, num, q, X)
 
 
 def draws(s, rng, n, near):

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..response import HALF_PI, matignon_stable
+from ..response import HALF_PI, matignon_stable, polyval_ascending
 
 #: Exponents closer than this to an integer count as integers.
 INTEGER_TOL = 1e-12
@@ -332,6 +332,27 @@ def commensurate_passive(den, num, q, *, rtol: float = DISSIPATION_RTOL) -> np.n
     coef, scale = dissipation_polynomial(den, num, q)
     ok = nonnegative_on_positive_axis(-coef, scale, rtol=rtol)
     return ok & np.isfinite(np.broadcast_to(np.atleast_1d(np.asarray(q, float)), ok.shape))
+
+
+def passive_on_grid(den, num, q, x, *, rtol: float = DISSIPATION_RTOL,
+                    chunk: int = 250) -> np.ndarray:
+    """The definition on a grid, the reference of :func:`commensurate_passive` in the tests and
+    ``benchmarks/bench_passivity.py``: Im[N(λ) conj D(λ)] ≤ 0 at λ = x e^{jqπ/2} for every x of
+    the grid, evaluated through complex λ (not through the dissipation polynomial), with the
+    same rounding tolerance relative to Σ|n_k| x^k · Σ|d_l| x^l. ``chunk`` parameter sets at a
+    time keep the memory at chunk × len(x)."""
+    den, num = np.atleast_2d(den), np.atleast_2d(num)
+    q, x = np.atleast_1d(q), np.asarray(x, dtype=float)
+    out = []
+    for i in range(0, len(q), chunk):
+        lam = x * np.exp(1j * q[i:i + chunk, None] * HALF_PI)
+        with np.errstate(all="ignore"):
+            n = polyval_ascending(num[i:i + chunk], lam)
+            d = polyval_ascending(den[i:i + chunk], lam)
+            size = (polyval_ascending(np.abs(num[i:i + chunk]), x[None]).real
+                    * polyval_ascending(np.abs(den[i:i + chunk]), x[None]).real)
+        out.append(np.all((n * d.conj()).imag <= rtol * size, axis=1))
+    return np.concatenate(out)
 
 
 def _live_indices(n_den: int, n_num: int) -> np.ndarray:

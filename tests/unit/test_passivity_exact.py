@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bayesfo.response import polyval_ascending
 from bayesfo.structures import get_structure, passivity
 from bayesfo.structures.passivity import (
     commensurate_passive,
@@ -19,20 +18,8 @@ from bayesfo.structures.passivity import (
 X = np.logspace(-30, 30, 20_000)
 
 
-def _grid_passive(den, num, q, rtol=1e-12, chunk=250):
-    """The definition on a dense grid of x = ω^q, Im[N conj D] ≤ 0, evaluated through complex
-    λ = x e^{jqπ/2} (not through the dissipation polynomial), with the rounding tolerance
-    of the exact check relative to Σ|n_k| x^k · Σ|d_l| x^l."""
-    out = []
-    for i in range(0, len(q), chunk):
-        lam = X * np.exp(1j * q[i:i + chunk, None] * np.pi / 2)
-        with np.errstate(all="ignore"):
-            n = polyval_ascending(num[i:i + chunk], lam)
-            d = polyval_ascending(den[i:i + chunk], lam)
-            size = (polyval_ascending(np.abs(num[i:i + chunk]), X[None]).real
-                    * polyval_ascending(np.abs(den[i:i + chunk]), X[None]).real)
-        out.append(np.all((n * d.conj()).imag <= rtol * size, axis=1))
-    return np.concatenate(out)
+def _grid_passive(den, num, q):
+    return passivity.passive_on_grid(den, num, q, X)
 
 
 def _draws(structure, rng, n, near_passive=False):

@@ -133,8 +133,8 @@ def lawrence_rogers(S, y, weights, *, epsilon: float = LR_EPSILON, passes: int =
     that minimiser updated one observation at a time), so each pass is computed here as that
     regularised least-squares solution, in one batched solve, without a Python loop over the
     frequencies. It matches an independent least-squares solution of that problem to 1e-9
-    relative; the recursion itself (kept as ``_lawrence_rogers_recursion``, tested) matches it
-    to about 1e-7, the digits its start from H_0 = I/(ε·s) loses.
+    relative; the recursion itself (one frequency at a time, in the tests) matches it to about
+    1e-7, the digits its start from H_0 = I/(ε·s) loses.
     """
     w2 = np.asarray(weights, dtype=float) ** 2
     batch = S.shape[:-2]
@@ -153,31 +153,6 @@ def lawrence_rogers(S, y, weights, *, epsilon: float = LR_EPSILON, passes: int =
     As = A / d[..., :, None] / d[..., None, :]
     for _ in range(passes):
         p = _solve_batch(As, (b + reg[..., None] * p) / d) / d
-    return p
-
-
-def _lawrence_rogers_recursion(S, y, weights, *, epsilon: float = LR_EPSILON,
-                               passes: int = LR_PASSES) -> np.ndarray:
-    """The recursion itself, one frequency at a time (the reference for
-    :func:`lawrence_rogers` in the tests)."""
-    w2 = np.asarray(weights, dtype=float) ** 2
-    batch = S.shape[:-2]
-    P = S.shape[-1]
-    p = np.zeros(batch + (P,))
-    info_scale = np.sum(2.0 * w2[..., :, None] * np.abs(S) ** 2, axis=(-2, -1)) / P
-    h0 = 1.0 / (epsilon * np.broadcast_to(info_scale, batch))
-    for _ in range(passes):
-        H = np.eye(P) * h0[..., None, None]
-        for k in range(S.shape[-2]):
-            wk = np.broadcast_to(w2[..., k], batch)
-            for part in (S[..., k, :].real, S[..., k, :].imag):
-                Hr = np.einsum("...ij,...j->...i", H, part)
-                denom = 1.0 / (2.0 * wk) + np.einsum("...i,...i->...", part, Hr)
-                H = H - Hr[..., :, None] * Hr[..., None, :] / denom[..., None, None]
-            r = S[..., k, :]
-            e = y[..., k] - np.einsum("...i,...i->...", r, p)
-            grad = 2.0 * wk[..., None] * np.real(np.conj(r) * e[..., None])
-            p = p + np.einsum("...ij,...j->...i", H, grad)
     return p
 
 

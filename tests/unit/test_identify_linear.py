@@ -48,14 +48,37 @@ def test_lawrence_rogers_with_tiny_epsilon_equals_batch_levy_with_squared_weight
 
 
 
+def _lawrence_rogers_recursion(S, y, weights, *, epsilon: float = 1e-9,
+                               passes: int = 3) -> np.ndarray:
+    """The recursion of eqs. (3.19)-(3.21) itself, one frequency at a time: two rank-one
+    (Sherman-Morrison) updates of H per frequency from H_0 = I/(ε·s), p_0 = 0."""
+    w2 = np.asarray(weights, dtype=float) ** 2
+    batch = S.shape[:-2]
+    P = S.shape[-1]
+    p = np.zeros(batch + (P,))
+    info_scale = np.sum(2.0 * w2[..., :, None] * np.abs(S) ** 2, axis=(-2, -1)) / P
+    h0 = 1.0 / (epsilon * np.broadcast_to(info_scale, batch))
+    for _ in range(passes):
+        H = np.eye(P) * h0[..., None, None]
+        for k in range(S.shape[-2]):
+            wk = np.broadcast_to(w2[..., k], batch)
+            for part in (S[..., k, :].real, S[..., k, :].imag):
+                Hr = np.einsum("...ij,...j->...i", H, part)
+                denom = 1.0 / (2.0 * wk) + np.einsum("...i,...i->...", part, Hr)
+                H = H - Hr[..., :, None] * Hr[..., None, :] / denom[..., None, None]
+            r = S[..., k, :]
+            e = y[..., k] - np.einsum("...i,...i->...", r, p)
+            grad = 2.0 * wk[..., None] * np.real(np.conj(r) * e[..., None])
+            p = p + np.einsum("...ij,...j->...i", H, grad)
+    return p
+
+
 @pytest.mark.parametrize("n, m", [(1, 1), (2, 2), (3, 2)])
 def test_lawrence_rogers_estimate_is_the_minimiser_the_recursion_ends_at(n, m):
     # One pass of the recursion ends at argmin Σ 2w²|E|² + ε·s·|p − p_0|²; here that minimiser
     # is computed independently by lstsq on the stacked, augmented rows, on a batch of orders
     # with unequal weights (as in method 5). The closed form matches it to rounding; the
     # recursion itself, one frequency at a time from H_0 = I/(ε·s), keeps about 7 digits.
-    from bayesfo.identify.linear import _lawrence_rogers_recursion
-
     rng = np.random.default_rng(2)
     G = g_spec() + thesis_noise(rng, 1)[0]
     qs = np.linspace(0.3, 0.9, 7)

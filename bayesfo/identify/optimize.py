@@ -23,6 +23,7 @@ G_spec max-n2m2 (a1 = 0) is kept among the optima.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from scipy import optimize
@@ -168,8 +169,7 @@ class _Problem:
         # Forward differences evaluated as one vectorised batch of n+1 parameter sets.
         h = 1e-7 * np.maximum(1.0, np.abs(u))
         pts = np.vstack([u, u + np.diag(h)])
-        r = self.residuals_many(pts) if weight is None else self.penalised_many(pts, weight)
-        r = np.where(np.isfinite(r), r, 1e10)
+        r = _finite(self.residuals_many(pts) if weight is None else self.penalised_many(pts, weight))
         return ((r[1:] - r[0]) / h[:, None]).T
 
     # -------------------------------------------------------------- the passivity boundary
@@ -320,22 +320,21 @@ def fit_structure(
             # along a ridge of equivalent optima without a passive end). Starts that ended at
             # an optimum already repaired reuse its result; at most REPAIR_MAX_FAILED failed
             # attempts of each kind per fit.
-            key = next((k for k in repaired if k[3] and np.allclose(x, k[0], rtol=1e-4, atol=1e-8)),
-                       None)
-            for kind, origin in enumerate((u, x)):
-                if key is not None or failures[kind] >= REPAIR_MAX_FAILED:
+            done = next((r for r in repaired if r.ok and _same(x, r.optimum)), None)
+            for origin, start in enumerate((u, x)):  # 0: from the start, 1: from the optimum
+                if done is not None or failures[origin] >= REPAIR_MAX_FAILED:
                     continue
-                if kind == 1 and any(np.allclose(x, k[0], rtol=1e-4, atol=1e-8)
-                                     for k in repaired if k[4] == 1):
+                if origin == 1 and any(r.origin == 1 and _same(x, r.optimum) for r in repaired):
                     continue  # this optimum failed before
-                attempt = (x, *prob.repair(origin, cost, REPAIR_COST_RATIO * best_cost), kind)
+                attempt = _Repair(x, *prob.repair(start, cost, REPAIR_COST_RATIO * best_cost),
+                                  origin)
                 repaired.append(attempt)
-                if attempt[3]:
-                    key = attempt
+                if attempt.ok:
+                    done = attempt
                 else:
-                    failures[kind] += 1
-            if key is not None and key[3]:
-                x, cost, ok_i = key[1], key[2], True
+                    failures[origin] += 1
+            if done is not None:
+                x, cost, ok_i = done.x, done.cost, True
         sols.append(x)
         costs.append(cost)
         oks.append(ok_i)
@@ -381,6 +380,23 @@ def fit_structure(
 
 def _finite(r: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(r), r, 1e10)
+
+
+class _Repair(NamedTuple):
+    """One attempt of :meth:`_Problem.repair`: the optimum it started from, its result (x,
+    the data's cost, whether admissible) and where the penalised solve began (0: the start,
+    1: the optimum)."""
+
+    optimum: np.ndarray
+    x: np.ndarray
+    cost: float
+    ok: bool
+    origin: int
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    """Two optima that are the same point (starts often end at one optimum)."""
+    return bool(np.allclose(a, b, rtol=1e-4, atol=1e-8))
 
 
 def _interleave(first: np.ndarray, second: np.ndarray) -> np.ndarray:

@@ -86,6 +86,10 @@ def _adequacy_sentences(comparison, rows) -> list[tuple[str, bool]]:
             text += (f" The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
                      f"{_join(small)}.")
         return [(text.rstrip(), True)]
+    if best.adequate and best.misfit_masked:
+        return [(f"{name} passes its posterior predictive checks at the {level} level, but "
+                 f"{best.caution} (its {best.noise} noise model treats them as noise; if they "
+                 "are more precise than that, the pass does not extend to them).", True)]
     if best.adequate:
         return [(f"{name} describes the data: its posterior predictive checks pass at the "
                  f"{level} level (largest misfit {best.max_phase_error_deg:.1f}° in phase, "

@@ -93,12 +93,15 @@ class StructureResult:
 
     @property
     def fits(self) -> str | None:
-        """``"yes"`` (adequate), ``"small"`` (a systematic misfit within 2° and 3.5 %),
-        ``"no"``, or None without a check."""
+        """``"yes"`` (adequate), ``"partly"`` (adequate, but the fitted noise swamps points that
+        the posterior mode misses by more than 2° or 3.5 %: ``misfit_masked``), ``"small"`` (a
+        systematic misfit within 2° and 3.5 %), ``"no"``, or None without a check."""
         a = self.adequacy
         if a is None:
             return None
-        return "yes" if a.adequate else ("small" if a.misfit_small else "no")
+        if a.adequate:
+            return "partly" if a.misfit_masked else "yes"
+        return "small" if a.misfit_small else "no"
 
     def __repr__(self) -> str:
         if self.error is not None:
@@ -332,7 +335,7 @@ class Comparison:
                  f"({d.omega.min():.4g} to {d.omega.max():.4g} rad/s), {d.kind}; seed "
                  f"{self.seed}; ranked by ln Z",
                  f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
-                 f"{'certified':>9} {'fits':>5}"]
+                 f"{'certified':>9} {'fits':>6}"]
         for row in self.table():
             if row.get("error"):
                 lines.append(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  failed: "
@@ -344,7 +347,7 @@ class Comparison:
                 f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} "
                 f"{_fmt(row['delta_log_evidence'], '.2f'):>8} "
                 f"{_fmt(row['posterior_probability'], '.3f'):>6} "
-                f"{'yes' if row['converged'] else 'NO':>9} {(row['fits'] or '-'):>5}")
+                f"{'yes' if row['converged'] else 'NO':>9} {(row['fits'] or '-'):>6}")
         for w in self.data_warnings:
             lines.append(f"! {w}")
         return "\n".join(lines)

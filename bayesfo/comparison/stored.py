@@ -332,7 +332,13 @@ def _adequacy(block: dict | None) -> Adequacy | None:
         noise_scale_implausible=bool(block["noise_scale_implausible"]),
         misfit_small=bool(block["misfit_small"]), reasons=tuple(block["reasons"]),
         summary=block["summary"], n_draws=int(block["n_draws"]),
-        n_reference=int(block["n_reference"]), seed=int(block["seed"]))
+        n_reference=int(block["n_reference"]), seed=int(block["seed"]),
+        # Runs stored before the noise-dominated points were checked have no such keys.
+        noise_dominated_omega=tuple(_num(w) for w in block.get("noise_dominated_omega", ())),
+        misfit_masked=bool(block.get("misfit_masked", False)),
+        masked_phase_error_deg=_num(block.get("masked_phase_error_deg", 0.0)),
+        masked_log10_magnitude_error=_num(block.get("masked_log10_magnitude_error", 0.0)),
+        caution=block.get("caution", ""))
 
 
 def _criteria(s: dict, idata) -> Criteria:

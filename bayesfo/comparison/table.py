@@ -67,7 +67,8 @@ def ranking_rows(structures, ranking) -> list[dict]:
         if adequacy is None:
             fits = None
         else:
-            fits = ("yes" if adequacy.get("adequate")
+            fits = (("partly" if adequacy.get("misfit_masked") else "yes")
+                    if adequacy.get("adequate")
                     else "small" if adequacy.get("misfit_small") else "no")
         p_values = None if adequacy is None else [
             math.nan if v is None else v for v in adequacy.get("p_values", {}).values()]

@@ -85,6 +85,15 @@ misfit looks like noise. A posterior median σ_rel above ``max_noise_scale`` (0.
 and dynamic analysers give a few per cent), or a constant σ above ``max_noise_scale`` times the
 median |G|, counts against adequacy.
 
+A constant σ that is plausible on the median |G| can still swamp the points of smallest |G|
+(a modulus that spans two decades, fitted with σ = 5 % of its median, has noise of 70 % at its
+lowest point): there a misfit of tens of per cent looks like noise to every statistic. Such
+points are listed (``noise_dominated_omega``: the noise's standard deviation above
+``max_noise_scale`` of |G|), and a pass where the posterior mode misses them by more than
+``SMALL_MISFIT`` is marked ``misfit_masked``: the structure describes the rest of the data, and
+the noise model says those points carry no information; whether they do is for the user (or the
+evidence of the other noise model) to say.
+
 References
 ----------
 Gelman, A., Meng, X.-L., Stern, H. (1996). Posterior predictive assessment of model fitness via
@@ -174,6 +183,19 @@ class Adequacy:
         The posterior mode misses the data by at most ``SMALL_MISFIT`` (2° in phase, 0.015 in
         log10 |G|) and the noise scale is plausible: when not ``adequate``, a systematic misfit
         that is small in practice.
+    noise_dominated_omega : tuple of float
+        Frequencies where the sampled noise (posterior median of its standard deviation) exceeds
+        ``max_noise_scale`` times the data's |G|: the checks hardly test the structure there.
+        Empty when σ is known. Under ``constant`` noise these are the points of smallest |G|.
+    misfit_masked : bool
+        ``adequate``, but the posterior mode misses the noise-dominated points by more than
+        ``SMALL_MISFIT``: the pass rests on a noise scale that swamps part of the data.
+    masked_phase_error_deg, masked_log10_magnitude_error : float
+        The posterior mode's largest misfit at the noise-dominated points (0 when there are
+        none).
+    caution : str
+        When ``misfit_masked``, where the noise-dominated points are and by how much the mode
+        misses them, in words; else empty.
     reasons : tuple of str
         Plain-language reasons against adequacy (empty when adequate).
     summary : str
@@ -202,6 +224,11 @@ class Adequacy:
     n_draws: int
     n_reference: int
     seed: int
+    noise_dominated_omega: tuple[float, ...] = ()
+    misfit_masked: bool = False
+    masked_phase_error_deg: float = 0.0
+    masked_log10_magnitude_error: float = 0.0
+    caution: str = ""
 
     def to_dict(self) -> dict:
         """The JSON block of ``summary.json``: finite numbers, None for anything else."""
@@ -228,6 +255,11 @@ class Adequacy:
             "n_draws": int(self.n_draws),
             "n_reference": int(self.n_reference),
             "seed": int(self.seed),
+            "noise_dominated_omega": [_finite(w) for w in self.noise_dominated_omega],
+            "misfit_masked": bool(self.misfit_masked),
+            "masked_phase_error_deg": _finite(self.masked_phase_error_deg),
+            "masked_log10_magnitude_error": _finite(self.masked_log10_magnitude_error),
+            "caution": self.caution,
         }
 
 
@@ -456,10 +488,21 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
                     f"({100 * (10 ** abs(mag_err[i_mag]) - 1):.0f} %) at ω = {omega[i_mag]:.3g} rad/s",)
     small = bool(abs(phase_err[i_ph]) <= SMALL_MISFIT[0]
                  and abs(mag_err[i_mag]) <= SMALL_MISFIT[1] and not implausible)
+    # Points where the sampled noise exceeds max_noise_scale of |G| (under a constant σ, those of
+    # smallest |G|): a misfit there looks like noise to every statistic.
+    dominated = np.zeros(n, dtype=bool)
+    if lik.noise != "known":
+        dominated = np.median(np.abs(sd), axis=0) > max_noise_scale * np.abs(g)
+    masked_ph = float(np.nanmax(np.abs(phase_err[dominated]), initial=0.0))
+    masked_mag = float(np.nanmax(np.abs(mag_err[dominated]), initial=0.0))
+    masked = bool(adequate and (masked_ph > SMALL_MISFIT[0] or masked_mag > SMALL_MISFIT[1]))
+    caution = (_masked_text(omega[dominated], n, max_noise_scale, masked_ph, masked_mag)
+               if masked else "")
     if adequate:
         summary = (f"{post.structure} describes the data: no discrepancy below the level "
                    f"{level:g} (smallest p = {min(p_values.values()):.3g}); largest misfit "
-                   f"{abs(phase_err[i_ph]):.1f}° in phase, {abs(mag_err[i_mag]):.3f} in log10 |G|")
+                   f"{abs(phase_err[i_ph]):.1f}° in phase, {abs(mag_err[i_mag]):.3f} in log10 |G|"
+                   + ("; but " + caution if masked else ""))
     elif small:
         summary = (f"{post.structure} misses the data systematically but by little (at most "
                    f"{abs(phase_err[i_ph]):.1f}° in phase and "
@@ -475,8 +518,21 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
         outside_band_omega=tuple(float(w) for w in omega[outside]),
         noise=lik.noise, noise_scale=noise_scale, noise_scale_implausible=bool(implausible),
         misfit_small=small, reasons=reasons, summary=summary, n_draws=int(n_used), n_reference=int(n_reference),
-        seed=int(seed),
+        seed=int(seed), noise_dominated_omega=tuple(float(w) for w in omega[dominated]),
+        misfit_masked=masked, masked_phase_error_deg=masked_ph,
+        masked_log10_magnitude_error=masked_mag, caution=caution,
     )
+
+
+def _masked_text(omega, n: int, max_scale: float, phase_deg: float, log10_mag: float) -> str:
+    """The caution of a pass that rests on noise-dominated points (:attr:`Adequacy.misfit_masked`):
+    where they are, and by how much the posterior mode misses them."""
+    where = (f"ω = {omega.min():.3g}–{omega.max():.3g} rad/s" if omega.size > 1
+             else f"ω = {omega[0]:.3g} rad/s")
+    return (f"at {where} ({omega.size} of {n} points) the fitted noise exceeds "
+            f"{100 * max_scale:g} % of |G|, so the checks do not test the structure there, and "
+            f"its posterior mode misses those points by up to {phase_deg:.1f}° in phase and "
+            f"{100 * (10 ** log10_mag - 1):.0f} % in magnitude")
 
 
 def _check_args(lik, post, seed, level, n_draws, n_reference, max_noise_scale) -> None:

@@ -180,6 +180,55 @@ def test_implausible_noise_scale_counts_against_adequacy(zener_on_zener):
     assert ok.adequate and not ok.noise_scale_implausible
 
 
+def _constant_noise_case(sigma_rel_median, seed=3):
+    """Zener modulus data (|G| from 1 to 100) with a constant complex noise of
+    ``sigma_rel_median`` times the median |G|, and a point-mass posterior at the true parameters
+    and that σ."""
+    g = get_structure("zener").response([ZENER_TRUE], W, "modulus")[0]
+    sigma = sigma_rel_median * np.median(np.abs(g))
+    rng = np.random.default_rng(seed)
+    y = g + sigma / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
+    data = FrequencyResponse(W, y, kind="modulus")
+    lik = Likelihood(get_structure("zener"), data, noise="constant")
+    _, post = _fit("zener", data, noise="constant")
+    truth = lik.to_scaled(np.array([[*ZENER_TRUE, sigma]]))[0]
+    return data, g, sigma, check_adequacy(lik, _point_mass(lik, post, truth))
+
+
+def test_points_swamped_by_a_constant_noise_are_named():
+    # σ = 5 % of the median |G|: plausible overall (below 10 %), but above 10 % of |G| wherever
+    # |G| < σ / 0.1, the low-frequency end of the Zener's two decades.
+    data, g, sigma, result = _constant_noise_case(0.05)
+    assert result.adequate and not result.noise_scale_implausible
+    dominated = sigma > 0.1 * np.abs(data.response)
+    assert 3 <= dominated.sum() < W.size  # the case has such points, and not only those
+    assert result.noise_dominated_omega == pytest.approx(tuple(W[dominated]))
+    # The mode is the true response: its misfit there is the noise itself, computed directly.
+    ratio = data.response[dominated] / g[dominated]
+    assert result.masked_phase_error_deg == pytest.approx(np.max(np.abs(np.degrees(np.angle(ratio)))))
+    assert result.masked_log10_magnitude_error == pytest.approx(np.max(np.abs(np.log10(np.abs(ratio)))))
+    # Noise of 10-50 % of |G| there misses by more than 2° or 3.5 %: the pass is marked.
+    assert result.misfit_masked
+    assert f"({dominated.sum()} of {W.size} points)" in result.caution
+    assert result.summary.endswith(result.caution) and "; but at ω = 0.1–" in result.summary
+    assert json.loads(json.dumps(result.to_dict()))["misfit_masked"] is True
+
+
+def test_a_small_constant_noise_swamps_nothing():
+    # σ = 0.2 % of the median |G| is below 10 % of |G| at every point (|G| ≥ 1 % of the median).
+    _, _, _, result = _constant_noise_case(0.002)
+    assert result.noise_dominated_omega == () and not result.misfit_masked
+    assert result.caution == "" and result.masked_phase_error_deg == 0.0
+
+
+def test_known_sigma_is_never_noise_dominated():
+    # A measured σ is the data's own precision, not a fitted scale that could hide a misfit.
+    data = zener_data(seed=4, rel=0.3, known=True)
+    lik, post = _fit("zener", data, noise="known")
+    result = check_adequacy(lik, post)
+    assert result.noise_dominated_omega == () and not result.misfit_masked
+
+
 def test_example_simulated_from_voigt_is_adequate():
     # examples/data/pp_compliance.csv is simulated from a fractional Voigt compliance with
     # constant complex noise (see its header): the Voigt structure must pass.

@@ -316,6 +316,17 @@ def test_adequacy_of_every_structure(voigt_comparison):
     alone = dataclasses.replace(result, results=(result["voigt-int"],))
     text, flagged = next((t, f) for t, f in verdict(alone) if t.startswith("None of"))
     assert flagged and "voigt-int: residuals are correlated along frequency" in text
+    # A pass that rests on noise-dominated points is flagged, in the verdict and the tables.
+    masked = dataclasses.replace(result[best].adequacy, misfit_masked=True,
+                                 caution="at ω = 0.1–0.3 rad/s (3 of 20 points) the fitted noise")
+    crit = dataclasses.replace(result[best].criteria, adequacy=masked)
+    swapped = dataclasses.replace(result, results=tuple(
+        dataclasses.replace(r, criteria=crit) if r.name == best else r for r in result.results))
+    assert swapped[best].fits == "partly"
+    assert {r["structure"]: r["fits"] for r in swapped.table()}[best] == "partly"
+    text, flagged = next((t, f) for t, f in verdict(swapped) if "predictive checks" in t)
+    assert flagged and text.startswith(f"{best} passes its posterior predictive checks at the "
+                                       "1 % level, but at ω = 0.1–0.3 rad/s (3 of 20 points)")
 
 
 def test_ranking_figure_names_the_structures_that_misfit(voigt_comparison):

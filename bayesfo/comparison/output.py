@@ -76,7 +76,9 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     formats : sequence of str
         Figure file formats.
     pool : concurrent.futures.Executor, optional
-        Draw the figures in these worker processes (from :func:`process_pool`).
+        Draw the figures in these worker processes (from :func:`process_pool`; a
+        :class:`~bayesfo.parallel.LazyPool` whose processes were not started is not started
+        for them: the figures are then drawn in this process).
 
     Returns
     -------

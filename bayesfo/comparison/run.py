@@ -13,8 +13,10 @@ and the posterior predictive adequacy checks (:mod:`bayesfo.inference.adequacy`)
 ranked by ln Z; posterior model probabilities assume equal prior odds unless given.
 
 Structures run one after the other or side by side in worker processes (``workers``), where
-the posteriors of a structure's two noise models run side by side too (:mod:`.schedule`); each
-step runs with the same seed, so the numbers do not depend on how many.
+the posteriors of a structure's two noise models run side by side too (:mod:`.schedule`), or,
+by default in the command line (``workers=0``), in this process where the noise screen
+promises a quick certified posterior and in worker processes, started only then, where it
+does not; each step runs with the same seed, so the numbers do not depend on where.
 
 Outputs (:func:`~bayesfo.comparison.output.write_outputs`, staged and swapped in as one run by
 :mod:`bayesfo.outdir`): one ``<structure>.nc`` (arviz InferenceData) per structure,
@@ -40,7 +42,13 @@ from ..inference.importance import K_HAT_MAX, importance_posterior, screen_noise
 from ..inference.likelihood import NOISE_PRIORS
 from ..inference.posterior import posterior_from_particles
 from ..options import EVIDENCE_ROUTES, SAMPLERS
-from ..parallel import available_cpus, process_pool
+from ..parallel import (
+    LazyPool,
+    available_cpus,
+    lazy_process_pool,
+    process_pool,
+    single_blas_thread,
+)
 from ..structures import Structure, resolve_structures
 from .criteria import _criteria, _evidence, _evidence_check, _holdout, _model_probabilities
 from .criteria_types import Criteria
@@ -86,11 +94,17 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         Angular frequencies [rad/s] left out of the fit (thesis §4.3.3); the log predictive
         density and the RMSE on them are reported next to the in-sample figures.
     workers : int
-        Processes running structures side by side (0: one per CPU). The numbers do not depend
-        on it: every structure runs with ``seed``.
+        Processes running structures side by side. 0: automatic: this process runs each
+        structure's optimisation and noise screen, and the posteriors that the screen's
+        importance weights promise to certify quickly; the others (the tempered ladder, emcee)
+        run in worker processes, one per CPU, started only when some structure needs them
+        (:func:`~bayesfo.parallel.lazy_process_pool`). The numbers do not depend on it: every
+        step runs with ``seed``.
     pool : concurrent.futures.Executor, optional
         Run the structures in this pool instead (from :func:`process_pool`; ``workers`` is then
-        ignored).
+        ignored). A :class:`~bayesfo.parallel.LazyPool` (from
+        :func:`~bayesfo.parallel.lazy_process_pool`) gets the automatic schedule of
+        ``workers=0``.
     sampler : {"auto", "emcee"}
         How each posterior is computed. ``"auto"``: importance sampling from the optima where
         its weights certify it (Pareto k̂ < 0.7, ESS ≥ 1000; well-posed structures, a fraction
@@ -154,16 +168,23 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
                "evidence": evidence,
                "test": test, "sampler": sampler, "sampler_kwargs": sampler_kwargs}
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
-    if pool is None and n_proc <= 1:
-        outcomes = []
-        for s in structures:
-            outcomes.append(_run_structure(s, data, options))
-            bar.update()
+    # Each step gets the same seed whatever the worker count or the process that runs it, so
+    # the numbers do not depend on them.
+    if isinstance(pool, LazyPool):
+        with single_blas_thread():
+            outcomes = run_in_pool(pool, structures, data, options, bar, here=True)
     elif pool is not None:
         outcomes = run_in_pool(pool, structures, data, options, bar)
+    elif workers == 0:
+        with lazy_process_pool(n_proc) as own, single_blas_thread():
+            outcomes = run_in_pool(own, structures, data, options, bar, here=True)
+    elif n_proc <= 1:
+        outcomes = []
+        with single_blas_thread():
+            for s in structures:
+                outcomes.append(_run_structure(s, data, options))
+                bar.update()
     else:
-        # Each structure gets the same seed whatever the worker count, so the numbers do not
-        # depend on it.
         with process_pool(n_proc) as own:
             outcomes = run_in_pool(own, structures, data, options, bar)
     bar.close()
@@ -347,15 +368,13 @@ def _exponent_intervals(run: dict) -> dict:
 SCREEN_MARGIN = 5.0
 
 
-def _screen(s, data, candidates, fit, options) -> dict | None:
-    """The quick ln Z of each candidate noise model, and the leader where it is decisive (see
-    :data:`SCREEN_MARGIN`); None when all candidates must be sampled."""
-    if len(candidates) < 2 or not fit.optima.size:
-        return None
+def _quick_estimates(s, data, candidates, fit, options) -> dict:
+    """The quick ln Z (:func:`~bayesfo.inference.importance.screen_noise`) of each candidate
+    noise model in turn, up to the first that has none (None)."""
     quick = {}
     for noise in candidates:
         own = {k: v for k, v in (options["priors"] or {}).items()
-               if k in s.param_names or k == NOISE_PRIORS[noise][0]}
+               if k in s.param_names or k == NOISE_PRIORS.get(noise, ("",))[0]}
         lik = Likelihood(s, data, noise=noise, priors=own)
         modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling),
                                         lik.scaling)
@@ -364,7 +383,21 @@ def _screen(s, data, candidates, fit, options) -> dict | None:
         except (np.linalg.LinAlgError, FloatingPointError):
             quick[noise] = None
         if quick[noise] is None:
-            return None
+            break
+    return quick
+
+
+def _screen(s, data, candidates, fit, options, quick=None) -> dict | None:
+    """The quick ln Z of each candidate noise model, and the leader where it is decisive (see
+    :data:`SCREEN_MARGIN`); None when all candidates must be sampled. ``quick``: the estimates
+    of :func:`_quick_estimates`, when already made."""
+    if len(candidates) < 2 or not fit.optima.size:
+        return None
+    if quick is None:
+        quick = _quick_estimates(s, data, candidates, fit, options)
+    if any(quick.get(noise) is None for noise in candidates):
+        return None
+    quick = {noise: quick[noise] for noise in candidates}
     order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
     leader, other = order[0], order[1]
     if (quick[leader]["log_z"] - quick[other]["log_z"] < SCREEN_MARGIN
@@ -463,14 +496,48 @@ def _run_structure(s: Structure, data: FrequencyResponse, options: dict):
 def _fit_and_screen(s: Structure, data: FrequencyResponse, options: dict):
     """Step 1: the optimisation and the noise screen (:func:`_screen`). Returns the fit, the
     screen's record (None when it did not decide) and the noise models to sample."""
+    candidates, fit = _fit(s, data, options)
+    screened = _screen(s, data, candidates, fit, options)
+    return fit, screened, [n for n in candidates if screened is None or n == screened["leader"]]
+
+
+def _fit_and_probe(s: Structure, data: FrequencyResponse, options: dict):
+    """Step 1 as :func:`_fit_and_screen`, and whether the rest promises to be quick: the
+    screen's raw importance weights of every noise model still to sample have a Pareto k̂ below
+    :data:`~bayesfo.inference.importance.K_HAT_MAX`, so that importance sampling will most
+    likely certify the posterior (a fraction of a second) and neither the ladder nor emcee will
+    run. Returns ((fit, screened, noise models), quick). The numbers and the warnings are those
+    of :func:`_fit_and_screen`: the estimates that the screen does not make itself are made
+    with their warnings discarded, and they only guide where the next steps run."""
+    candidates, fit = _fit(s, data, options)
+    quick = (_quick_estimates(s, data, candidates, fit, options)
+             if len(candidates) > 1 and fit.optima.size else {})
+    screened = _screen(s, data, candidates, fit, options, quick=quick)
+    noises = [n for n in candidates if screened is None or n == screened["leader"]]
+    if (options["sampler"] != "auto" or options["evidence"] != "auto"
+            or options["evidence_check"] or not fit.optima.size):
+        return (fit, screened, noises), False
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for noise in noises:
+            if noise not in quick:
+                try:
+                    quick.update(_quick_estimates(s, data, (noise,), fit, options))
+                except (InputError, np.linalg.LinAlgError, FloatingPointError):
+                    quick[noise] = None
+    promise = all(quick.get(n) is not None and quick[n]["k_hat"] < K_HAT_MAX for n in noises)
+    return (fit, screened, noises), promise
+
+
+def _fit(s: Structure, data: FrequencyResponse, options: dict):
+    """The noise models to choose from and the global optimisation (the modes)."""
     candidates = _noise_candidates(data, options["noise"])
     structure = Likelihood(s, data, noise=candidates[0], priors={
         k: v for k, v in (options["priors"] or {}).items() if k in s.param_names
     }).structure
     fit = fit_structure(structure, data, rng=options["seed"], seed_methods=True,
                         linear_methods=True)
-    screened = _screen(s, data, candidates, fit, options)
-    return fit, screened, [n for n in candidates if screened is None or n == screened["leader"]]
+    return candidates, fit
 
 
 def _sample_held(s: Structure, data: FrequencyResponse, noise: str, fit, options: dict) -> dict:

@@ -245,11 +245,14 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
             t.set(rotation=0, ha="right", va="center", rotation_mode="default")
     px = fig.dpi / 72.0
 
-    def place_labels():
+    def place_labels(drawn: bool = False):
         # One x for the y labels of the left column and one y for the x labels of the bottom
         # row, beyond every tick label of the column or row: a label taller or wider than its
         # panel then clears the tick labels of its neighbours too, and the labels align.
-        fig.draw_without_rendering()
+        # ``drawn``: the figure has been drawn since the panels last moved. An axis label
+        # placed by set_label_coords has its extent without another drawing.
+        if not drawn:
+            fig.draw_without_rendering()
         renderer = fig.canvas.get_renderer()
         boxes = [b for ax in left for b in _tick_boxes(ax.get_yticklabels(), renderer)]
         x = min([b.x0 for b in boxes] + [ax.bbox.x0 for ax in left]) - LABEL_PAD * px
@@ -259,12 +262,11 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
         y = min([b.y0 for b in boxes] + [ax.bbox.y0 for ax in bottom]) - LABEL_PAD * px
         for ax in bottom:
             ax.xaxis.set_label_coords(0.5, (y - ax.bbox.y0) / ax.bbox.height)
-        fig.draw_without_rendering()
         return renderer
 
-    _declutter(fig, left, bottom)
-    for _ in range(iterations):
-        renderer = place_labels()
+    _declutter(fig, left, bottom)  # draws the figure
+    for i in range(iterations):
+        renderer = place_labels(drawn=i == 0)
         boxes = [b for ax in left + bottom
                  for b in _tick_boxes([*ax.get_xticklabels(), *ax.get_yticklabels(),
                                        ax.xaxis.label, ax.yaxis.label], renderer)]
@@ -281,7 +283,7 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
                             bottom=sp.bottom + grow_bottom / height,
                             right=min(sp.right, sp.right - grow_right / width))
     _declutter(fig, left, bottom)  # the panels as the last margins left them
-    place_labels()  # against the tick labels where the last margins put them
+    place_labels(drawn=True)  # against the tick labels where the last margins put them
 
 
 def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:

@@ -118,3 +118,43 @@ def test_models_option_before_or_after_the_command(tmp_path, run_cli):
         assert status == 0 and "kv2 " in out and "kv2-int " in out
     status, out, _ = run_cli("structures")
     assert "kv2" not in out
+
+
+ADHESIVE = EXAMPLES / "adhesive_468mp" / "Tp020C.csv"
+
+
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_compare_writes_the_same_summary_whichever_process_computes(run_cli, tmp_path):
+    """The default schedule (quick posteriors in the command's process), one process, and two
+    worker processes give the same summary.json: every step runs with the same seed."""
+    summaries = {}
+    for workers in ("0", "1", "2"):
+        out = tmp_path / f"w{workers}"
+        status, _, err = run_cli("compare", ADHESIVE, "--structures", "zener-int,voigt",
+                                 "--workers", workers, "--out", out, "--no-figures", "--quiet")
+        assert status == 0, err
+        summaries[workers] = json.loads((out / "summary.json").read_text())
+    assert summaries["0"] == summaries["1"] == summaries["2"]
+    assert [s["sampler"] for s in summaries["0"]["structures"]] == ["importance"] * 2
+
+
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_figure_formats_png_alone(run_cli, tmp_path):
+    out = tmp_path / "out"
+    status, _, err = run_cli("compare", ADHESIVE, "--structures", "voigt", "--out", out,
+                             "--figure-formats", "PNG", "--quiet")
+    assert status == 0, err
+    names = sorted(p.name for p in (out / "figures").iterdir())
+    assert names == ["bode.png", "corner_voigt.png", "nyquist.png", "q_posteriors.png",
+                     "ranking.png", "residuals.png", "trace_voigt.png"]
+    assert (out / "report.html").read_text().count("data:image/png;base64,") == len(names)
+
+
+@pytest.mark.parametrize("formats, message", [
+    ("png,xyz", "--figure-formats: cannot write 'xyz' figures; use one of"),
+    (",", "--figure-formats is empty")])
+def test_bad_figure_formats_are_refused_before_work(run_cli, tmp_path, formats, message):
+    out = tmp_path / "out"
+    status, _, err = run_cli("compare", ADHESIVE, "--out", out, "--figure-formats", formats)
+    assert status == 2 and err.startswith(f"bayesfo: error: {message}")
+    assert len(err.strip().splitlines()) == 1 and not out.exists()

@@ -6,14 +6,17 @@ from __future__ import annotations
 
 import json
 import warnings
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 
 import bayesfo as bf
 import bayesfo.comparison.run as run
+import bayesfo.comparison.schedule as schedule
+from bayesfo import parallel
 from bayesfo.errors import InputError
+from bayesfo.parallel import LazyPool, lazy_process_pool
 
 DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
 #: On this isotherm the screen decides neither structure's noise model: both are sampled (by
@@ -128,3 +131,97 @@ def test_an_input_error_in_a_step_ends_that_structure_alone(monkeypatch):
     # has no conclusion.
     assert [st for st in recorder.steps if st[1] == "zener-int"] == [("_first", "zener-int", None)]
     assert ("_conclude", "maxwell-int", None) not in recorder.steps
+
+
+# ------------------------------------------------ the automatic schedule (workers=0)
+class _LazyRecorder(LazyPool):
+    """A LazyPool that runs each task at once in this process and thread (monkeypatches apply;
+    warnings are caught as in a worker of its own), recording which step each task runs."""
+
+    def __init__(self):
+        super().__init__(1)
+        self.steps = []
+
+    def submit(self, fn, /, *args):
+        self.steps.append((args[0].__name__, args[1].name,
+                           args[3] if args[0].__name__ == "_sample_held" else None))
+        future = Future()
+        future.set_result(fn(*args))
+        return future
+
+
+def test_the_automatic_schedule_gives_the_numbers_of_the_serial_path(noisy_sampler):
+    serial, caught_serial = _compare(workers=1)
+    auto, caught_auto = _compare(workers=0)
+    assert _numbers(serial.results) == _numbers(auto.results)
+    assert json.dumps(serial.to_summary(), sort_keys=True, default=str) == \
+        json.dumps(auto.to_summary(), sort_keys=True, default=str)
+    assert caught_serial == caught_auto
+
+
+def test_quick_posteriors_run_here_and_start_no_process():
+    """Both noise models of both structures are certified by importance sampling: the screen
+    promises it, and no worker process is started."""
+    serial, caught_serial = _compare(workers=1)
+    with lazy_process_pool(2) as pool:
+        auto, caught_auto = _compare(pool=pool)
+        assert not pool.started
+    assert _numbers(serial.results) == _numbers(auto.results)
+    assert caught_serial == caught_auto
+
+
+def test_structures_without_the_promise_go_to_the_pool(monkeypatch, noisy_sampler):
+    """A structure whose screen does not promise a quick posterior has its posteriors and its
+    conclusion run by the pool, with the numbers and warnings of the serial path; the others
+    run here."""
+    probe = schedule._fit_and_probe
+
+    def pessimistic(s, data, options):
+        prepared, quick = probe(s, data, options)
+        return prepared, quick and s.name != "maxwell-int"
+
+    monkeypatch.setattr(schedule, "_fit_and_probe", pessimistic)
+    serial, caught_serial = _compare(workers=1)
+    pool = _LazyRecorder()
+    auto, caught_auto = _compare(pool=pool)
+    assert _numbers(serial.results) == _numbers(auto.results)
+    assert caught_serial == caught_auto
+    assert sorted(pool.steps) == [("_conclude", "maxwell-int", None),
+                                           ("_sample_held", "maxwell-int", "constant"),
+                                           ("_sample_held", "maxwell-int", "proportional")]
+
+
+def test_an_input_error_ends_that_structure_alone_on_the_automatic_schedule(monkeypatch):
+    fit_structure, sample = run.fit_structure, run._sample
+
+    def failing_fit(structure, *args, **kwargs):
+        if structure.name == "zener-int":
+            raise InputError("no fit here")
+        return fit_structure(structure, *args, **kwargs)
+
+    def failing_sample(s, data, noise, fit, options):
+        if s.name == "maxwell-int" and noise == "proportional":
+            raise InputError("no posterior here")
+        return sample(s, data, noise, fit, options)
+
+    monkeypatch.setattr(run, "fit_structure", failing_fit)
+    monkeypatch.setattr(run, "_sample", failing_sample)
+    auto, _ = _compare(BOTH + ",voigt-int", workers=0)
+    assert auto["zener-int"].error == "no fit here"
+    assert auto["maxwell-int"].error == "no posterior here"
+    serial, _ = _compare("voigt-int", workers=1)
+    assert _numbers([serial["voigt-int"]]) == _numbers([auto["voigt-int"]])
+
+
+def test_one_blas_thread_inside_the_block_and_the_count_restored_after():
+    from threadpoolctl import threadpool_info
+
+    def counts():
+        return [p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"]
+
+    before = counts()
+    if not before:
+        pytest.skip("no BLAS library found in this process")
+    with parallel.single_blas_thread():
+        assert counts() == [1] * len(before)
+    assert counts() == before

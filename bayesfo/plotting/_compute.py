@@ -330,10 +330,12 @@ def coincident_groups(curves: dict, span: float, fraction: float = COINCIDE_FRAC
 
 def legend_name(result) -> str:
     """A structure's name in a legend, marked where the posterior predictive checks reject it
-    (``"maxwell (misfits)"``; ``"(small misfit)"`` within 2° and 3.5 %), so that a curve in a
-    Bode, Nyquist or residual figure is not read as a description of the data it fails."""
+    (``"maxwell (misfits)"``; ``"(small misfit)"`` within 2° and 3.5 %; ``"(misfit hidden by
+    noise)"`` where a pass rests on points its fitted noise swamps), so that a curve in a Bode,
+    Nyquist or residual figure is not read as a description of the data it fails."""
     fits = getattr(result, "fits", None)
-    return result.name + {"no": " (misfits)", "small": " (small misfit)"}.get(fits, "")
+    return result.name + {"no": " (misfits)", "small": " (small misfit)",
+                          "partly": " (misfit hidden by noise)"}.get(fits, "")
 
 
 def join_names(names) -> str:

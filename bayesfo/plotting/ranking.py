@@ -60,7 +60,8 @@ def _label(name: str, converged: bool, fits: str) -> str:
     """A structure's tick label, with what the reader must know about it: a posterior that is
     not certified, and a structure that does not describe the data (adequacy checks)."""
     notes = [] if converged else ["not converged"]
-    notes += {"no": ["misfits the data"], "small": ["small misfit"]}.get(fits, [])
+    notes += {"no": ["misfits the data"], "small": ["small misfit"],
+              "partly": ["misfit hidden by noise"]}.get(fits, [])
     return "\n".join([name, *notes])
 
 
@@ -110,8 +111,8 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         bottom): ``"structures"``, ``"y"``, ``"delta_log_evidence"``, ``"log_evidence_err"``,
         ``"posterior_probability"``, ``"delta_loo"``, ``"delta_loo_se"``, ``"delta_aic_half"``,
         ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing), ``"fits"``
-        (``"yes"``, ``"small"``, ``"no"`` from the adequacy checks; labels say "misfits the
-        data" or "small misfit"), ``"pareto_k_max"``; ``"note"`` (why WAIC is not shown).
+        (``"yes"``, ``"partly"``, ``"small"``, ``"no"`` from the adequacy checks; labels say
+        "misfit hidden by noise", "misfits the data" or "small misfit"), ``"pareto_k_max"``; ``"note"`` (why WAIC is not shown).
         ``artists``: ``"<name>/log_evidence"`` (``ErrorbarContainer``), one
         ``ErrorbarContainer`` per criterion under its value key (the markers of PSIS-LOO shown
         only where k̂ ≤ 0.7), ``"delta_loo_unreliable"`` (``Line2D``: the open markers where

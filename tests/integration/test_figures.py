@@ -562,9 +562,10 @@ def test_a_long_coincidence_note_is_wrapped_inside_the_figure():
 
 def test_structures_that_misfit_are_marked_in_the_response_legends():
     # Adequacy as the checks report it: maxwell rejected, zener within the small-misfit band.
+    # voigt passes only where its fitted noise does not swamp the data.
     comp = _demo_comparison(("voigt", "zener", "maxwell"))
-    comp.results[1].fits, comp.results[2].fits = "small", "no"
-    expected = ["voigt", "zener (small misfit)", "maxwell (misfits)"]
+    comp.results[0].fits, comp.results[1].fits, comp.results[2].fits = "partly", "small", "no"
+    expected = ["voigt (misfit hidden by noise)", "zener (small misfit)", "maxwell (misfits)"]
     for drawn in (plot_bode(comp, n_draws=40), plot_nyquist(comp, n_draws=40, n_lines=0),
                   plot_residuals(comp, n_draws=40)):
         shown = [t.get_text() for legend in drawn.figure.legends for t in legend.get_texts()]

@@ -98,11 +98,12 @@ def run(args) -> int:
               "probability, equal prior odds; ok = posterior certified; fits = posterior "
               "predictive checks pass (small: a systematic misfit within 2° and 3.5 %; partly: "
               "pass, but the fitted noise swamps points the fit misses)")
-        print(f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
+        width = max([16] + [len(row['structure']) for row in result.table()])
+        print(f"{'#':>2} {'structure':<{width}} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
               f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3} {'fits':>6}")
         for row in result.table():
             if row.get("error"):
-                print(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  skipped: {row['error']}")
+                print(f"{'-':>2} {row['structure']:<{width}} {row['n_params']:>2}  skipped: {row['error']}")
                 continue
             q = "" if row["q_mean"] is None else f"{row['q_mean']:.3f} ({row['q_sd']:.3f})"
             if row["log_evidence"] is None:
@@ -112,7 +113,7 @@ def run(args) -> int:
                 z += " L" if row["evidence_method"] == "ladder" else "  "
                 dz = f"{row['delta_log_evidence']:.2f}"
                 p = f"{row['posterior_probability']:.3f}"
-            print(f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} {dz:>8} "
+            print(f"{row['rank']:>2} {row['structure']:<{width}} {row['n_params']:>2} {z:>18} {dz:>8} "
                   f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>16} "
                   f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3} "
                   f"{(row['fits'] or '-').replace('no', 'NO'):>6}")

@@ -331,20 +331,21 @@ class Comparison:
         ``print(result.summary())``; per structure, :meth:`StructureResult.summary`."""
         d = self.data
         held = "" if self.holdout is None else f", {self.holdout.n_frequencies} held out"
+        width = max([16] + [len(row['structure']) for row in self.table()])
         lines = [f"{d.label}: {d.n_frequencies} frequencies{held} "
                  f"({d.omega.min():.4g} to {d.omega.max():.4g} rad/s), {d.kind}; seed "
                  f"{self.seed}; ranked by ln Z",
-                 f"{'#':>2} {'structure':<16} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
+                 f"{'#':>2} {'structure':<{width}} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
                  f"{'certified':>9} {'fits':>6}"]
         for row in self.table():
             if row.get("error"):
-                lines.append(f"{'-':>2} {row['structure']:<16} {row['n_params']:>2}  failed: "
+                lines.append(f"{'-':>2} {row['structure']:<{width}} {row['n_params']:>2}  failed: "
                              f"{row['error']}")
                 continue
             z = ("-" if row["log_evidence"] is None else
                  f"{_fmt(row['log_evidence'], '.2f')} ± {_fmt(row['log_evidence_err'], '.2f')}")
             lines.append(
-                f"{row['rank']:>2} {row['structure']:<16} {row['n_params']:>2} {z:>18} "
+                f"{row['rank']:>2} {row['structure']:<{width}} {row['n_params']:>2} {z:>18} "
                 f"{_fmt(row['delta_log_evidence'], '.2f'):>8} "
                 f"{_fmt(row['posterior_probability'], '.3f'):>6} "
                 f"{'yes' if row['converged'] else 'NO':>9} {(row['fits'] or '-'):>6}")

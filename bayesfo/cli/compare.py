@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
@@ -33,6 +34,30 @@ def add_parser(subparsers):
     return p
 
 
+def _compare(data, structures, out, n_proc, workers, formats, no_figures, options):
+    """The comparison and its outputs, in the processes that ``workers`` asks for."""
+    from ..comparison import compare, write_outputs
+    from ..parallel import lazy_process_pool, process_pool
+
+    figures = {} if formats is None else {"formats": formats}
+    if workers == 0:
+        # The quick steps here, the long ones in worker processes started only if some
+        # structure needs them; those then draw the figures too.
+        with lazy_process_pool(n_proc) as pool:
+            result = compare(data, structures, pool=pool, **options)
+            write_outputs(result, out, figures=not no_figures, pool=pool, **figures)
+    elif n_proc > 1:
+        # One pool for the structures and then the figures: its processes have the libraries
+        # loaded by the time they draw.
+        with process_pool(n_proc) as pool:
+            result = compare(data, structures, pool=pool, **options)
+            write_outputs(result, out, figures=not no_figures, pool=pool, **figures)
+    else:
+        result = compare(data, structures, workers=1, **options)
+        write_outputs(result, out, figures=not no_figures, **figures)
+    return result
+
+
 def _num(x, fmt: str = ".2f") -> str:
     """A number for the terminal table; '-' for one that is undefined (its reason is among
     the warnings)."""
@@ -40,9 +65,8 @@ def _num(x, fmt: str = ".2f") -> str:
 
 
 def run(args) -> int:
-    from ..comparison import compare, write_outputs
     from ..outdir import check_output_directory
-    from ..parallel import available_cpus, lazy_process_pool, process_pool
+    from ..parallel import available_cpus
     from ..structures import resolve_structures
 
     data = read_data(args)
@@ -60,35 +84,26 @@ def run(args) -> int:
 
         formats = check_formats([f for f in args.figure_formats.split(",") if f.strip()],
                                 "--figure-formats")
-    out = check_output_directory(args.out if args.out else f"bayesfo-{Path(args.data).stem}",
-                                 directories=() if args.no_figures else ("figures",))
-    progress = not args.quiet and sys.stderr.isatty()
     holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
+    if args.workers < 0:
+        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
+    progress = not args.quiet and sys.stderr.isatty()
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
                    evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,
                    sampler=args.sampler)
     options.update(sampler_options(settings))
-    if args.workers < 0:
-        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
     n_proc = min(args.workers or available_cpus(), len(structures))
-    if args.workers == 0:
-        # The quick steps here, the long ones in worker processes started only if some
-        # structure needs them; those then draw the figures too.
-        with lazy_process_pool(n_proc) as pool:
-            result = compare(data, structures, pool=pool, **options)
-            write_outputs(result, out, figures=not args.no_figures, pool=pool,
-                          **({} if formats is None else {"formats": formats}))
-    elif n_proc > 1:
-        # One pool for the structures and then the figures: its processes have the libraries
-        # loaded by the time they draw.
-        with process_pool(n_proc) as pool:
-            result = compare(data, structures, pool=pool, **options)
-            write_outputs(result, out, figures=not args.no_figures, pool=pool,
-                          **({} if formats is None else {"formats": formats}))
-    else:
-        result = compare(data, structures, workers=1, **options)
-        write_outputs(result, out, figures=not args.no_figures,
-                      **({} if formats is None else {"formats": formats}))
+    target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
+    created = not target.exists()
+    out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
+    try:
+        result = _compare(data, structures, out, n_proc, args.workers, formats, args.no_figures,
+                          options)
+    except BaseException:
+        if created:  # a run that wrote nothing leaves no directory behind
+            with contextlib.suppress(OSError):
+                out.rmdir()
+        raise
     if not args.quiet:
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"

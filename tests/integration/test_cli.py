@@ -158,3 +158,16 @@ def test_bad_figure_formats_are_refused_before_work(run_cli, tmp_path, formats, 
     status, _, err = run_cli("compare", ADHESIVE, "--out", out, "--figure-formats", formats)
     assert status == 2 and err.startswith(f"bayesfo: error: {message}")
     assert len(err.strip().splitlines()) == 1 and not out.exists()
+
+
+@pytest.mark.parametrize("argv", [["--holdout", "1e9"], ["--holdout", "1_0"], ["--workers", "-1"]])
+def test_a_compare_that_fails_leaves_no_output_directory(run_cli, tmp_path, monkeypatch, argv):
+    # Without --out the output directory is bayesfo-<data name> in the working directory: a run
+    # refused before any output leaves no empty directory there, and one that existed stays.
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run_cli("compare", ADHESIVE, "--no-figures", *argv)
+    assert status == 2 and err.startswith("bayesfo: error:")
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "bayesfo-Tp020C").mkdir()
+    status, _, _ = run_cli("compare", ADHESIVE, "--no-figures", *argv)
+    assert status == 2 and (tmp_path / "bayesfo-Tp020C").is_dir()

@@ -45,7 +45,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..response import HALF_PI, matignon_stable, polyval_ascending
+from ..response import (
+    CLOSED_FORM_MIN_ROWS,
+    HALF_PI,
+    cubic_roots,
+    matignon_stable,
+    polyval_ascending,
+)
 
 #: Exponents closer than this to an integer count as integers.
 INTEGER_TOL = 1e-12
@@ -243,6 +249,52 @@ def _evaluate_ratio(p: np.ndarray, s: np.ndarray, x: np.ndarray) -> np.ndarray:
         return np.where(den > 0, num / den, 0.0)
 
 
+def _isolated_negatives_dominated(p: np.ndarray) -> np.ndarray:
+    """Rows of ascending coefficients (shape (n, K)) that are ≥ 0 at every x > 0 by the
+    arithmetic–geometric mean inequality: no two negative coefficients are adjacent, and
+    every negative p_j satisfies p_j² ≤ 4 (w p_{j−1})(w′ p_{j+1}), where w, w′ are the shares of
+    its neighbours (1, or 1/2 for a neighbour between two negative coefficients), so that
+    w p_{j−1} x^{j−1} + p_j x^j + w′ p_{j+1} x^{j+1} ≥ 0 and the shares add up to at most p.
+    A sufficient condition (a certificate), with a factor 1 − 1e-9 against rounding."""
+    neg = p < 0
+    if p.shape[1] < 3:
+        return ~neg.any(axis=1)
+    adjacent = np.any(neg[:, 1:] & neg[:, :-1], axis=1)
+    count = np.zeros(p.shape)
+    count[:, 1:] += neg[:, :-1]
+    count[:, :-1] += neg[:, 1:]
+    share = np.maximum(p, 0.0) / np.maximum(count, 1.0)
+    inner = p[:, 1:-1]
+    dominated = inner * inner <= 4.0 * share[:, :-2] * share[:, 2:] * (1.0 - 1e-9)
+    ends = ~neg[:, 0] & ~neg[:, -1]
+    return ends & ~adjacent & np.all(dominated | ~neg[:, 1:-1], axis=1)
+
+
+def _cubic_critical_check(p: np.ndarray, s: np.ndarray, deriv: np.ndarray, rtol: float
+                          ) -> tuple[np.ndarray, np.ndarray]:
+    """The rule of :func:`nonnegative_on_positive_axis` for rows whose p′ (ascending
+    ``deriv``, 4 coefficients) is a cubic, with its roots in closed form: (ok, sure).
+
+    ``sure`` marks rows whose decision is the same at any candidate points within twice the
+    error bound of :func:`~bayesfo.response.cubic_roots` (which also bounds the eigenvalues
+    of the companion matrix): every root is clearly off the imaginary axis and away from 0,
+    and every ratio p/S at a candidate x is farther from −rtol than it can move there
+    (|d(p/S)/dx| ≤ 2 S′/S ≤ 2K/x, as |p_j| ≤ s_j) plus 1e-14 of rounding."""
+    roots, err = cubic_roots(deriv[:, -2::-1] / deriv[:, -1:])
+    e = 2.0 * err
+    with np.errstate(all="ignore"):
+        absr = np.abs(roots)
+        clear = np.all((absr > 2.0 * e) & (np.abs(roots.real) > e), axis=1)
+        cand = np.concatenate([absr, np.where(roots.real > 0, roots.real, 1.0)], axis=1)
+        move = np.concatenate([e, np.where(roots.real > 0, e, 0.0)], axis=1)
+        ratio = _evaluate_ratio(p, s, np.where(cand > 0, cand, 1.0))
+        slack = 2.0 * (p.shape[1] - 1) * move / (cand - move) + 1e-14
+        above = ratio >= -rtol + slack
+        below = ratio < -rtol - slack
+    ok = np.all(above, axis=1)
+    return ok, clear & np.isfinite(err).all(axis=1) & (ok | np.any(below, axis=1))
+
+
 def nonnegative_on_positive_axis(coef, scale=None, *, rtol: float = DISSIPATION_RTOL
                                  ) -> np.ndarray:
     """Whether real polynomials are ≥ 0 at every x > 0 (exact up to a rounding tolerance).
@@ -268,7 +320,11 @@ def nonnegative_on_positive_axis(coef, scale=None, *, rtol: float = DISSIPATION_
     positive at both ends of (0, ∞) and its minimum there is at a positive real root of p′,
     found as the eigenvalues of the companion matrices of p′ (batched by degree). p is evaluated
     at the modulus and the real part of every root of p′ (all positive points, so extra points
-    only add checks), in powers of 1/x beyond x = 1 to stay finite.
+    only add checks), in powers of 1/x beyond x = 1 to stay finite. Two shortcuts give the same
+    decisions with less work: a certificate of p ≥ 0 (isolated negative coefficients dominated
+    by their neighbours, :func:`_isolated_negatives_dominated`) settles rows without roots, and
+    a cubic p′ takes closed-form roots (:func:`_cubic_critical_check`) wherever their error
+    bound cannot change a decision; the other rows take the eigenvalues.
     """
     p = np.atleast_2d(np.asarray(coef, dtype=float))
     s = np.abs(p) if scale is None else np.atleast_2d(np.asarray(scale, dtype=float))
@@ -290,6 +346,11 @@ def nonnegative_on_positive_axis(coef, scale=None, *, rtol: float = DISSIPATION_
     ends_bad = any_nz & ((p[rows, j0] < 0) | (p[rows, j1] < 0))
     out[finite & all_pos] = True
     rest = np.flatnonzero(finite & ~all_pos & ~ends_bad)
+    if rest.size:
+        # A certificate of p ≥ 0 settles most of the others without roots.
+        certified = _isolated_negatives_dominated(p[rest])
+        out[rest[certified]] = True
+        rest = rest[~certified]
     if rest.size == 0:
         return out
     # p'(x) = Σ_{j≥1} j p_j x^(j−1); trimmed to x^(j0−1) … x^(j1−1), a factor x^(j0−1) dropped.
@@ -297,6 +358,12 @@ def nonnegative_on_positive_axis(coef, scale=None, *, rtol: float = DISSIPATION_
         grp = rest[(j0[rest] == lo) & (j1[rest] == hi)]
         deriv = p[grp, lo:hi + 1] * np.arange(lo, hi + 1)  # ascending coefficients of p'/x^(lo-1)
         deg = hi - lo
+        if deg == 3 and grp.size >= CLOSED_FORM_MIN_ROWS:
+            ok, sure = _cubic_critical_check(p[grp], s[grp], deriv, rtol)
+            out[grp[sure]] = ok[sure]
+            grp, deriv = grp[~sure], deriv[~sure]
+            if grp.size == 0:
+                continue
         lead = deriv[:, -1:]
         comp = np.zeros((grp.size, deg, deg))
         comp[:, 0, :] = -(deriv[:, -2::-1] / lead)

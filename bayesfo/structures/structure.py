@@ -304,6 +304,9 @@ class Structure:
         springpots with exponents spanning less than 2; integer exponents; else the argument
         principle on the imaginary axis).
         """
+        if self.commensurate_order is not None:
+            ok = self._stable_polynomials(*self.polynomials(theta), kind)
+            return ok[0] if np.ndim(theta) != 2 else ok
         vals, single = self.values(theta)
         n_sets = np.atleast_2d(np.asarray(theta, float)).shape[0]
         ok = np.ones(n_sets, dtype=bool)
@@ -321,6 +324,25 @@ class Structure:
                                                rows.size)
                 ok[rows] = side_stable(coef, expo)
         return ok[0] if single else ok
+
+    def _stable_polynomials(self, den, num, q, kind: str) -> np.ndarray:
+        """:meth:`stable` of a commensurate structure from its polynomials
+        (:meth:`polynomials`): Matignon's theorem on each side that is not a constant, in one
+        call when both sides have the same degree."""
+        polys = [poly for poly, terms in ((den, self.denominator), (num, self.numerator))
+                 if _polynomial_order(terms) != ""
+                 and (terms is self.denominator or kind in ("compliance", "modulus"))]
+        n = q.shape[0]
+        if not polys:
+            return np.ones(n, dtype=bool)
+        if len(polys) == 2 and polys[0].shape[1] == polys[1].shape[1]:
+            both = matignon_stable(np.concatenate(polys), np.concatenate([q, q]),
+                                   allow_integrator=True)
+            return both[:n] & both[n:]
+        ok = np.ones(n, dtype=bool)
+        for poly in polys:
+            ok &= matignon_stable(poly, q, allow_integrator=True)
+        return ok
 
     def passive(self, theta, kind: str, omega_grid) -> np.ndarray:
         """Dissipation ≥ 0 of the response compared with ``kind`` data, at every ω > 0.
@@ -375,6 +397,13 @@ class Structure:
             ok |= sums
         return ok & np.all(np.isfinite(theta2), axis=1)
 
+    @property
+    def _exact_commensurate(self) -> bool:
+        """Commensurate of degree > 1, whose dissipation :meth:`passive` decides with
+        :func:`~bayesfo.structures.passivity.commensurate_passive`."""
+        return (self.commensurate_order is not None and not self._first_degree
+                and passivity.EXACT_COMMENSURATE)
+
     @cached_property
     def _first_degree(self) -> bool:
         """Commensurate with numerator and denominator of degree ≤ 1 in λ = s^q."""
@@ -408,6 +437,17 @@ class Structure:
             if isinstance(c, Inequality):
                 ok &= c.holds(vals)
         names = {c for c in self.constraints if isinstance(c, str)}
+        if "stable" in names and ok.any() and self._exact_commensurate:
+            # The polynomials once for both checks.
+            rows = np.flatnonzero(ok)
+            den, num, q = self.polynomials(theta[rows])
+            stable = self._stable_polynomials(den, num, q, kind)
+            ok[rows] = stable
+            if "passive" in names and kind != "generic" and stable.any():
+                keep = np.flatnonzero(stable)
+                ok[rows[keep]] = (commensurate_passive(den[keep], num[keep], q[keep])
+                                  & np.all(np.isfinite(theta[rows[keep]]), axis=1))
+            return ok
         if "stable" in names and ok.any():
             rows = np.flatnonzero(ok)
             ok[rows] = self.stable(theta[rows], kind)

@@ -290,6 +290,29 @@ def test_one_dead_worker_fails_only_its_data_set(tmp_path):
 
 
 # ---------------------------------------------------------------------- signals
+def _earlier_run(tmp_path) -> tuple[Path, dict]:
+    """An output directory holding (stand-ins for) an earlier run's files, and its tree."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text('{"structures": [{"name": "voigt"}]}')
+    (out / "voigt.nc").write_text("earlier")
+    return out, _tree(out)
+
+
+def _assert_one_line_end(stderr: str) -> None:
+    # Warnings of the run may come first; the end is one line, and no worker speaks.
+    lines = stderr.strip().splitlines()
+    assert all(line.startswith("bayesfo: ") for line in lines), stderr
+    assert lines[-1].endswith("(no output is left half-written)")
+
+
+def _has_loaded(proc, name: str) -> bool:
+    try:
+        return any(name in m.path for m in psutil.Process(proc.pid).memory_maps())
+    except psutil.Error:
+        return False
+
+
 def _cli(*args, cwd):
     env = dict(os.environ, MPLBACKEND="Agg")
     return subprocess.Popen([sys.executable, "-m", "bayesfo.cli", *map(str, args)], cwd=cwd,
@@ -317,11 +340,7 @@ def _workers(proc) -> list:
     (signal.SIGTERM, "writing", 143), (signal.SIGKILL, "writing", -9)])
 def test_a_signal_ends_compare_and_its_workers_leaving_the_earlier_output(
         tmp_path, sig, moment, status):
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "summary.json").write_text('{"structures": [{"name": "voigt"}]}')
-    (out / "voigt.nc").write_text("earlier")
-    before = _tree(out)
+    out, before = _earlier_run(tmp_path)
     proc = _cli("compare", ADHESIVE / "Tp020C.csv", "--structures", "voigt,zener",
                 "--workers", "2", "--out", out, "--quiet", cwd=tmp_path)
     if moment == "sampling":
@@ -336,11 +355,38 @@ def test_a_signal_ends_compare_and_its_workers_leaving_the_earlier_output(
     gone, alive = psutil.wait_procs(workers, timeout=5)
     assert not alive
     if sig != signal.SIGKILL:
-        # Warnings of the run may come first; the end is one line, and no worker speaks.
-        lines = stderr.strip().splitlines()
-        assert all(line.startswith("bayesfo: ") for line in lines), stderr
-        assert lines[-1].endswith("(no output is left half-written)")
+        _assert_one_line_end(stderr)
     outdir.recover(out)  # what the next run into the directory does first
+    assert _tree(out) == before
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+@pytest.mark.parametrize("moment", ["here", "workers"])
+def test_a_signal_ends_the_automatic_schedule_leaving_the_earlier_output(
+        tmp_path, sig, status, moment):
+    # The default schedule (--workers 0): quick posteriors in the command's own process, worker
+    # processes only for the long routes. The Maxwell's posterior takes the ladder (seconds): it
+    # starts the workers.
+    out, before = _earlier_run(tmp_path)
+    structures = "voigt,zener" if moment == "here" else "maxwell,voigt"
+    proc = _cli("compare", ADHESIVE / "Tp020C.csv", "--structures", structures, "--out", out,
+                "--quiet", "--no-figures", cwd=tmp_path)
+    if moment == "here":
+        # matplotlib's font library is loaded with arviz, which the noise screen imports: the
+        # command is computing in its own process.
+        _wait_for(lambda: _has_loaded(proc, "ft2font"))
+    else:
+        _wait_for(lambda: len(_workers(proc)) >= 1)
+        time.sleep(0.5)
+    assert proc.poll() is None, "the command ended before the signal"
+    workers = _workers(proc)
+    proc.send_signal(sig)
+    _, stderr = proc.communicate(timeout=15)
+    assert proc.returncode == status, stderr
+    _, alive = psutil.wait_procs(workers, timeout=5)
+    assert not alive
+    _assert_one_line_end(stderr)
+    outdir.recover(out)
     assert _tree(out) == before
 
 

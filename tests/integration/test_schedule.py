@@ -102,7 +102,10 @@ def test_a_pool_keeps_the_warnings_of_the_serial_path(noisy_sampler):
         + [("_conclude", s, None) for s in ("zener-int", "maxwell-int")])
 
 
-def test_an_input_error_in_a_step_ends_that_structure_alone(monkeypatch):
+@pytest.fixture
+def failing_steps(monkeypatch):
+    """zener-int's optimisation and maxwell-int's posterior under proportional noise raise an
+    InputError."""
     fit_structure, sample = run.fit_structure, run._sample
 
     def failing_fit(structure, *args, **kwargs):
@@ -117,6 +120,9 @@ def test_an_input_error_in_a_step_ends_that_structure_alone(monkeypatch):
 
     monkeypatch.setattr(run, "fit_structure", failing_fit)
     monkeypatch.setattr(run, "_sample", failing_sample)
+
+
+def test_an_input_error_in_a_step_ends_that_structure_alone(failing_steps):
     structures = BOTH + ",voigt-int"
     serial, _ = _compare(structures, workers=1)
     recorder = _Recorder()
@@ -191,21 +197,7 @@ def test_structures_without_the_promise_go_to_the_pool(monkeypatch, noisy_sample
                                            ("_sample_held", "maxwell-int", "proportional")]
 
 
-def test_an_input_error_ends_that_structure_alone_on_the_automatic_schedule(monkeypatch):
-    fit_structure, sample = run.fit_structure, run._sample
-
-    def failing_fit(structure, *args, **kwargs):
-        if structure.name == "zener-int":
-            raise InputError("no fit here")
-        return fit_structure(structure, *args, **kwargs)
-
-    def failing_sample(s, data, noise, fit, options):
-        if s.name == "maxwell-int" and noise == "proportional":
-            raise InputError("no posterior here")
-        return sample(s, data, noise, fit, options)
-
-    monkeypatch.setattr(run, "fit_structure", failing_fit)
-    monkeypatch.setattr(run, "_sample", failing_sample)
+def test_an_input_error_ends_that_structure_alone_on_the_automatic_schedule(failing_steps):
     auto, _ = _compare(BOTH + ",voigt-int", workers=0)
     assert auto["zener-int"].error == "no fit here"
     assert auto["maxwell-int"].error == "no posterior here"

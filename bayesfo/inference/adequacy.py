@@ -101,20 +101,19 @@ realized discrepancies. Statistica Sinica 6, 733–807.
 Bayarri, M. J., Berger, J. O. (2000). P values for composite null models. JASA 95, 1127–1142.
 Kulldorff, M. (1997). A spatial scan statistic. Commun. Statist. Theory Meth. 26, 1481–1496.
 
-This module is longer than the project's 500-line guide: the three statistics, their common
-posterior predictive reference, the noise-scale judgement and the verdict text are one check;
-the statistics alone are a third of it.
+The argument checks and the sentences of the verdict are in
+:mod:`bayesfo.inference._adequacy_parts`.
 """
 
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
+from . import _adequacy_parts as _parts
 from .likelihood import Likelihood
 from .results import PosteriorResult
 
@@ -407,7 +406,7 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
     >>> result.adequate, result.p_values["autocorrelation"]           # doctest: +SKIP
     (True, 0.41)
     """
-    _check_args(lik, post, seed, level, n_draws, n_reference, max_noise_scale)
+    _parts.check_args(lik, post, seed, level, n_draws, n_reference, max_noise_scale)
     rng = np.random.default_rng(seed)
     n = lik.g_scaled.size
     if n < 4:
@@ -480,7 +479,7 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
         bands = _bands(a_obs, b_obs, omega, crit, parts)
     systematic = tuple(float(w) for lo, hi, _ in bands for w in omega[(omega >= lo) & (omega <= hi)])
     systematic = tuple(sorted(set(systematic)))
-    reasons = _reasons(failed, p_values, statistics, n, bands, implausible, noise_scale,
+    reasons = _parts.reasons(failed, p_values, statistics, n, bands, implausible, noise_scale,
                        lik.noise, max_noise_scale)
     if reasons:
         reasons += (f"largest misfit of the posterior mode: {abs(phase_err[i_ph]):.1f}° in phase "
@@ -496,7 +495,7 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
     masked_ph = float(np.nanmax(np.abs(phase_err[dominated]), initial=0.0))
     masked_mag = float(np.nanmax(np.abs(mag_err[dominated]), initial=0.0))
     masked = bool(adequate and (masked_ph > SMALL_MISFIT[0] or masked_mag > SMALL_MISFIT[1]))
-    caution = (_masked_text(omega[dominated], n, max_noise_scale, masked_ph, masked_mag)
+    caution = (_parts.masked_text(omega[dominated], n, max_noise_scale, masked_ph, masked_mag)
                if masked else "")
     if adequate:
         summary = (f"{post.structure} describes the data: no discrepancy below the level "
@@ -522,46 +521,6 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
         misfit_masked=masked, masked_phase_error_deg=masked_ph,
         masked_log10_magnitude_error=masked_mag, caution=caution,
     )
-
-
-def _masked_text(omega, n: int, max_scale: float, phase_deg: float, log10_mag: float) -> str:
-    """The caution of a pass that rests on noise-dominated points (:attr:`Adequacy.misfit_masked`):
-    where they are, and by how much the posterior mode misses them."""
-    where = (f"ω = {omega.min():.3g}–{omega.max():.3g} rad/s" if omega.size > 1
-             else f"ω = {omega[0]:.3g} rad/s")
-    return (f"at {where} ({omega.size} of {n} points) the fitted noise exceeds "
-            f"{100 * max_scale:g} % of |G|, so the checks do not test the structure there, and "
-            f"its posterior mode misses those points by up to {phase_deg:.1f}° in phase and "
-            f"{100 * (10 ** log10_mag - 1):.0f} % in magnitude")
-
-
-def _check_args(lik, post, seed, level, n_draws, n_reference, max_noise_scale) -> None:
-    if not isinstance(lik, Likelihood):
-        raise InputError(f"argument 'lik' must be a Likelihood, got {type(lik).__name__}")
-    if not isinstance(post, PosteriorResult):
-        raise InputError(f"argument 'post' must be a PosteriorResult, got {type(post).__name__}")
-    if tuple(post.param_names) != tuple(lik.param_names):
-        raise InputError(
-            f"argument 'post' does not belong to 'lik': its parameters are "
-            f"{', '.join(post.param_names)}, the likelihood's {', '.join(lik.param_names)} "
-            f"(structure {lik.structure.name}, noise {lik.noise})")
-    samples = np.asarray(post.samples_scaled)
-    if samples.ndim != 2 or samples.shape[1] != lik.ndim or samples.shape[0] == 0:
-        raise InputError(f"argument 'post': samples_scaled must have shape (n_draws, {lik.ndim}), "
-                         f"got {samples.shape}")
-    for name, value, low in (("seed", seed, 0), ("n_draws", n_draws, 20),
-                             ("n_reference", n_reference, 1000)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-            raise InputError(f"argument '{name}' must be an integer, got {value!r}")
-        if value < low:
-            raise InputError(f"argument '{name}' must be at least {low}, got {value}")
-    for name, value, ok, what in (
-            ("level", level, lambda v: 0 < v <= 0.5, "in (0, 0.5]"),
-            ("max_noise_scale", max_noise_scale, lambda v: v > 0, "positive")):
-        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-            raise InputError(f"argument '{name}' must be a finite number, got {value!r}")
-        if not ok(value):
-            raise InputError(f"argument '{name}' must be {what}, got {value!r}")
 
 
 def _outside_band(g, y_rep, m_ref) -> np.ndarray:
@@ -613,35 +572,3 @@ def _bands(a_obs, b_obs, omega, crit: float, parts: bool = False) -> tuple:
             text = "the data's phase lies " + ("above" if value > 0 else "below") + " the fit's"
         bands.append((float(omega[lo]), float(omega[hi]), text))
     return tuple(bands)
-
-
-def _p_text(p: float) -> str:
-    return "p < 0.001" if p < 0.001 else f"p = {p:.3f}"
-
-
-def _band_text(bands) -> str:
-    return ", ".join(f"ω = {lo:.3g}–{hi:.3g} rad/s" for lo, hi, _ in bands)
-
-
-def _reasons(failed, p, stats, n, bands, implausible, noise_scale, noise,
-             max_scale) -> tuple[str, ...]:
-    out = []
-    where = _band_text(bands)
-    if "autocorrelation" in failed:
-        out.append(f"residuals are correlated along frequency (lag-1 autocorrelation "
-                   f"{stats['autocorrelation']:.2f}, {_p_text(p['autocorrelation'])}): the structure "
-                   f"misses the shape" + (f" at {where}" if where else ""))
-    if "scan" in failed:
-        lo, hi, text = bands[0]
-        out.append(f"{text} over ω = {lo:.3g}–{hi:.3g} rad/s more consistently than noise "
-                   f"allows (scan statistic {stats['scan']:.1f}, {_p_text(p['scan'])})")
-        out.extend(f"also {t} over ω = {lo:.3g}–{hi:.3g} rad/s" for lo, hi, t in bands[1:])
-    if "chi2" in failed:
-        out.append(f"residuals are larger than the noise model allows (Σ|r|²/σ² = "
-                   f"{stats['chi2']:.0f} for {n} points, expected about {n}; {_p_text(p['chi2'])})")
-    if implausible:
-        what = "σ_rel" if noise in ("proportional", "relative_parts") else "σ / median |G|"
-        out.append(f"the fitted noise scale is implausibly large ({what} = {noise_scale:.3g}, above "
-                   f"{max_scale:g}): the structure's misfit is being absorbed as noise"
-                   + (f", most clearly at {where}" if where and not failed else ""))
-    return tuple(out)

@@ -53,9 +53,6 @@ def check_formats(formats, argument: str = "argument 'formats'") -> tuple[str, .
     return formats
 
 
-_check_formats = check_formats
-
-
 def _combined_makers(comparison, seed: int) -> dict:
     """The figures drawn from the whole comparison, by name, in the order they are written."""
     makers = {
@@ -160,7 +157,7 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
     InputError
         If ``formats`` is empty or names a format matplotlib cannot write.
     """
-    formats = _check_formats(formats)
+    formats = check_formats(formats)
     out_dir = Path(out_dir)
     if pool is not None and getattr(pool, "started", True) is False:
         # A lazy pool that the comparison did not need: spawning processes now (each imports

@@ -81,7 +81,7 @@ def main(argv=None):
         with eigenvalues_only():
             slow = structure.constraints_hold(theta, kind, lik.grid)
         line = []
-        for n in (1, 100, 1000):
+        for n in (1, 50, 150, 1000):
             rows = theta[:n]
             reps = max(3, 2000 // n)
             t_fast, t_slow = [], []

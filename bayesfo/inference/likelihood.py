@@ -219,16 +219,23 @@ class Likelihood:
                 out = self._log_parts - np.log(s2) - rho2 / (2.0 * s2)
             out = out + self._unit_shift
             return np.where(np.isfinite(out), out, -np.inf)
-        r2 = np.abs(self.g_scaled - model) ** 2
+        # In place where the arrays are this call's own: the same arithmetic with fewer
+        # temporaries of shape (n_sets, n_freq).
+        own = model.flags.writeable and model.shape == (theta.shape[0], self.g_scaled.size)
+        r2 = np.abs(np.subtract(self.g_scaled, model, out=model) if own else self.g_scaled - model)
+        np.square(r2, out=r2)
         if self.noise == "known":
-            out = self._log_norm - r2 / self._var
+            r2 /= self._var
+            out = np.subtract(self._log_norm, r2, out=r2)
         else:
             s = theta[:, -1:]
             var = s * s if self.noise == "constant" else (s * s) * self._abs_g2
             with np.errstate(divide="ignore", invalid="ignore"):
-                out = -np.log(np.pi * var) - r2 / var
-        out = out + self._unit_shift
-        return np.where(np.isfinite(out), out, -np.inf)
+                out = -np.log(np.pi * var)
+                out = out - np.divide(r2, var, out=r2)
+        out += self._unit_shift
+        np.copyto(out, -np.inf, where=~np.isfinite(out))
+        return out
 
     def _relative_parts2(self, model) -> np.ndarray:
         """(ΔRe/Re g)² + (ΔIm/Im g)² per point, the summand of pyRheo's cost."""

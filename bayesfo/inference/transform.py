@@ -53,7 +53,8 @@ def _log_parts_fn(lik: Likelihood, tr: _Transform, *, constraints: bool = True):
         rows = np.flatnonzero(np.all((u >= tr.lo_u) & (u <= tr.hi_u), axis=1))
         if not rows.size:
             return log_prior, log_lik
-        theta = tr.to_theta(u[rows])
+        # All rows in the box (most calls): the points as they are, without a copy.
+        theta = tr.to_theta(u if rows.size == u.shape[0] else u[rows])
         if constraints:
             ok = lik.structure.constraints_hold(theta[:, :k], kind, grid)
             rows, theta = rows[ok], theta[ok]

@@ -102,7 +102,7 @@ class Structure:
         names = {p for t in self.numerator + self.denominator for p in t.exponent.params}
         return tuple(sorted(names))
 
-    @property
+    @cached_property
     def commensurate_order(self) -> str | None:
         """The name of q when numerator and denominator are polynomials in λ = s^q, else None."""
         p = _polynomial_order(self.numerator + self.denominator)
@@ -329,9 +329,9 @@ class Structure:
         """:meth:`stable` of a commensurate structure from its polynomials
         (:meth:`polynomials`): Matignon's theorem on each side that is not a constant, in one
         call when both sides have the same degree."""
-        polys = [poly for poly, terms in ((den, self.denominator), (num, self.numerator))
-                 if _polynomial_order(terms) != ""
-                 and (terms is self.denominator or kind in ("compliance", "modulus"))]
+        den_roots, num_roots = self._sides_with_roots
+        polys = ([den] if den_roots else []) + (
+            [num] if num_roots and kind in ("compliance", "modulus") else [])
         n = q.shape[0]
         if not polys:
             return np.ones(n, dtype=bool)
@@ -397,6 +397,20 @@ class Structure:
             ok |= sums
         return ok & np.all(np.isfinite(theta2), axis=1)
 
+    @cached_property
+    def _sides_with_roots(self) -> tuple[bool, bool]:
+        """Whether the denominator and the numerator are polynomials that are not constants."""
+        return (_polynomial_order(self.denominator) != "",
+                _polynomial_order(self.numerator) != "")
+
+    @cached_property
+    def _constraint_plan(self) -> tuple[tuple, frozenset]:
+        """The card's inequalities and the names of its other constraints (``stable``,
+        ``passive``), sorted once: :meth:`constraints_hold` runs thousands of times per
+        tempered ladder on batches of tens of rows, where its fixed cost counts."""
+        return (tuple(c for c in self.constraints if isinstance(c, Inequality)),
+                frozenset(c for c in self.constraints if isinstance(c, str)))
+
     @property
     def _exact_commensurate(self) -> bool:
         """Commensurate of degree > 1, whose dissipation :meth:`passive` decides with
@@ -432,15 +446,17 @@ class Structure:
         ranges; rows where ``where`` is false are skipped (returned false)."""
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         ok = np.ones(theta.shape[0], dtype=bool) if where is None else np.array(where, dtype=bool)
-        vals, _ = self.values(theta)
-        for c in self.constraints:
-            if isinstance(c, Inequality):
+        inequalities, names = self._constraint_plan
+        if inequalities:
+            vals, _ = self.values(theta)
+            for c in inequalities:
                 ok &= c.holds(vals)
-        names = {c for c in self.constraints if isinstance(c, str)}
-        if "stable" in names and ok.any() and self._exact_commensurate:
-            # The polynomials once for both checks.
+        elif theta.shape[1] != self.n_params:
+            self.values(theta)  # raises the error of a wrong shape
+        if "stable" in names and self._exact_commensurate and ok.any():
+            # The polynomials once for both checks (all rows: no copy of theta).
             rows = np.flatnonzero(ok)
-            den, num, q = self.polynomials(theta[rows])
+            den, num, q = self.polynomials(theta if rows.size == ok.size else theta[rows])
             stable = self._stable_polynomials(den, num, q, kind)
             ok[rows] = stable
             if "passive" in names and kind != "generic" and stable.any():

@@ -138,3 +138,18 @@ def test_constraints_hold_unchanged_by_the_shortcuts(monkeypatch, name):
     _eigen_only(monkeypatch)
     for kind, f in zip(kinds, fast):
         np.testing.assert_array_equal(f, s.constraints_hold(theta, kind))
+
+
+@pytest.mark.parametrize("size", [1, 31, 127, 128, 129, 400])
+def test_matignon_batch_size_does_not_change_decisions(monkeypatch, size):
+    # Batches below CLOSED_FORM_MIN_ROWS take the eigenvalues, larger ones the closed form:
+    # the same decisions either way.
+    rng = np.random.default_rng(size)
+    a, q = _cubic_cases(rng, 400)[5]
+    a = np.concatenate([a, rng.uniform(-100, 100, (400, 4))])
+    q = np.concatenate([q, rng.uniform(0.0, 1.0, 400)])
+    chunks = [response.matignon_stable(a[i:i + size], q[i:i + size], allow_integrator=True)
+              for i in range(0, len(a), size)]
+    _eigen_only(monkeypatch)
+    np.testing.assert_array_equal(np.concatenate(chunks),
+                                  response.matignon_stable(a, q, allow_integrator=True))

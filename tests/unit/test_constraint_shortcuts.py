@@ -101,6 +101,36 @@ def test_matignon_cubic_shortcut_makes_the_eigenvalue_decisions(monkeypatch):
         np.testing.assert_array_equal(f, response.matignon_stable(a, q))
 
 
+@pytest.mark.parametrize("degree", [2, 3, 4])
+def test_same_sign_certificate_makes_the_eigenvalue_decisions(monkeypatch, degree):
+    # Coefficients of one sign over 12 decades, some zero, with q spread over (0, 1.2) and
+    # packed at the certificate's edge 2/n; and 1 + λ^n, whose roots lie on the edge
+    # |arg λ| = π/n itself. Every row the certificate settles must be stable by the roots.
+    rng = np.random.default_rng(20 + degree)
+    n = 20_000
+    a = rng.uniform(0.0, 1.0, (n, degree + 1)) * 10.0 ** rng.uniform(-6, 6, (n, degree + 1))
+    a[rng.random((n, degree + 1)) < 0.1] = 0.0
+    a[:, 0] = np.where(a[:, 0] == 0, 1.0, a[:, 0])
+    a[: n // 2] *= rng.choice([-1.0, 1.0], (n // 2, 1))
+    edge = 2.0 / degree
+    q = np.concatenate([rng.uniform(0.0, 1.2, n // 2),
+                        np.minimum(edge * (1 + rng.choice([-1, 1], n // 2)
+                                           * 10.0 ** rng.uniform(-12, -3, n // 2)), 1.99)])
+    tip = np.zeros((4, degree + 1))
+    tip[:, 0] = tip[:, -1] = 1.0
+    a = np.concatenate([a, tip])
+    q = np.concatenate([q, edge * (1 - np.array([1e-3, 1e-9, 1e-12, 0.0]))])
+    c = a[:, 1:] / a[:, :1]
+    settled = response._same_sign_sector(c, q)
+    assert settled.mean() > 0.3 and not settled.all()
+    fast = response.matignon_stable(a, q)
+    assert np.all(fast[settled])
+    _eigen_only(monkeypatch)
+    monkeypatch.setattr(response, "_same_sign_sector",
+                        lambda c, q: np.zeros(c.shape[0], dtype=bool))
+    np.testing.assert_array_equal(fast, response.matignon_stable(a, q))
+
+
 def _touching(rng, n, k, eps):
     """x ((x − r)² + eps r²) e(x), e with positive coefficients: ≥ 0 iff eps ≥ 0 (up to the
     rounding tolerance 1e-12 of the check)."""

@@ -336,7 +336,9 @@ def excel_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
         __import__(engine)
     except ImportError:
         raise InputError(f"file '{path}': reading Excel workbooks needs the package {engine} "
-                         f"(pip install {engine}); or save the sheet as CSV or text") from None
+                         f"(pip install {engine}"
+                         + ("" if engine == "xlrd" else ", or pip install 'bayesfo[excel]'")
+                         + "); or save the sheet as CSV or text") from None
     try:
         book = pd.read_excel(path, sheet_name=None, header=None, dtype=object, engine=engine)
     except Exception as exc:  # noqa: BLE001 - any failure of the workbook library is bad input

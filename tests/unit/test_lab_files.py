@@ -349,7 +349,7 @@ def test_excel_without_openpyxl_says_what_to_install(tmp_path, monkeypatch):
     path = tmp_path / "a.xlsx"
     path.write_bytes(b"PK")
     with pytest.raises(InputError, match=r"a.xlsx': reading Excel workbooks needs the package "
-                                         r"openpyxl \(pip install openpyxl\)"):
+                                         r"openpyxl \(pip install openpyxl, or pip install 'bayesfo\[excel\]'\)"):
         read(path)
 
 

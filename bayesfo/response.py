@@ -292,7 +292,8 @@ def _same_sign_sector(c: np.ndarray, q: np.ndarray) -> np.ndarray:
 
     Such a polynomial has no root with |arg λ| < π/n: for λ = r e^{jθ}, 0 < |θ| < π/n, every
     sin kθ (k ≤ n) has the sign of θ, so Im A(λ) = Σ c_k r^k sin kθ ≠ 0, and A(r) ≥ 1 on the
-    positive axis. With qπ/2 < π/n every root then lies outside the sector. Exact for the
+    positive axis (a classical exclusion sector, e.g. A. Melman 2021). With qπ/2 < π/n every
+    root then lies outside the sector. Exact for the
     floating-point coefficients (the roots of the other routes are of the same ``c``). Measured
     on the rows of one tempered-ladder run on the G_spec set-up: it settles 41 % of max-n3m3's
     and 80 % of max-n2m2's, and takes ``matignon_stable`` over that run's calls from 1.40 to

@@ -6,12 +6,14 @@ Each round runs, one after the other (interleaved, so that a change of the machi
 touches all alike):
 
 - ``auto``: the default ``--workers 0`` (quick posteriors in the command's own process, worker
-  processes only for structures that need the long routes);
+  processes only for structures that need the long routes; the figures drawn in the command's
+  process and, when a CPU was idle during the comparison, in one forked from it), with
+  ``--no-figures``, with the figures in PNG alone (``--figure-formats png``) and with the
+  default PNG and PDF;
+- ``one process``: ``--workers 1``, PNG and PDF (everything, figures included, in the
+  command's process);
 - ``pool``: ``--workers 2`` (both structures in two worker processes, which also draw the
-  figures);
-
-each with ``--no-figures``, with the figures in PNG alone (``--figure-formats png``) and with
-the default PNG and PDF. dynesty (nlive 500, uniform sampling in bounding ellipsoids, evidence
+  figures), with ``--no-figures`` and with PNG and PDF. dynesty (nlive 500, uniform sampling in bounding ellipsoids, evidence
 only) runs once per structure, under the noise model the comparison chose. Prints the median
 and range of each, the ratio of the medians to dynesty's total, and the load average.
 
@@ -39,6 +41,7 @@ VARIANTS = {
     "auto, no figures": ["--no-figures"],
     "auto, PNG figures": ["--figure-formats", "png"],
     "auto, PNG+PDF figures": [],
+    "one process (--workers 1), PNG+PDF": ["--workers", "1"],
     "pool (--workers 2), no figures": ["--workers", "2", "--no-figures"],
     "pool (--workers 2), PNG+PDF figures": ["--workers", "2"],
 }
@@ -108,10 +111,10 @@ def main() -> None:
             total = args.skip_dynesty
     print(f"dynesty evidence alone, zener + voigt: {total:.1f} s"
           + (" (given)" if args.skip_dynesty is not None else ""))
-    print(f"{'variant':<38} {'median s':>9} {'min':>6} {'max':>6} {'ratio':>7}")
+    print(f"{'variant':<40} {'median s':>9} {'min':>6} {'max':>6} {'ratio':>7}")
     for k, v in times.items():
         med = float(np.median(v))
-        print(f"{k:<38} {med:>9.2f} {min(v):>6.2f} {max(v):>6.2f} {med / total:>7.3f}")
+        print(f"{k:<40} {med:>9.2f} {min(v):>6.2f} {max(v):>6.2f} {med / total:>7.3f}")
     print("load average after the CLI rounds " + " ".join(f"{x:.2f}" for x in load_mid)
           + ", at the end " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
 

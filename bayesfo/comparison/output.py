@@ -3,10 +3,12 @@ ranking.csv and summary.json, swapped in as one run (:mod:`bayesfo.outdir`)."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -51,8 +53,44 @@ def _finite(obj):
     return obj
 
 
+@contextlib.contextmanager
+def _without_distributed():
+    """Inside the block, dask's ``distributed`` cannot be imported unless it already was.
+
+    xarray's ``to_netcdf`` asks dask which scheduler is active, and dask imports ``distributed``
+    (when installed) to look for a ``Client`` (about 0.2 s on a quiet machine, 1 s on a busy
+    one, in every command that writes NetCDF). A ``Client`` cannot exist in a process that never
+    imported the package, so the answer is the same without it: the import fails at once
+    (``sys.modules`` entries ``None``) and xarray takes the scheduler for a local one. A process
+    that has imported it (a batch on a Dask cluster) is left alone.
+    """
+    names = ("distributed", "dask.distributed")
+    if any(n in sys.modules for n in names):
+        yield
+        return
+    for n in names:
+        sys.modules[n] = None
+    try:
+        yield
+    finally:
+        for n in names:
+            if n in sys.modules and sys.modules[n] is None:
+                del sys.modules[n]
+
+
+def _write_netcdf(comparison: Comparison, stage: Path) -> dict[str, Path]:
+    """One NetCDF per structure with a posterior, into ``stage``."""
+    written = {}
+    with _without_distributed():
+        for r in comparison.results:
+            if r.posterior is not None:
+                written[r.name] = save_netcdf(netcdf_for(comparison, r), stage / f"{r.name}.nc")
+    return written
+
+
 def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
-                  formats=("png", "pdf"), pool=None) -> dict[str, Path]:
+                  formats=("png", "pdf"), pool=None, figure_processes: int = 1
+                  ) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
     One NetCDF per structure (arviz InferenceData with the attributes that :func:`load` needs,
@@ -79,6 +117,10 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         Draw the figures in these worker processes (from :func:`process_pool`; a
         :class:`~bayesfo.parallel.LazyPool` whose processes were not started is not started
         for them: the figures are then drawn in this process).
+    figure_processes : int
+        Without a pool (or with a lazy pool not started): 2 draws the figures in this process
+        and in one forked from it, which starts drawing while this one writes the NetCDF files
+        (:func:`bayesfo.plotting.output.draw_forked`); 1 draws them here.
 
     Returns
     -------
@@ -88,17 +130,19 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     out_dir = Path(out_dir)
     written = {}
     with staged_run(out_dir) as stage:
-        for r in comparison.results:
-            if r.posterior is not None:
-                written[r.name] = save_netcdf(netcdf_for(comparison, r), stage / f"{r.name}.nc")
         if figures:
             from ..plotting import write_figures
             from ..report import write_report
 
+            # The NetCDF files are written while a forked process already draws.
             drawn = write_figures(comparison, stage / "figures", formats=formats,
-                                  seed=comparison.seed, pool=pool)
+                                  seed=comparison.seed, pool=pool, processes=figure_processes,
+                                  meanwhile=lambda: written.update(_write_netcdf(comparison,
+                                                                                 stage)))
             written.update(drawn)
             written["report.html"] = write_report(comparison, stage, drawn)
+        else:
+            written.update(_write_netcdf(comparison, stage))
         written["ranking.csv"] = atomic_write_text(stage / "ranking.csv", ranking_csv(comparison))
         text = json.dumps(_finite(comparison.to_summary()), indent=2, default=_json_default,
                           allow_nan=False)

@@ -145,6 +145,10 @@ def prior_range(prior: dict, samples: np.ndarray) -> tuple[float, float]:
     return lo - pad, hi + pad
 
 
+#: Bandwidths beyond the outermost draws where :func:`density_1d` takes a kernel density as 0.
+KDE_REACH = 10.0
+
+
 def density_1d(samples: np.ndarray, lo: float, hi: float, n_grid: int = 400):
     """Kernel density of ``samples`` on [lo, hi], reflected at both ends so that it integrates
     to one over the interval.
@@ -172,9 +176,16 @@ def density_1d(samples: np.ndarray, lo: float, hi: float, n_grid: int = 400):
     bw = float(np.sqrt(kde.covariance[0, 0]))
     fine = np.linspace(max(lo, x.min() - 4 * bw), min(hi, x.max() + 4 * bw), n_grid)
     grid = np.unique(np.concatenate([np.linspace(lo, hi, n_grid), fine]))
-    dens = kde(grid)
-    # Reflection keeps the mass that a kernel puts beyond a hard prior bound.
-    dens = dens + kde(2 * lo - grid) + kde(2 * hi - grid)
+    # Reflection keeps the mass that a kernel puts beyond a hard prior bound. Points farther
+    # than KDE_REACH bandwidths from every draw get 0: each kernel is below exp(-50) of its
+    # peak there. A narrow posterior on a wide prior leaves most of the even grid and of its
+    # reflections there (the q figure of two structures: 0.34 s → 0.06 s of kernel sums).
+    points = np.concatenate([grid, 2 * lo - grid, 2 * hi - grid])
+    near = (points >= x.min() - KDE_REACH * bw) & (points <= x.max() + KDE_REACH * bw)
+    values = np.zeros(points.size)
+    if near.any():
+        values[near] = kde(points[near])
+    dens = values.reshape(3, grid.size).sum(axis=0)
     return grid, dens
 
 

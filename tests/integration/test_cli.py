@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -171,3 +172,110 @@ def test_a_compare_that_fails_leaves_no_output_directory(run_cli, tmp_path, monk
     (tmp_path / "bayesfo-Tp020C").mkdir()
     status, _, _ = run_cli("compare", ADHESIVE, "--no-figures", *argv)
     assert status == 2 and (tmp_path / "bayesfo-Tp020C").is_dir()
+
+
+_TWO_PROCESS_CLI = """
+import sys
+from pathlib import Path
+import bayesfo.cli.compare as cli_compare
+import bayesfo.plotting.output as output
+from bayesfo.cli import main
+
+marker = Path(sys.argv[1])
+cli_compare._figure_processes = lambda since: 2  # as if a CPU were idle
+draw_in_child = output._draw_in_child
+
+def child(*args):
+    marker.write_text("ran")
+    draw_in_child(*args)
+
+output._draw_in_child = child
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_compare_draws_in_two_processes_the_files_of_one(run_cli, tmp_path):
+    """With a spare CPU, the default schedule draws the figures here and in a process forked
+    from this one; the files are those of one process. The two-process command runs in a
+    fresh interpreter: in the test process other threads (e.g. a Dask client's) may be left
+    running, and then no fork is made (:func:`bayesfo.plotting.output.can_fork`)."""
+    import subprocess
+    import sys
+
+    marker = tmp_path / "child-ran"
+    outs = {w: tmp_path / f"w{w}" for w in ("1", "0")}
+    common = ["compare", str(ADHESIVE), "--structures", "voigt", "--figure-formats", "png",
+              "--quiet"]
+    status, _, err = run_cli(*common, "--out", outs["1"], "--workers", "1")
+    assert status == 0, err
+    done = subprocess.run([sys.executable, "-W", "ignore", "-c", _TWO_PROCESS_CLI, str(marker),
+                           *common, "--out", str(outs["0"]), "--workers", "0"],
+                          capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert done.returncode == 0, done.stderr
+    assert marker.read_text() == "ran"
+    one, two = (sorted((o / "figures").iterdir()) for o in (outs["1"], outs["0"]))
+    assert [p.name for p in one] == [p.name for p in two]
+    assert all(a.read_bytes() == b.read_bytes() for a, b in zip(one, two))
+    assert (outs["1"] / "summary.json").read_text() == (outs["0"] / "summary.json").read_text()
+
+
+def test_figures_in_two_processes_only_with_a_spare_cpu(monkeypatch):
+    import time
+
+    import bayesfo.cli.compare as cli_compare
+    import bayesfo.parallel
+
+    since = cli_compare._cpu_times()
+    assert since is not None and 0 < since[0] <= since[1]  # Linux: /proc/stat
+    time.sleep(0.2)
+    idle = cli_compare._idle_cpus(since)
+    assert idle is not None and 0.0 <= idle <= os.cpu_count()
+    assert cli_compare._idle_cpus(None) is None
+    monkeypatch.setattr(bayesfo.parallel, "available_cpus", lambda: 2)
+    for idle, expected in [(0.2, 1), (0.49, 1), (0.5, 2), (1.6, 2), (None, 1)]:
+        monkeypatch.setattr(cli_compare, "_idle_cpus", lambda since, idle=idle: idle)
+        assert cli_compare._figure_processes(since) == expected, idle
+    monkeypatch.setattr(bayesfo.parallel, "available_cpus", lambda: 1)
+    assert cli_compare._figure_processes(since) == 1
+
+
+def test_writing_the_netcdf_files_does_not_import_dask_distributed(tmp_path):
+    """xarray's to_netcdf asks dask for its scheduler, which imports distributed (a second on
+    a busy machine); a process without it has no distributed client, so it is not needed."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    done = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "bayesfo.cli", "compare", str(ADHESIVE),
+         "--structures", "voigt", "--out", str(out), "--no-figures", "--quiet"],
+        capture_output=True, text=True, env=dict(os.environ, MPLBACKEND="Agg"))
+    assert done.returncode == 0, done.stderr
+    imported = {line.rsplit("|", 1)[-1].strip() for line in done.stderr.splitlines()
+                if line.startswith("import time:")}
+    assert "xarray" in imported and (out / "voigt.nc").is_file()
+    # importtime lists the refused attempt too (a few microseconds); the package's modules
+    # are not loaded.
+    assert not [m for m in imported if m.startswith("distributed.")]
+
+
+def test_distributed_stays_importable_around_the_netcdf_writes(monkeypatch):
+    import sys
+    import types
+
+    from bayesfo.comparison.output import _without_distributed
+
+    for name in ("distributed", "dask.distributed"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    with _without_distributed():
+        with pytest.raises(ImportError):
+            import distributed  # noqa: F401
+    assert "distributed" not in sys.modules and "dask.distributed" not in sys.modules
+    # A process that has imported it (a batch on a Dask cluster) keeps it.
+    loaded = types.ModuleType("distributed")
+    monkeypatch.setitem(sys.modules, "distributed", loaded)
+    with _without_distributed():
+        import distributed
+    assert distributed is loaded

@@ -421,3 +421,81 @@ def test_write_figures_in_worker_processes_gives_the_same_files(comparison, tmp_
     for name, paths in serial.items():
         # Agg renders the same pixels in any process: the figures are the same figures.
         assert pooled[name][0].read_bytes() == paths[0].read_bytes(), name
+
+
+def _mark_child(monkeypatch, marker, fail: bool = False):
+    """Make the forked figure process leave ``marker`` (and, with ``fail``, fail at its first
+    figure): the wrapper runs in the child, which the test cannot see otherwise."""
+    import bayesfo.plotting.output as output
+
+    draw_in_child = output._draw_in_child
+
+    def child(*args):
+        marker.write_text("ran")
+        if fail:
+            def broken(*a, **k):
+                raise RuntimeError("the forked process fails")
+
+            output._save_all = broken  # in the child only
+        draw_in_child(*args)
+
+    monkeypatch.setattr(output, "_draw_in_child", child)
+
+
+@pytest.mark.parametrize("child_fails", [False, True])
+def test_write_figures_in_two_processes_gives_the_files_of_one(comparison, tmp_path,
+                                                               monkeypatch, child_fails):
+    """Two processes (this one and one forked from it) write the files that one writes; if the
+    forked one fails, this one draws what it had taken."""
+    from bayesfo.plotting.output import can_fork
+
+    if not can_fork():
+        pytest.skip("another thread runs in this process: no fork")
+    marker = tmp_path / "child-ran"
+    _mark_child(monkeypatch, marker, fail=child_fails)
+    serial = write_figures(comparison, tmp_path / "serial", formats=("png",))
+    steps = []
+    two = write_figures(comparison, tmp_path / "two", formats=("png",), processes=2,
+                        meanwhile=lambda: steps.append("meanwhile"))
+    assert marker.read_text() == "ran" and steps == ["meanwhile"]
+    assert list(two) == list(serial)
+    for name, paths in serial.items():
+        assert two[name] == [tmp_path / "two" / f"{name}.png"]
+        assert two[name][0].read_bytes() == paths[0].read_bytes(), name
+    assert sorted(p.name for p in (tmp_path / "two").iterdir()) == \
+        sorted(p.name for p in (tmp_path / "serial").iterdir())
+    with pytest.raises(InputError, match="'processes' must be 1 or 2"):
+        write_figures(comparison, tmp_path / "three", formats=("png",), processes=3)
+
+
+def test_figures_are_handed_out_costliest_first(comparison):
+    from bayesfo.plotting.output import _draw_order, figure_jobs
+
+    names = [n for n, _ in figure_jobs(comparison)]
+    order = _draw_order(comparison, names)
+    assert sorted(order) == sorted(names)
+    corners = [n for n in order if n.startswith("corner_")]
+    assert order[: len(corners)] == corners
+    sizes = [comparison[n[len("corner_"):]].structure.n_params for n in corners]
+    assert sizes == sorted(sizes, reverse=True)
+    assert order.index("q_posteriors") < order.index("bode") < order.index("nyquist")
+    assert all(order.index(n) > order.index("residuals") for n in order if n.startswith("trace_"))
+
+
+@pytest.mark.parametrize("draws", ["narrow", "at the bound", "spread"])
+def test_density_1d_equals_the_reflected_kernel_sum_everywhere(draws):
+    """Points far from every draw are taken as 0 instead of summing kernels there: the density
+    is the full reflected kernel sum to 1e-12 of its peak."""
+    from scipy import stats
+
+    from bayesfo.plotting._compute import density_1d
+
+    rng = np.random.default_rng(3)
+    x = {"narrow": 0.568 + 0.002 * rng.standard_normal(2000),
+         "at the bound": 0.01 * rng.standard_exponential(2000),
+         "spread": rng.beta(0.5, 0.5, 1500)}[draws]
+    grid, dens = density_1d(x, 0.0, 1.0)
+    kde = stats.gaussian_kde(x)
+    full = kde(grid) + kde(-grid) + kde(2.0 - grid)
+    assert np.max(np.abs(dens - full)) <= 1e-12 * full.max()
+    assert trapezoid(dens, grid) == pytest.approx(1.0, abs=2e-3)

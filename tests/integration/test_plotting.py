@@ -499,3 +499,33 @@ def test_density_1d_equals_the_reflected_kernel_sum_everywhere(draws):
     full = kde(grid) + kde(-grid) + kde(2.0 - grid)
     assert np.max(np.abs(dens - full)) <= 1e-12 * full.max()
     assert trapezoid(dens, grid) == pytest.approx(1.0, abs=2e-3)
+
+
+@pytest.mark.parametrize("names, columns", [
+    (["voigt", "zener", "maxwell"], 3),
+    (["maxwell (misfits)", "fractional_zener_sl (misfits)", "fractional_maxwell_gel (misfits)",
+      "fractional_maxwell_liquid (misfits)", "fractional_kelvin_voigt (misfits)"], None),
+])
+def test_the_response_legend_stays_inside_the_figure(names, columns):
+    """Long structure names take fewer legend columns instead of running past the figure's
+    edges (three columns of them were cut at both sides); short ones keep three."""
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    from bayesfo.plotting._base import new_figure
+    from bayesfo.plotting.response import _legend
+    from bayesfo.plotting.style import COLUMN_WIDTH, style
+
+    with style():
+        fig = new_figure(None, (COLUMN_WIDTH, 4.0))
+        fig.subplots(2, 1, sharex=True)
+        labels = [*names, "data"]
+        legend = _legend(fig, [Line2D([], []) for _ in labels], labels)
+        fig.canvas.draw()
+        box = legend.get_window_extent()
+        assert 0 <= box.x0 and box.x1 <= fig.bbox.width, (box, fig.bbox)
+        if columns is not None:
+            assert legend._ncols == columns
+        else:
+            assert legend._ncols < 3
+        plt.close(fig)

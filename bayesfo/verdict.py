@@ -21,7 +21,6 @@ import math
 EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
                   (5.0, "strong"), (math.inf, "very strong"))
 CRITERIA_NAMES = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
-ORDER_PARAMS = ("q", "beta")
 HDI_PERCENT = 94
 
 def _finite(x) -> bool:
@@ -51,8 +50,9 @@ def _strength(d: float) -> str:
 
 
 def _order(result):
-    names = result.posterior.param_names
-    p = next((n for n in ORDER_PARAMS if n in names), None)
+    from .comparison.table import order_parameter
+
+    p = order_parameter(result.posterior.param_names)
     return p, (result.posterior.summary.get(p) if p else None)
 
 

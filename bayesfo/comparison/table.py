@@ -9,11 +9,17 @@ import math
 
 from .parameters import physical_text
 
+#: The parameters that name a structure's fractional order, in order of preference: the
+#: commensurate order ``q``; ``beta`` (the generalised Maxwell model's order; the lower order
+#: of two springpots in parallel); ``alpha`` (the one springpot of the fractional Maxwell gel
+#: and liquid, the Zener solid–liquid and the springpot itself).
+ORDER_PARAMS = ("q", "beta", "alpha")
+
 
 def order_parameter(parameters) -> str | None:
-    """The name of the fractional order among ``parameters`` (names or a dict by name): ``q``,
-    else ``beta`` (the generalised Maxwell model), else None."""
-    return next((k for k in ("q", "beta") if k in parameters), None)
+    """The name of the fractional order among ``parameters`` (names or a dict by name), the
+    first of :data:`ORDER_PARAMS` present, else None."""
+    return next((k for k in ORDER_PARAMS if k in parameters), None)
 
 
 def _finite_or_none(value) -> bool:

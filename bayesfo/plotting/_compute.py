@@ -21,8 +21,6 @@ N_GRID = 300
 DEFAULT_N_STRUCTURES = 3
 #: Quantiles of the bands: 90 % (5–95 %) and 50 % (25–75 %) central intervals and the median.
 BAND_PROBS = (0.05, 0.25, 0.5, 0.75, 0.95)
-#: Names of the fractional order, in order of preference (``beta`` for the Maxwell model).
-ORDER_PARAMS = ("q", "beta")
 
 
 def ok_results(comparison) -> list:
@@ -113,10 +111,12 @@ def quantiles(values: np.ndarray, probs=BAND_PROBS) -> dict[float, np.ndarray]:
 
 
 def order_parameter(result) -> str | None:
-    """Name of the free fractional order of a structure (``q`` or ``beta``), else None."""
+    """Name of the free fractional order of a structure
+    (:func:`bayesfo.comparison.table.order_parameter`), else None."""
+    from ..comparison.table import order_parameter as from_names
+
     post = result.posterior
-    names = post.param_names if post is not None else result.structure.param_names
-    return next((n for n in ORDER_PARAMS if n in names), None)
+    return from_names(post.param_names if post is not None else result.structure.param_names)
 
 
 def prior_density(prior: dict, x: np.ndarray) -> np.ndarray:

@@ -422,8 +422,10 @@ OUTLINE_FLOOR = 2e-3
 def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Drawn:
     """Posterior density of the fractional order of every structure, one ridge per structure.
 
-    Structures are ordered as in the ranking (best on top); the order is ``q``, or ``beta`` for
-    the generalised Maxwell model; structures without a free order (``-int``) are left out. Each
+    Structures are ordered as in the ranking (best on top); the order is ``q``, else ``beta``
+    (the generalised Maxwell model), else ``alpha`` (the springpot models with one order; see
+    :func:`bayesfo.comparison.table.order_parameter`), named beside the structure; structures
+    without a free order (``-int``) are left out. Each
     ridge is a kernel density of the draws, reflected at the prior bounds, scaled to its own
     peak; the dashed line is the prior density on the same scale, so a ridge that is no higher
     than its prior line is as uncertain as the prior. The bar under a ridge is the 94 % HDI
@@ -465,7 +467,8 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     results = [(r, order_parameter(r)) for r in ok_results(comparison)]
     results = [(r, p) for r, p in results if p is not None]
     if not results:
-        raise InputError("no structure of the comparison has a free fractional order (q or beta)")
+        raise InputError("no structure of the comparison has a free fractional order "
+                         "(q, beta or alpha)")
     styles = comparison_styles(comparison)
     n = len(results)
     values, artists = {"structures": np.array([r.name for r, _ in results])}, {}
@@ -510,7 +513,7 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
                                                   lw=2.6, solid_capstyle="butt", zorder=3 + i)
             ax.plot([s.mean, s.mean], [base - 0.1, base + 0.1], color="black", lw=0.9,
                     zorder=3 + i)
-            sym = "q" if p == "q" else r"\beta"
+            sym = _ORDER_SYMBOLS.get(p, p)
             digits = _hdi_digits(s.hdi_high - s.hdi_low)
             label = (f"${sym}$ = {s.mean:.3g} ± {s.sd:.2g}\n"
                      f"HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}")
@@ -526,15 +529,21 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
                 insets.append(_zoom_inset(ax, r.name, s, grid, dens, pd, base, c,
                                           (x_lo, x_hi), ridge_height, values, artists))
         ax.set_yticks([n - 1 - i for i in range(n)],
-                      [r.name if p == "q" else f"{r.name} (β)" for r, p in results])
+                      [r.name if p == "q" else f"{r.name} (${_ORDER_SYMBOLS.get(p, p)}$)"
+                       for r, p in results])
         ax.set_ylim(-0.35, n - 1 + ridge_height + 0.25)
         ax.set_xlim(x_lo, x_hi)
         ax.grid(axis="y", visible=False)
-        ax.set_xlabel("fractional order $q$" + (r" ($\beta$ for maxwell)"
-                                                if any(p == "beta" for _, p in results) else "")
+        others = sorted({p for _, p in results if p != "q"}, key=list(_ORDER_SYMBOLS).index)
+        ax.set_xlabel("fractional order" + (" $q$" if any(p == "q" for _, p in results) else "")
+                      + (" (" + ", ".join(f"${_ORDER_SYMBOLS[p]}$" for p in others)
+                         + " where named)" if others else "")
                       + f"\nbar: {HDI_LABEL}, tick: mean; dashed: prior")
     return Drawn.build(fig, (ax, *insets), values, artists)
 
+
+#: Symbols of the fractional orders (:data:`bayesfo.comparison.table.ORDER_PARAMS`).
+_ORDER_SYMBOLS = {"q": "q", "beta": r"\beta", "alpha": r"\alpha"}
 
 #: The posterior's highest-density interval in the labels (as the summaries).
 HDI_LABEL = "94 % HDI"
@@ -583,7 +592,7 @@ def _zoom_inset(ax, name, s, grid, dens, pd, base, color, span, ridge_height, va
     inset.set_xlim(z_lo, z_hi)
     inset.set_ylim(-0.12, 1.08)
     inset.set_yticks([])
-    inset.xaxis.set_major_locator(MaxNLocator(nbins=3))
+    inset.xaxis.set_major_locator(MaxNLocator(nbins=2))
     inset.tick_params(axis="x", labelsize=5.5, length=2, pad=1)
     inset.grid(False)
     inset.patch.set_alpha(0.9)

@@ -495,3 +495,25 @@ def test_an_alias_naming_a_picture_reports_that_picture():
         resolve_structures("zener,fpt")
     with pytest.raises(StructureError, match="has no picture"):
         zener.with_picture("burgers")
+
+
+def test_every_fractional_structure_reports_an_order():
+    # The ranking's q column, the q-posterior figure and the verdict take the structure's
+    # order from order_parameter: each structure with a free exponent names one of its
+    # exponents (the springpot models' alpha too, which had no order reported before).
+    from bayesfo.comparison.table import order_parameter
+
+    lib = default_library()
+    with_exponent = 0
+    for s in lib.values():
+        exponents = [p.name for p in s.parameters if p.role == "exponent"]
+        name = order_parameter(s.param_names)
+        if exponents:
+            with_exponent += 1
+            assert name in exponents, (s.name, exponents, name)
+        else:
+            assert name is None, (s.name, name)
+    assert with_exponent >= 12
+    assert order_parameter(get_structure("fractional_maxwell_gel").param_names) == "alpha"
+    assert order_parameter(get_structure("maxwell").param_names) == "beta"
+    assert order_parameter(get_structure("max-n2m1").param_names) == "q"

@@ -104,6 +104,20 @@ def _compare(data, structures, out, n_proc, workers, formats, no_figures, option
     return result
 
 
+def _units_note(path, kind: str) -> str:
+    """What a run on data without units says: the parameters are in the data's own unit."""
+    if kind == "compliance":
+        symbol, how = "[J]", ("give the response columns a unit in brackets (e.g. \"J' [1/Pa]\", "
+                              "in the header or with --columns), or add a '# units: 1/Pa' line "
+                              "to a bayesfo CSV")
+    else:
+        symbol, how = "[G]", ("give both columns a unit, e.g. --columns storage=\"Storage "
+                              "Modulus [Pa]\",loss=\"Loss Modulus [Pa]\" (with the file's "
+                              "headers), or add a '# units: Pa' line to a bayesfo CSV")
+    return (f"bayesfo: note: '{path}' gives no unit for the response, so the parameters are in "
+            f"the data's own unit ({symbol} in the table and report); to name it, {how}")
+
+
 def _num(x, fmt: str = ".2f") -> str:
     """A number for the terminal table; '-' for one that is undefined (its reason is among
     the warnings)."""
@@ -151,6 +165,8 @@ def run(args) -> int:
                 out.rmdir()
         raise
     if not args.quiet:
+        if not data.units:
+            print(_units_note(args.data, data.kind), file=sys.stderr)
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
         print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "

@@ -279,3 +279,15 @@ def test_distributed_stays_importable_around_the_netcdf_writes(monkeypatch):
     with _without_distributed():
         import distributed
     assert distributed is loaded
+
+
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_compare_without_units_says_how_to_name_them(run_cli, gspec_csv, tmp_path):
+    status, _, err = run_cli("compare", gspec_csv, "--structures", "voigt", "--no-figures",
+                             "--out", tmp_path / "o1")
+    assert status == 0, err
+    assert "gives no unit for the response" in err and "[J]" in err and "# units: 1/Pa" in err
+    status, _, err = run_cli("compare", ADHESIVE, "--structures", "voigt", "--no-figures",
+                             "--out", tmp_path / "o2")
+    assert status == 0, err
+    assert "no unit" not in err

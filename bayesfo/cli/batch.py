@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from ..batch import OK, BatchResult, expand_inputs, run_batch
 from ..options import (
@@ -105,7 +106,15 @@ def _print_table(result: BatchResult) -> None:
             f"{best['q_mean']:.3f} [{best['q_hdi_low']:.3f}, {best['q_hdi_high']:.3f}]")
         flags = "reused" if o.reused else "ok"
         if not best.get("converged"):
-            flags += ", not converged"
+            # The report says what to do (more steps, another prior); name it, and the best
+            # structure whose posterior is certified.
+            ranked = sorted((r for r in o.rows if r.get("rank") is not None),
+                            key=lambda r: r["rank"])
+            certified = next((r["structure"] for r in ranked if r.get("converged")), None)
+            report = "report.html" if (Path(result.out_dir) / o.dataset.id
+                                       / "report.html").exists() else "summary.json"
+            flags += (", not converged" + (f" (best certified: {certified})" if certified else "")
+                      + f"; see {o.dataset.id}/{report}")
         print(f"{o.dataset.id:<{width}} {t:>7}  {best['structure']:<14} "
               f"{'-' if p is None else f'{p:.3f}':>6}  {q:<26} {flags}")
 

@@ -478,3 +478,28 @@ def test_batch_figure_orders_isotherms_by_temperature():
     ax_q = fig.axes[1]
     assert [t.get_text() for t in ax_q.get_xticklabels()] == ["Tm040C", "Tm010C", "Tp020C"]
     plt.close(fig)
+
+
+def test_batch_table_points_to_the_report_when_the_best_is_not_certified(capsys, tmp_path):
+    # The best structure by evidence whose posterior is not certified: the status names the
+    # best certified one and the data set's report (which says what to do), as the report does.
+    from types import SimpleNamespace
+
+    from bayesfo.batch.task import OK
+    from bayesfo.cli.batch import _print_table
+
+    rows = [{"structure": "zener", "rank": 1, "best": True, "converged": False,
+             "posterior_probability": 0.9, "q_mean": None},
+            {"structure": "maxwell", "rank": 3, "best": False, "converged": True},
+            {"structure": "voigt", "rank": 2, "best": False, "converged": True}]
+    outcome = SimpleNamespace(dataset=SimpleNamespace(id="Tp017p85C", temperature=17.85),
+                              status=OK, rows=rows, reused=False)
+    _print_table(SimpleNamespace(outcomes=[outcome], out_dir=tmp_path))
+    line = capsys.readouterr().out.splitlines()[1]
+    assert "zener" in line  # without figures there is no report
+    assert line.endswith("ok, not converged (best certified: voigt); see Tp017p85C/summary.json")
+    (tmp_path / "Tp017p85C").mkdir()
+    (tmp_path / "Tp017p85C" / "report.html").write_text("<html></html>")
+    _print_table(SimpleNamespace(outcomes=[outcome], out_dir=tmp_path))
+    line = capsys.readouterr().out.splitlines()[1]
+    assert line.endswith("ok, not converged (best certified: voigt); see Tp017p85C/report.html")

@@ -165,10 +165,12 @@ _NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?
 _NON_FINITE = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
 
 
-def show(text: str, limit: int = 40) -> str:
-    """``text`` quoted for a one-line message: invisible and non-ASCII characters escaped,
-    long text shortened (with its length)."""
-    shown = text if text.isascii() and text.isprintable() else ascii(text)[1:-1]
+def show(text: str, limit: int = 40, *, ascii_only: bool = True) -> str:
+    """``text`` quoted for a one-line message: invisible and (with ``ascii_only``, for cells
+    of a data file, where a look-alike letter such as a Cyrillic е in 1.2е5 would hide) non-ASCII
+    characters escaped, long text shortened (with its length)."""
+    plain = text.isprintable() and (text.isascii() or not ascii_only)
+    shown = text if plain else ascii(text)[1:-1]
     if len(shown) > limit:
         shown = f"{shown[:limit]}... ({len(text)} characters)"
     return f"'{shown}'"

@@ -12,6 +12,7 @@ set passes the checks and limits of the contract reader. Every choice is recorde
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -140,9 +141,24 @@ def select(sets: list[Isotherm], block: int | str, where: str) -> Isotherm:
         return sets[k - 1]
     hits = [s for s in sets if s.label.lower() == str(block).strip().lower()]
     if not hits:
-        raise InputError(f"{where}: no data set {show(str(block))}; the file holds "
-                         f"{_summary(sets)}")
+        # A temperature ("20 °C", "20C", "-40.0 °C") names the data set at that temperature.
+        match = _TEMPERATURE.fullmatch(str(block).strip())
+        if match:
+            hits = [s for s in sets if s.temperature is not None
+                    and abs(s.temperature - float(match[1])) < 1e-6]
+            if len(hits) > 1:
+                raise InputError(f"{where}: {len(hits)} data sets are at "
+                                 f"{show(str(block), ascii_only=False)}; the file holds "
+                                 f"{_summary(sets)}; give the number (--block N, N from 1)")
+    if not hits:
+        raise InputError(f"{where}: no data set {show(str(block), ascii_only=False)}; the file "
+                         f"holds {_summary(sets)}; give the number (--block N, N from 1), the "
+                         "label or the temperature (e.g. '20 °C')")
     return hits[0]
+
+
+#: A block given as a temperature in °C (:func:`select`).
+_TEMPERATURE = re.compile(r"([+-]?[0-9]+(?:\.[0-9]*)?)\s*(?:°\s*)?C", re.IGNORECASE)
 
 
 def _summary(sets) -> str:

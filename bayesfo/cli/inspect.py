@@ -66,16 +66,20 @@ def run(args) -> int:
         print(f"{args.data}: {len(infos)} data sets, read as {first['format']} "
               f"({first['delimiter']}-separated, decimal '{first['decimal']}', "
               f"{first['encoding']}); each one:")
+    seen = set()
     for k, info in enumerate(infos, start=1):
         if len(infos) > 1:
-            print(f"\n[{k}] {info['block'] or 'data set'}"
-                  + (f" ({info['temperature_C']:g} °C)" if info["temperature_C"] is not None
-                     else ""))
-        _print(info)
+            label = info["block"] or "data set"
+            t = info["temperature_C"]
+            print(f"\n[{k}] {label}" + (f" ({t:g} °C)" if t is not None and "°C" not in label
+                                          else ""))
+        _print(info, seen)
     return 0
 
 
-def _print(info: dict) -> None:
+def _print(info: dict, seen: set | None = None) -> None:
+    """One data set's description; a note already printed for an earlier data set of the file
+    (``seen``) is not repeated (a file of 20 isotherms printed the same 8 notes 20 times)."""
     reading = info["reading"]
     print(f"{info['name']}: {info['n_frequencies']} frequencies, "
           f"{info['omega_min']:.4g} to {info['omega_max']:.4g} rad/s, kind {info['kind']}"
@@ -92,8 +96,16 @@ def _print(info: dict) -> None:
               + (f"temperature {info['temperature_C']:g} °C ('# temperature:' line); "
                  if info["temperature_C"] is not None else "")
               + "no units converted (the '# units:' line is a label)")
+    repeated = 0
     for note in info["notes"]:
+        if seen is not None and note in seen:
+            repeated += 1
+            continue
         print(f"note: {note}")
+        if seen is not None:
+            seen.add(note)
+    if repeated:
+        print(f"note: and {repeated} note(s) as for the data sets above")
     if "holdout" in info:
         print("held out: " + ", ".join(f"{w:.4g}" for w in info["holdout"]) + " rad/s")
     if "structures" in info:

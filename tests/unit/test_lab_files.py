@@ -527,6 +527,18 @@ def test_block_by_temperature_and_unicode_in_the_message(run_cli):
     assert "the temperature (e.g. '20 °C')" in err
 
 
+def test_inspect_of_several_data_sets_prints_each_note_once(run_cli):
+    status, out, _ = run_cli("inspect", LAB / "trios_steps.csv")
+    assert status == 0
+    notes = [line for line in out.splitlines() if line.startswith("note: ")]
+    assert len(notes) == len(set(notes))  # the second set's shared notes are not repeated
+    assert "note: and 7 note(s) as for the data sets above" in notes
+    assert "[2] Frequency sweep - 3 (60 °C)" in out.splitlines()
+    status, out, _ = run_cli("inspect", LAB / "trios_steps.csv", "--block", "2")
+    assert "note: units converted to SI: 'Storage modulus': kPa → Pa (× 1000)" in out.replace(
+        "; 'Loss modulus': kPa → Pa (× 1000)", "")  # one data set: every note
+
+
 # ---------------------------------------------------------------------- batch: a temperature series
 def test_batch_expands_a_lab_file_into_isotherms(tmp_path):
     from bayesfo.batch import expand_inputs

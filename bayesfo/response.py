@@ -64,7 +64,8 @@ def power_sum(omega, coef, exponent) -> np.ndarray:
     # casts the moduli to a complex temporary of shape (..., n_terms, n_freq) and takes 0.32
     # against 0.24 µs per set of two terms at 25 frequencies).
     re, im = phase.real, phase.imag
-    out = np.zeros(coef.shape[:-1] + omega.shape, dtype=complex)
+    out = np.zeros(np.broadcast_shapes(phase.shape[:-1] + (1,),
+                                       modulus.shape[:-2] + modulus.shape[-1:]), dtype=complex)
     out_re, out_im = out.real, out.imag
     for t in range(coef.shape[-1]):
         out_re += re[..., t:t + 1] * modulus[..., t, :]

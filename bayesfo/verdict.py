@@ -168,7 +168,7 @@ def verdict(comparison) -> list[tuple[str, bool]]:
             out.append((lead + "; ".join(parts) + ".", False))
     p, s = _order(result)
     if s is not None:
-        sym = "q" if p == "q" else "β"
+        sym = {"q": "q", "beta": "β", "alpha": "α"}.get(p, p)
         digits = _digits(s.sd)
         text = (f"The fractional order of {name} is {sym} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
                 f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}).")

@@ -67,6 +67,10 @@ def main(argv=None) -> int:
     import signal
     import threading
 
+    # The commands write figures to files and show no window: matplotlib's file backend unless
+    # the user chose one (a desktop session would otherwise load a GUI toolkit, whose state a
+    # process forked to draw figures must not share; bayesfo.plotting.output.can_fork).
+    os.environ.setdefault("MPLBACKEND", "agg")
     parser = build_parser()
     previous = None
     if threading.current_thread() is threading.main_thread():

@@ -76,6 +76,11 @@ def _without_distributed():
         for n in names:
             if n in sys.modules and sys.modules[n] is None:
                 del sys.modules[n]
+        # dask caches the failed import (a configured string scheduler asks for it): a Client
+        # the user creates later would then be ignored. Forget it, so dask asks again.
+        base = sys.modules.get("dask.base")
+        if base is not None and getattr(base, "_DISTRIBUTED_AVAILABLE", None) is False:
+            base._DISTRIBUTED_AVAILABLE = None
 
 
 def _write_netcdf(comparison: Comparison, stage: Path) -> dict[str, Path]:

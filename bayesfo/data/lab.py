@@ -144,8 +144,9 @@ def select(sets: list[Isotherm], block: int | str, where: str) -> Isotherm:
         # A temperature ("20 °C", "20C", "-40.0 °C") names the data set at that temperature.
         match = _TEMPERATURE.fullmatch(str(block).strip())
         if match:
+            # Measured temperatures (a column's mean, 19.98) match within 0.5 °C.
             hits = [s for s in sets if s.temperature is not None
-                    and abs(s.temperature - float(match[1])) < 1e-6]
+                    and abs(s.temperature - float(match[1])) <= 0.5]
             if len(hits) > 1:
                 raise InputError(f"{where}: {len(hits)} data sets are at "
                                  f"{show(str(block), ascii_only=False)}; the file holds "

@@ -222,6 +222,14 @@ def can_fork() -> bool:
     stay held in the child)."""
     if not sys.platform.startswith("linux"):
         return False
+    if "matplotlib.pyplot" in sys.modules:
+        # A child must not draw through an interactive backend's state (a GUI connection
+        # shared with this process): only where figures are drawn off screen.
+        import matplotlib
+
+        if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg", "ps", "cairo",
+                                                     "module://matplotlib_inline.backend_inline"):
+            return False
     _stop_tqdm_monitor()
     return threading.active_count() == 1
 
@@ -346,8 +354,10 @@ def draw_forked(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
             while (i := _take(state, lock, _HERE)) is not None:
                 drawn.update(_save_all({order[i]: jobs[order[i]]}, out_dir, formats))
             # The forked process draws one figure at most by now (a few seconds); one that
-            # has not ended in CHILD_TIMEOUT is stopped and its figure drawn here.
-            child.join(CHILD_TIMEOUT)
+            # has not ended in CHILD_TIMEOUT (or holds no figure and has not ended at once) is
+            # stopped and its figure drawn here.
+            busy = any(state[i] == _TAKEN for i in range(len(order)))
+            child.join(CHILD_TIMEOUT if busy else 5.0)
             if child.is_alive():
                 child.terminate()
                 child.join()

@@ -281,6 +281,24 @@ def test_distributed_stays_importable_around_the_netcdf_writes(monkeypatch):
     assert distributed is loaded
 
 
+def test_dask_forgets_the_import_that_failed_inside_the_block(monkeypatch):
+    # dask caches whether distributed imports (asked when a string scheduler is configured);
+    # a failure cached inside the block would make a later Client unusable.
+    import sys
+
+    import dask.base
+
+    from bayesfo.comparison.output import _without_distributed
+
+    for name in ("distributed", "dask.distributed"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    monkeypatch.setattr(dask.base, "_DISTRIBUTED_AVAILABLE", None)
+    with _without_distributed():
+        assert dask.base._distributed_available() is False
+    assert dask.base._DISTRIBUTED_AVAILABLE is None
+    assert dask.base._distributed_available() is True
+
+
 @pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
 def test_compare_without_units_says_how_to_name_them(run_cli, gspec_csv, tmp_path):
     status, _, err = run_cli("compare", gspec_csv, "--structures", "voigt", "--no-figures",

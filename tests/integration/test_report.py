@@ -217,3 +217,17 @@ def test_bayes_factor_wording():
     assert _strength(0.5).startswith("not worth") and _strength(2.0) == "positive"
     assert _strength(4.0) == "strong" and _strength(7.0) == "very strong"
     assert _bayes_factor(1.0) == f"{math.e:.3g}" and _bayes_factor(1431.3) == "about 10^622"
+
+
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_verdict_names_a_springpot_models_order_alpha():
+    # The fractional Maxwell gel's one order is alpha: the verdict states it as α, not β.
+    s = get_structure("fractional_maxwell_gel")
+    w = np.logspace(-1, 2, 20)
+    rng = np.random.default_rng(4)
+    g = s.response(np.array([1.0, 2.0, 0.6]), w, "modulus")
+    noisy = g * (1 + 0.01 * (rng.normal(size=w.size) + 1j * rng.normal(size=w.size)))
+    result = compare(FrequencyResponse(w, noisy, kind="modulus"), "fractional_maxwell_gel",
+                     workers=1, seed=0, progress=False)
+    texts = [t for t, _ in verdict(result) if "fractional order" in t]
+    assert texts and "is α = " in texts[0] and "β" not in texts[0], texts

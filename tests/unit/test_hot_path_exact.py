@@ -214,3 +214,16 @@ def test_constraints_hold_on_small_batches_as_on_one_large(name):
         parts = [s.constraints_hold(theta[i:j], kind) for i, j in zip(starts[:-1], starts[1:])]
         np.testing.assert_array_equal(np.concatenate(parts), whole[:starts[-1]])
         assert whole.any() and not whole.all()
+
+
+def test_power_sums_of_a_scalar_or_two_dimensional_omega_keep_their_shapes():
+    # As the former einsum: a scalar ω gives one value per set, an (sets, n) ω a table.
+    s = get_structure("maxwell")
+    theta = np.array([1.0, 0.5, 0.3, 0.7])
+    one = s.transfer(theta, 2.0)
+    assert one.shape == (1,)
+    np.testing.assert_allclose(one, s.transfer(theta, np.array([2.0])), rtol=1e-15)
+    w = np.array([[0.5, 1.0, 2.0]])
+    table = response.power_sum(w, np.ones((3, 2)), np.array([[0.0, 0.5]] * 3))
+    assert table.shape == (3, 3)
+    np.testing.assert_allclose(table[1], 1 + np.sqrt(1j * w[0]), rtol=1e-14)

@@ -517,9 +517,9 @@ def test_cli_columns_block_and_errors(run_cli):
 
 def test_block_by_temperature_and_unicode_in_the_message(run_cli):
     # trios_steps.csv: two frequency sweeps, the second at 60 °C. A temperature names the data
-    # set at it ("60 °C", "60C", "60.0 °C"); an unknown one is refused with the degree sign as
+    # set within 0.5 °C of it ("60 °C", "60C", "59.8C"); an unknown one is refused with the degree sign as
     # typed (not escaped as \xb0) and what to give instead.
-    for block in ("60 °C", "60C", "60.0 °C"):
+    for block in ("60 °C", "60C", "60.0 °C", "59.8C"):  # measured temperatures within 0.5 °C
         status, out, _ = run_cli("inspect", LAB / "trios_steps.csv", "--block", block, "--json")
         assert status == 0 and json.loads(out)["temperature_C"] == 60.0, block
     status, _, err = run_cli("inspect", LAB / "trios_steps.csv", "--block", "61 °C")

@@ -36,26 +36,42 @@ def add_parser(subparsers):
     return p
 
 
-def _cpu_times() -> tuple[float, float] | None:
-    """(idle, total) CPU time of the machine so far, in clock ticks (``/proc/stat``); ``None``
-    where the system does not tell."""
+def _cpu_times() -> tuple[float, float, int] | None:
+    """(idle, total, CPUs) time so far, in clock ticks (``/proc/stat``), of the CPUs this
+    process may run on (its affinity set: under taskset, a cpuset or a batch scheduler, idle
+    CPUs outside it are no use); ``None`` where the system does not tell."""
+    try:
+        allowed = os.sched_getaffinity(0)
+    except (AttributeError, OSError):
+        allowed = None
+    idle = total = 0.0
+    count = 0
     try:
         with open("/proc/stat") as f:
-            fields = [float(x) for x in f.readline().split()[1:]]
+            for line in f:
+                name, _, rest = line.partition(" ")
+                if not name.startswith("cpu") or name == "cpu":
+                    continue
+                if allowed is not None and int(name[3:]) not in allowed:
+                    continue
+                fields = [float(x) for x in rest.split()]
+                if len(fields) < 4:
+                    return None
+                idle += fields[3] + (fields[4] if len(fields) > 4 else 0.0)  # idle + iowait
+                total += sum(fields[:8])
+                count += 1
     except (OSError, ValueError):
         return None
-    if len(fields) < 4:
-        return None
-    idle = fields[3] + (fields[4] if len(fields) > 4 else 0.0)  # idle + iowait
-    return idle, sum(fields[:8])
+    return (idle, total, count) if count else None
 
 
-def _idle_cpus(since: tuple[float, float] | None) -> float | None:
-    """CPUs the machine left idle on average since ``since`` (from :func:`_cpu_times`)."""
+def _idle_cpus(since) -> float | None:
+    """CPUs of this process's set left idle on average since ``since`` (from
+    :func:`_cpu_times`)."""
     now = _cpu_times()
-    if since is None or now is None or now[1] <= since[1]:
+    if since is None or now is None or now[2] != since[2] or now[1] <= since[1]:
         return None
-    return (os.cpu_count() or 1) * (now[0] - since[0]) / (now[1] - since[1])
+    return now[2] * (now[0] - since[0]) / (now[1] - since[1])
 
 
 #: Idle CPUs during the comparison from which the figures are drawn in two processes.

@@ -367,6 +367,9 @@ def draw_forked(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
             raise
         for i, name in enumerate(order):
             if state[i] == _TAKEN:  # the forked process failed: draw its figure here
+                for fmt in formats:  # the temporary file of a save it did not finish
+                    for stray in out_dir.glob(f".{name}.*.{fmt}"):
+                        stray.unlink(missing_ok=True)
                 drawn.update(_save_all({name: jobs[name]}, out_dir, formats))
             elif state[i] == _DONE:
                 drawn[name] = [out_dir / f"{name}.{fmt}" for fmt in formats]

@@ -229,10 +229,17 @@ def test_figures_in_two_processes_only_with_a_spare_cpu(monkeypatch):
 
     since = cli_compare._cpu_times()
     assert since is not None and 0 < since[0] <= since[1]  # Linux: /proc/stat
+    assert since[2] == len(os.sched_getaffinity(0))  # the CPUs this process may use
     time.sleep(0.2)
     idle = cli_compare._idle_cpus(since)
-    assert idle is not None and 0.0 <= idle <= os.cpu_count()
+    assert idle is not None and 0.0 <= idle <= since[2]
     assert cli_compare._idle_cpus(None) is None
+    # Restricted to one CPU (taskset, a cpuset): only that CPU's idle time counts.
+    with monkeypatch.context() as m:
+        m.setattr(os, "sched_getaffinity", lambda pid: {0})
+        one = cli_compare._cpu_times()
+        assert one[2] == 1 and one[1] <= since[1]
+        assert cli_compare._idle_cpus(since) is None  # another CPU set: no comparison
     monkeypatch.setattr(bayesfo.parallel, "available_cpus", lambda: 2)
     for idle, expected in [(0.2, 1), (0.49, 1), (0.5, 2), (1.6, 2), (None, 1)]:
         monkeypatch.setattr(cli_compare, "_idle_cpus", lambda since, idle=idle: idle)

@@ -197,7 +197,9 @@ class Structure:
 
     def _polynomial(self, terms, vals, n_sets):
         """Ascending coefficients of a side that is a polynomial in λ = s^q."""
-        plan = self._polynomial_plans.get(id(terms)) or _polynomial_plan(terms)
+        plan = next((p for side, p in self._polynomial_plans if side is terms), None)
+        if plan is None:
+            plan = _polynomial_plan(terms)
         out = np.zeros((n_sets, plan[0] + 1))
         with np.errstate(all="ignore"):
             for degree, name, t in plan[1]:
@@ -206,9 +208,13 @@ class Structure:
         return out
 
     @cached_property
-    def _polynomial_plans(self) -> dict:
-        """Per side (by identity): its degree and each term's (degree, parameter or None, term)."""
-        return {id(side): _polynomial_plan(side) for side in (self.numerator, self.denominator)}
+    def _polynomial_plans(self) -> tuple:
+        """(side, plan) per side: its degree and each term's (degree, parameter or None, term).
+        The sides themselves, matched by identity, not their ``id()``: a structure pickled to
+        a worker process brings the plans along, and there the sides are new objects whose
+        ``id()`` could equal the other side's former one (pickling keeps the identity of the
+        side and of its entry here)."""
+        return tuple((side, _polynomial_plan(side)) for side in (self.numerator, self.denominator))
 
     def polynomials(self, theta):
         """Pseudo-polynomial coefficients of a commensurate structure.

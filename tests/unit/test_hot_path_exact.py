@@ -227,3 +227,18 @@ def test_power_sums_of_a_scalar_or_two_dimensional_omega_keep_their_shapes():
     table = response.power_sum(w, np.ones((3, 2)), np.array([[0.0, 0.5]] * 3))
     assert table.shape == (3, 3)
     np.testing.assert_allclose(table[1], 1 + np.sqrt(1j * w[0]), rtol=1e-14)
+
+
+def test_polynomial_plans_survive_pickling():
+    # A structure sent to a worker process carries its cached plans; they must still match
+    # its own numerator and denominator there.
+    import pickle
+
+    s = get_structure("max-n2m1")
+    theta = np.array([[0.7, 0.2, 1.3, 0.4, 0.55]])
+    before = s.polynomials(theta)
+    again = pickle.loads(pickle.dumps(s))
+    assert again._polynomial_plans[0][0] is again.numerator
+    assert again._polynomial_plans[1][0] is again.denominator
+    for x, y in zip(before, again.polynomials(theta), strict=True):
+        np.testing.assert_array_equal(x, y)

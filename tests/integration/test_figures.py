@@ -542,7 +542,7 @@ def test_a_long_coincidence_note_is_wrapped_inside_the_figure():
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
-    from bayesfo.plotting.response import _legend, _wrapped
+    from bayesfo.plotting._legend import _legend, _wrapped
 
     note = ("fractional_kelvin_voigt, voigt and zener coincide in magnitude; voigt and zener "
             "coincide in phase")

@@ -513,7 +513,7 @@ def test_the_response_legend_stays_inside_the_figure(names, columns):
     from matplotlib.lines import Line2D
 
     from bayesfo.plotting._base import new_figure
-    from bayesfo.plotting.response import _legend
+    from bayesfo.plotting._legend import _legend
     from bayesfo.plotting.style import COLUMN_WIDTH, style
 
     with style():

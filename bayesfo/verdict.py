@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 
+from .comparison.table import ORDER_SYMBOLS
+
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
 EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
                   (5.0, "strong"), (math.inf, "very strong"))
@@ -168,7 +170,7 @@ def verdict(comparison) -> list[tuple[str, bool]]:
             out.append((lead + "; ".join(parts) + ".", False))
     p, s = _order(result)
     if s is not None:
-        sym = {"q": "q", "beta": "β", "alpha": "α"}.get(p, p)
+        sym = ORDER_SYMBOLS.get(p, p)
         digits = _digits(s.sd)
         text = (f"The fractional order of {name} is {sym} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
                 f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}).")

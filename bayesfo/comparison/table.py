@@ -14,6 +14,8 @@ from .parameters import physical_text
 #: of two springpots in parallel); ``alpha`` (the one springpot of the fractional Maxwell gel
 #: and liquid, the Zener solid–liquid and the springpot itself).
 ORDER_PARAMS = ("q", "beta", "alpha")
+#: Their symbols in text.
+ORDER_SYMBOLS = {"q": "q", "beta": "β", "alpha": "α"}
 
 
 def order_parameter(parameters) -> str | None:

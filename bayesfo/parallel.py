@@ -1,6 +1,7 @@
 """Worker processes for the structures of a comparison and the data sets of a batch.
 
-Workers are spawned (no fork of a process that may hold threads), run one BLAS thread each,
+Workers are spawned, or forked where that is safe (a comparison's pools, see :func:`new_pool`
+and :func:`fork_safe`), run one BLAS thread each,
 ignore Ctrl-C (the parent answers it, once) and end when their parent dies, so an interrupted or
 killed run never leaves orphans behind. :func:`process_pool` ends its workers at once when the
 block that uses it raises.
@@ -11,6 +12,7 @@ from __future__ import annotations
 import ctypes
 import os
 import signal
+import sys
 from contextlib import contextmanager
 
 from .errors import InputError
@@ -46,9 +48,47 @@ def worker_environment():
                 os.environ[k] = v
 
 
+def _stop_tqdm_monitor() -> None:
+    """End tqdm's monitor thread, which any progress bar starts (even a disabled one) and which
+    otherwise sleeps on until the process exits; the next bar starts it again."""
+    if "tqdm" not in sys.modules:
+        return
+    import threading
+
+    from tqdm._monitor import TMonitor
+
+    for t in threading.enumerate():
+        if isinstance(t, TMonitor):
+            t.exit()
+
+
+#: matplotlib backends that draw off screen: a forked process may draw through them.
+OFF_SCREEN_BACKENDS = ("agg", "pdf", "svg", "ps", "cairo",
+                       "module://matplotlib_inline.backend_inline")
+
+
+def fork_safe() -> bool:
+    """Whether this process can be forked: on Linux, with no other Python thread running once
+    tqdm's idle monitor is ended (a lock another thread holds at the fork would stay held in
+    the child), and no matplotlib state of an on-screen backend (a GUI connection shared with
+    the child)."""
+    import threading
+
+    if not sys.platform.startswith("linux"):
+        return False
+    if "matplotlib.pyplot" in sys.modules:
+        import matplotlib
+
+        if matplotlib.get_backend().lower() not in OFF_SCREEN_BACKENDS:
+            return False
+    _stop_tqdm_monitor()
+    return threading.active_count() == 1
+
+
 def init_worker() -> None:
     """Initializer of every worker process: Ctrl-C goes to the parent alone (which ends the
-    workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL."""
+    workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL. A
+    forked worker also limits the BLAS it inherited, already loaded, to one thread."""
     import threading
 
     from tqdm import tqdm
@@ -64,15 +104,30 @@ def init_worker() -> None:
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
     except (OSError, AttributeError):  # not Linux: the parent's own cleanup must do
         pass
+    if "numpy" in sys.modules:  # forked: the environment came too late for the loaded BLAS
+        from threadpoolctl import threadpool_limits
+
+        threadpool_limits(limits=1, user_api="blas")
 
 
-def new_pool(workers: int):
+def new_pool(workers: int, *, fork: bool = False):
     """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` spawned processes with
-    :func:`init_worker`; create it inside :func:`worker_environment`."""
+    :func:`init_worker`; create it inside :func:`worker_environment`.
+
+    With ``fork``, the processes are forked from this one instead where :func:`fork_safe`
+    holds when it is created (they start at the first task, before the executor starts its
+    manager thread): each then has the libraries this process has loaded, where a spawned one
+    imports them again (measured: 1.9 s of CPU for a fresh interpreter to import what a
+    worker needs, twice for the two workers of the full comparison of the thesis' G_spec
+    set-up, whose serial run takes 58 s of CPU). Only for pools that
+    live within one call: a forked worker holds copies of this process's open files, so a
+    long-lived pool (a batch's) would keep the locks of later output directories held.
+    """
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+    method = "fork" if fork and fork_safe() else "spawn"
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context(method),
                                initializer=init_worker)
 
 
@@ -161,9 +216,12 @@ class LazyPool:
         return self._pool is not None
 
     def start(self):
-        """The pool, started now if it was not (inside :func:`worker_environment`)."""
+        """The pool, started now if it was not (inside :func:`worker_environment`); its
+        processes are forked from this one where :func:`fork_safe` (``new_pool(fork=True)``:
+        the pool lives within the block of :func:`lazy_process_pool`, and is started at its
+        first task, after which the executor starts its manager thread)."""
         if self._pool is None:
-            self._pool = new_pool(self.workers)
+            self._pool = new_pool(self.workers, fork=True)
         return self._pool
 
     def submit(self, fn, /, *args, **kwargs):

@@ -432,11 +432,14 @@ def _guided_moves(guide_mix: _GaussianMixture | None, u, log_prior, log_lik, bet
             return own.log_pdf(x)
         return np.logaddexp(own.log_pdf(x), guide_mix.log_pdf(x)) - math.log(2.0)
 
+    log_q_u = log_q(u)  # kept up to date as moves are accepted, not evaluated again
     for _ in range(steps):
         if guide_mix is None:
             prop = own.sample(n, rng)
         else:
             from_guide = rng.random(n) < 0.5
             prop = np.where(from_guide[:, None], guide_mix.sample(n, rng), own.sample(n, rng))
-        yield from _accept(prop, u, log_prior, log_lik, beta, np.log(rng.random(n)),
-                           log_q(prop), log_q(u))
+        log_q_prop = log_q(prop)
+        ok = yield from _accept(prop, u, log_prior, log_lik, beta, np.log(rng.random(n)),
+                                log_q_prop, log_q_u)
+        log_q_u[ok] = log_q_prop[ok]

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import os
-import sys
 import tempfile
-import threading
 import warnings
 from pathlib import Path
 
@@ -204,34 +202,13 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
 # Drawing in two processes: this one and one forked from it.
 
 
-def _stop_tqdm_monitor() -> None:
-    """End tqdm's monitor thread, which any progress bar starts (even a disabled one) and which
-    otherwise sleeps on until the process exits; the next bar starts it again."""
-    if "tqdm" not in sys.modules:
-        return
-    from tqdm._monitor import TMonitor
-
-    for t in threading.enumerate():
-        if isinstance(t, TMonitor):
-            t.exit()
-
-
 def can_fork() -> bool:
-    """Whether :func:`draw_forked` can fork this process: on Linux, with no other Python thread
-    running once tqdm's idle monitor is ended (a lock another thread holds at the fork would
-    stay held in the child)."""
-    if not sys.platform.startswith("linux"):
-        return False
-    if "matplotlib.pyplot" in sys.modules:
-        # A child must not draw through an interactive backend's state (a GUI connection
-        # shared with this process): only where figures are drawn off screen.
-        import matplotlib
+    """Whether :func:`draw_forked` can fork this process (:func:`bayesfo.parallel.fork_safe`:
+    on Linux, no other Python thread running once tqdm's idle monitor is ended, and no
+    on-screen matplotlib backend)."""
+    from ..parallel import fork_safe
 
-        if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg", "ps", "cairo",
-                                                     "module://matplotlib_inline.backend_inline"):
-            return False
-    _stop_tqdm_monitor()
-    return threading.active_count() == 1
+    return fork_safe()
 
 
 def _draw_order(comparison, names) -> list[str]:

@@ -180,8 +180,12 @@ def test_bridge_proposal_finds_the_components_of_a_mixture():
     assert np.allclose(np.exp(mix.log_pdf(x)), expected, rtol=1e-10, atol=1e-300)
     draws = mix.sample(20_000, rng)
     assert np.mean(draws[:, 0] > 4) == pytest.approx(0.3, abs=0.01)
-    # One compact cloud stays one normal.
-    assert len(_GaussianMixture.fit(a, rng).weights) == 1
+    # One compact cloud stays one normal, with its density.
+    one = _GaussianMixture.fit(a, rng)
+    assert len(one.weights) == 1
+    c = one.chols[0]
+    assert np.allclose(one.log_pdf(x), stats.multivariate_normal(one.means[0], c @ c.T).logpdf(x),
+                       rtol=1e-12, atol=1e-10)
 
 
 def test_importance_sampling_matches_closed_form(linear_case):

@@ -217,3 +217,47 @@ def test_one_blas_thread_inside_the_block_and_the_count_restored_after():
     with parallel.single_blas_thread():
         assert counts() == [1] * len(before)
     assert counts() == before
+
+
+_MARK = {"set_in_parent": False}
+
+
+def _worker_state():
+    """In a worker: whether it has the parent's memory (a fork) and its BLAS thread counts."""
+    from threadpoolctl import threadpool_info
+
+    return _MARK["set_in_parent"], [p["num_threads"] for p in threadpool_info()
+                                    if p["user_api"] == "blas"]
+
+
+def test_the_automatic_schedule_forks_its_workers_where_safe(monkeypatch):
+    """The automatic schedule's workers are forked where that is safe (they then share the
+    libraries this process has loaded instead of importing them again) and run one BLAS
+    thread each, as spawned ones do."""
+    if not parallel.fork_safe():
+        pytest.skip("another thread runs in this process (e.g. left by a Dask test)")
+    monkeypatch.setitem(_MARK, "set_in_parent", True)
+    with lazy_process_pool(2) as pool:
+        forked, blas = pool.submit(_worker_state).result()
+        assert pool._pool._mp_context.get_start_method() == "fork"
+    assert forked
+    assert blas and set(blas) == {1}
+
+
+def test_the_automatic_schedule_spawns_while_another_thread_runs(monkeypatch):
+    import threading
+
+    monkeypatch.setitem(_MARK, "set_in_parent", True)
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        assert not parallel.fork_safe()
+        with lazy_process_pool(1) as pool:
+            forked, blas = pool.submit(_worker_state).result()
+            assert pool._pool._mp_context.get_start_method() == "spawn"
+    finally:
+        stop.set()
+        other.join()
+    assert not forked
+    assert blas and set(blas) == {1}

@@ -16,7 +16,17 @@ class InputError(BayesfoError, ValueError):
     """Bad input from the user: a file, a column, a row or an argument that cannot be used.
 
     The message names what is wrong and where (file, column, row or argument name).
+
+    Attributes
+    ----------
+    command_line : str or None
+        The same message in the words of the command line (``--block 2`` where the message says
+        ``block=2``), where the two differ; the command line prints it instead of the message.
     """
+
+    def __init__(self, *args, command_line: str | None = None):
+        super().__init__(*args)
+        self.command_line = command_line
 
 
 class StructureError(InputError):

@@ -23,7 +23,8 @@ version wrote into), nothing is taken as the earlier run's: only files of the na
 writes are replaced, and a directory of such a name that no run recorded (a ``figures/`` of your
 own) is refused rather than replaced. Other files in the output directory are never touched.
 Runs into the same directory take turns: a lock (``.bayesfo-lock``) is held while a run swaps
-its outputs in.
+its outputs in, and removed by the run before it lets go of it (:func:`_locked` says why that is
+safe), so a finished run leaves no lock file behind.
 """
 
 from __future__ import annotations
@@ -250,19 +251,62 @@ def check_output_directory(out_dir, option: str = "--out", directories=()) -> Pa
     return out_dir
 
 
+def _same_file(a: os.stat_result, b: os.stat_result) -> bool:
+    return (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino)
+
+
+def _acquire(path: Path, fcntl) -> int:
+    """A descriptor of the lock file ``path``, flock-ed, that ``path`` still names."""
+    while True:
+        try:  # O_NOFOLLOW: a link named like the lock never makes a file outside the directory
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+        except OSError as exc:
+            if exc.errno == errno.ELOOP:
+                raise OutputError(f"'{path}' is a symbolic link, not bayesfo's lock file; "
+                                  "remove it") from None
+            raise
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            try:
+                now = os.stat(path, follow_symlinks=False)
+            except FileNotFoundError:
+                now = None
+            if now is not None and _same_file(os.fstat(fd), now):
+                return fd
+        except BaseException:
+            os.close(fd)
+            raise
+        os.close(fd)  # the run before removed the file we waited on: lock the one there now
+
+
 @contextlib.contextmanager
 def _locked(out_dir: Path):
-    """Hold the output directory's lock (waiting for another run's swap to finish)."""
+    """Hold the output directory's lock (waiting for another run's swap to finish).
+
+    The lock is an ``flock`` on ``out_dir/.bayesfo-lock``, removed while still held, so that no
+    lock file stays behind. That keeps the runs taking turns because a run only counts the lock
+    as taken once, holding it, it has seen that the path still names the file it locked: a run
+    that waited on a file its holder has since removed goes round again and locks the file now
+    at the path (a new one, created by whichever waiting run opens it first). Only the holder
+    removes the file, so two runs never both hold a file that the path names. (A bayesfo older
+    than this check, running into the same directory at the same moment, would not go round
+    again; runs of one version take turns.)
+    """
     try:
         import fcntl
     except ImportError:  # not POSIX: runs into one directory must not overlap
         yield
         return
-    fd = os.open(out_dir / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    path = out_dir / LOCK
+    fd = _acquire(path, fcntl)
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
         yield
     finally:
+        try:
+            if _same_file(os.fstat(fd), os.stat(path, follow_symlinks=False)):
+                os.unlink(path)
+        except OSError:  # already gone, or not removable: the next run locks it as it is
+            pass
         os.close(fd)
 
 

@@ -19,6 +19,7 @@ import html
 from pathlib import Path
 
 from ._io import atomic_write_text
+from .comparison.parameters import UNDETERMINED_DECADES
 from .errors import InputError
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
@@ -227,10 +228,10 @@ def _parameters_section(comparison) -> str:
     for name in comparison.ranking:
         r = comparison[name]
         units = getattr(r, "units", {}) or {}
+        judged = r.sampled_parameters
         rows = []
         for p, s in r.posterior.summary.items():
-            flags = [f for f, on in (("poorly determined", s.poorly_determined),
-                                     ("multimodal", s.multimodal)) if on]
+            flags = _flags(judged.get(p, {})) + (["multimodal"] if s.multimodal else [])
             rows.append(
                 f"<tr>{_text_cell(p)}{_text_cell(units.get(p, ''))}{_cell(s.mean, '.4g')}"
                 f"{_cell(s.sd, '.3g')}"
@@ -257,7 +258,10 @@ def _parameters_section(comparison) -> str:
     return (f"<p class='small'>Posterior summaries in physical units, the units derived from "
             f"the data's; HDI: {HDI_PERCENT} % highest-density interval; MAP: the draw of "
             "highest posterior density (for a physical parameter, its value at that draw). "
-            "'Poorly determined': the HDI covers more than half of the prior range. Each "
+            "'Poorly determined': the HDI covers more than half of the prior range. 'Not "
+            f"determined': the HDI of a quantity with a unit spans more than "
+            f"{UNDETERMINED_DECADES:g} decades or runs to 0 or infinity, so the data do not fix "
+            "even its order of magnitude and its numbers are not estimates. Each "
             "structure's parameters are given in the form natural to the data first (modulus "
             "data: moduli G [stress], quasi-properties c [stress·s^order], orders and times "
             "τ [s]; compliance data: the card's coefficients a, b and orders), then in the "
@@ -268,13 +272,25 @@ _PARAMETER_HEAD = ("<tr><th class='text'>parameter</th><th class='text'>unit</th
                    "<th>sd</th><th>HDI low</th><th>HDI high</th><th>median</th><th>MAP</th>")
 
 
+def _flags(s: dict) -> list[str]:
+    """'not determined: …' or 'poorly determined' for one summary (of
+    :func:`~bayesfo.comparison.parameters.with_determination`)."""
+    if s.get("not_determined"):
+        return [f"not determined: {s['not_determined_reason']}"]
+    return ["poorly determined"] if s.get("poorly_determined") else []
+
+
 def _physical_table(block: dict) -> str:
-    rows = "".join(
-        f"<tr>{_text_cell(p)}{_text_cell(s['unit'])}{_cell(s['mean'], '.4g')}"
-        f"{_cell(s['sd'], '.3g')}{_cell(s['hdi_low'], '.4g')}{_cell(s['hdi_high'], '.4g')}"
-        f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}</tr>"
-        for p, s in block.items())
-    return f"<table>{_PARAMETER_HEAD}</tr>{rows}</table>"
+    rows = []
+    for p, s in block.items():
+        flags = _flags(s)
+        rows.append(
+            f"<tr>{_text_cell(p)}{_text_cell(s['unit'])}{_cell(s['mean'], '.4g')}"
+            f"{_cell(s['sd'], '.3g')}{_cell(s['hdi_low'], '.4g')}{_cell(s['hdi_high'], '.4g')}"
+            f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}"
+            f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
+    return (f"<table>{_PARAMETER_HEAD}<th class='text'>flags</th></tr>{''.join(rows)}"
+            "</table>")
 
 
 def _picture_text(structure, picture: str) -> str:

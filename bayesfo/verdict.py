@@ -2,7 +2,7 @@
 much (Kass & Raftery's verbal scale of the Bayes factor), whether the information criteria and
 the posterior predictive checks agree, how well the fractional order is determined, which
 posteriors are not certified, how the noise model was chosen, and the winner's physical
-parameters with units.
+parameters with units (naming instead of valuing those the data do not determine).
 
 :func:`verdict` returns the sentences, each with a flag that marks a caution; the report
 (:mod:`bayesfo.report`) renders them as its first section, and scripts can print them.
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 
+from .comparison.parameters import UNDETERMINED_DECADES
 from .comparison.table import ORDER_SYMBOLS
 
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
@@ -115,7 +116,8 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     -------
     list of (str, bool)
         Sentences in reading order; ``flagged`` marks cautions (no convergence, poorly
-        determined order, an evidence difference within its error).
+        determined order, parameters the data do not determine, an evidence difference within
+        its error).
     """
     rows = [r for r in comparison.table() if r.get("rank") is not None]
     failed = [r for r in comparison.results if r.error is not None]
@@ -191,6 +193,12 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     if poor:
         out.append(("The fractional order is poorly determined (HDI wider than half the prior "
                     f"range) for: {', '.join(poor)}.", True))
+    vague = [f"{r['structure']} ({', '.join(names)})" for r in rows[1:]
+             if (names := _undetermined(comparison[r["structure"]]))]
+    if vague:
+        out.append((f"Parameters that the data do not determine ({HDI_PERCENT} % HDI over more "
+                    f"than {UNDETERMINED_DECADES:g} decades, or reaching 0 or infinity; their "
+                    f"numbers are not estimates): {'; '.join(vague)}.", True))
     if not best["converged"]:
         post = result.posterior
         out.append((f"Caution: the posterior of {name} did not converge (R-hat "
@@ -219,24 +227,41 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     return out
 
 
+def _undetermined(result) -> list[str]:
+    """The parameters of ``result``, in the form natural to the data, that the data do not
+    determine (:func:`~bayesfo.comparison.parameters.not_determined`)."""
+    if getattr(result, "posterior", None) is None:
+        return []
+    return [n for n, s in result.natural_parameters.items() if s.get("not_determined")]
+
+
 def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
-    """The winner's physical parameters: posterior median and 94 % HDI with units."""
+    """The winner's physical parameters: posterior median and 94 % HDI with units; those the
+    data do not determine are named with the reason instead of a value."""
     phys = getattr(result, "physical", None)
     if not phys or phys["picture"] is None:
         return []
-    parts = []
+    parts, vague = [], []
     for p, s in phys["physical"].items():
         if p == skip or not _finite(s.get("median")):
+            continue
+        if s.get("not_determined"):
+            vague.append(f"{p} ({s['not_determined_reason']})")
             continue
         unit = f" {s['unit']}" if s["unit"] else ""
         hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"
                if _finite(s.get("hdi_low")) and _finite(s.get("hdi_high")) else "")
         parts.append(f"{p} = {s['median']:.3g}{unit}{hdi}")
-    if not parts:
-        return []
+    out = []
     picture = "" if phys["picture"] == name else f" ({phys['picture']})"
-    return [(f"In physical parameters{picture}, {name} has {_join(parts)} "
-             f"(posterior medians, {HDI_PERCENT} % HDI in brackets).", False)]
+    if parts:
+        out.append((f"In physical parameters{picture}, {name} has {_join(parts)} "
+                    f"(posterior medians, {HDI_PERCENT} % HDI in brackets).", False))
+    if vague:
+        out.append((f"The data do not determine {_join(vague)} of {name}: "
+                    + ("its value is not an estimate." if len(vague) == 1
+                       else "their values are not estimates."), True))
+    return out
 
 
 def _join(items) -> str:

@@ -84,7 +84,7 @@ def main(argv=None) -> int:
             warnings.showwarning = _one_line_warning
             return importlib.import_module(f"{__name__}.{args.command}").run(args)
     except InputError as exc:
-        print(f"bayesfo: error: {exc}", file=sys.stderr)
+        print(f"bayesfo: error: {getattr(exc, 'command_line', None) or exc}", file=sys.stderr)
         return 2
     except OutputError as exc:
         print(f"bayesfo: error: {exc}", file=sys.stderr)

@@ -33,7 +33,8 @@ def add_data_options(p):
                         "(temperature=)")
     p.add_argument("--block", default=None, metavar="N|LABEL",
                    help="for a file of several data sets (steps, intervals, isotherms): which "
-                        "one, by number from 1 or label (bayesfo inspect lists them)")
+                        "one, by number from 1, label or temperature (\"20 °C\"; bayesfo "
+                        "inspect lists them)")
     p.add_argument("--delimiter", default=None, choices=(",", ";", "tab", "space"),
                    help="cell delimiter (default: sniffed)")
     p.add_argument("--decimal", default=None, choices=(".", ","),

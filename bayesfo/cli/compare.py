@@ -134,6 +134,32 @@ def _units_note(path, kind: str) -> str:
             f"the data's own unit ({symbol} in the table and report); to name it, {how}")
 
 
+def _print_undetermined(result) -> None:
+    """Beneath the table: the parameters (in the form natural to the data) that the data do
+    not determine, and the poorly determined orders, of each structure, best first."""
+    from ..comparison.parameters import UNDETERMINED_DECADES
+
+    vague, poor = [], []
+    for row in result.table():
+        if row.get("error"):
+            continue
+        r = result[row["structure"]]
+        names = [n for n, s in r.natural_parameters.items() if s.get("not_determined")]
+        if names:
+            vague.append(f"{r.name}: {', '.join(names)}")
+        orders = [n for n in r.structure.exponent_params
+                  if n in r.posterior.summary and r.posterior.summary[n].poorly_determined]
+        if orders:
+            poor.append(f"{r.name}: {', '.join(orders)}")
+    if vague:
+        print(f"not determined by the data (94 % HDI over more than {UNDETERMINED_DECADES:g} "
+              "decades, or reaching 0 or infinity; the values in the report, summary.json and "
+              "ranking.csv are not estimates): " + "; ".join(vague))
+    if poor:
+        print("orders poorly determined (94 % HDI wider than half the prior range): "
+              + "; ".join(poor))
+
+
 def _num(x, fmt: str = ".2f") -> str:
     """A number for the terminal table; '-' for one that is undefined (its reason is among
     the warnings)."""
@@ -210,6 +236,7 @@ def run(args) -> int:
                   f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>16} "
                   f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3} "
                   f"{(row['fits'] or '-').replace('no', 'NO'):>6}")
+        _print_undetermined(result)
         pairs = result.baselines()
         if pairs:
             print("integer baselines (q = 1) against their fractional parents:")

@@ -23,6 +23,7 @@ from .parameters import (  # noqa: F401  (re-exported: the names results offered
     physical_forms,
     physical_text,
     summarise_draws,
+    with_determination,
 )
 from .table import RANKING_FIELDS, order_parameter, ranking_rows  # noqa: F401  (re-exported)
 
@@ -80,10 +81,36 @@ class StructureResult:
         idx = {n: post.param_names.index(n) for n in names}
         draws = {n: post.samples[:, i] for n, i in idx.items()}
         at_map = {n: np.asarray(post.map_theta[i], dtype=float) for n, i in idx.items()}
+        poor = {n: s.poorly_determined for n, s in post.summary.items()}
         try:
-            return physical_forms(self.structure, draws, at_map, self.data_kind, self.data_units)
+            return physical_forms(self.structure, draws, at_map, self.data_kind, self.data_units,
+                                  poorly_determined=poor)
         except StructureError:
             return None
+
+    @property
+    def sampled_parameters(self) -> dict:
+        """``{name: summary}`` of the parameters as sampled (the card's coefficients and the
+        noise): ``ParameterSummary.to_dict()``, the unit where the data's kind is known, and
+        ``not_determined``/``not_determined_reason``
+        (:func:`~bayesfo.comparison.parameters.not_determined`); empty without a posterior."""
+        post = self.posterior
+        if post is None:
+            return {}
+        units = self.units
+        block = {k: v.to_dict() | ({"unit": units[k]} if k in units else {})
+                 for k, v in post.summary.items()}
+        return with_determination(block)
+
+    @property
+    def natural_parameters(self) -> dict:
+        """``{name: summary}`` in the form natural to the data: the physical parameters for
+        modulus data (:attr:`physical`), else the parameters as sampled
+        (:attr:`sampled_parameters`)."""
+        phys = self.physical
+        if phys is not None and phys["natural_form"] == "physical":
+            return phys["physical"]
+        return self.sampled_parameters
 
     @property
     def adequacy(self):
@@ -153,21 +180,22 @@ class StructureResult:
                                         post.map_theta[post.param_names.index(n)],
                                         units.get(n, ""))
                      for n in post.param_names if n not in s.param_names}
-            block.update(noise)
-        elif post is not None:
-            units = self.units
-            block = {n: {"unit": units.get(n, ""), "median": v.median, "hdi_low": v.hdi_low,
-                         "hdi_high": v.hdi_high} for n, v in post.summary.items()}
+            block.update(with_determination(
+                noise, {n: post.summary[n].poorly_determined for n in noise}))
         else:
-            block = {}
+            block = self.sampled_parameters
         if block:
             width = max(len(n) for n in block)
             lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI")
             for n, v in block.items():
                 unit = f" {v['unit']}" if v.get("unit") else ""
+                flag = (f"  (not determined: {v['not_determined_reason']})"
+                        if v.get("not_determined") else
+                        "  (poorly determined: the HDI covers more than half of the prior "
+                        "range)" if v.get("poorly_determined") else "")
                 lines.append(f"  {n:<{width}}  {_fmt(v.get('median'), '11.4g')}  "
                              f"[{_fmt(v.get('hdi_low'), '.4g')}, {_fmt(v.get('hdi_high'), '.4g')}]"
-                             f"{unit}")
+                             f"{unit}{flag}")
         for w in self.criteria.get("warnings", ()):
             lines.append(f"  ! {w}")
         return "\n".join(lines)
@@ -184,13 +212,11 @@ class StructureResult:
         post = self.posterior
         ev = self.criteria.get("evidence")
         check = self.criteria.get("evidence_check")
-        units = self.units
         phys = self.physical
         out.update(
             # Each parameter as sampled (the card's coefficients and the noise), with its unit
-            # when the data's kind is known.
-            parameters={k: v.to_dict() | ({"unit": units[k]} if k in units else {})
-                        for k, v in post.summary.items()},
+            # when the data's kind is known and whether the data determine it.
+            parameters=self.sampled_parameters,
             # Both forms with units (:func:`physical_forms`): which one is natural to the
             # data's kind, the physical parameters and the form that is not natural.
             natural_form=None if phys is None else phys["natural_form"],

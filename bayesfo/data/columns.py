@@ -234,13 +234,17 @@ def mapped(columns: list[Column], spec: str, role: str, where: str) -> Column:
 
 # ---------------------------------------------------------------------- choosing the columns
 #: Response forms, best first within a quantity: (name, roles).
+#: The contract's forms (real/imag, magnitude/phase_deg) belong to every quantity: a unit,
+#: from the header or from ``columns`` (``real="real [kPa]"``), makes their columns a modulus.
 _FORMS = {
     _M: (("storage/loss", ("storage", "loss")), ("magnitude/phase", ("magnitude", "phase")),
          ("magnitude/tan_delta", ("magnitude", "tan_delta")),
          ("viscosity/phase", ("viscosity", "phase")),
-         ("viscosity/tan_delta", ("viscosity", "tan_delta")), ("eta", ("eta_dyn", "eta_out"))),
+         ("viscosity/tan_delta", ("viscosity", "tan_delta")), ("eta", ("eta_dyn", "eta_out")),
+         ("real/imag", ("real", "imag")), ("magnitude/phase_deg", ("magnitude", "phase_deg"))),
     _C: (("storage/loss", ("storage", "loss")), ("magnitude/phase", ("magnitude", "phase")),
-         ("magnitude/tan_delta", ("magnitude", "tan_delta"))),
+         ("magnitude/tan_delta", ("magnitude", "tan_delta")),
+         ("real/imag", ("real", "imag")), ("magnitude/phase_deg", ("magnitude", "phase_deg"))),
     _ANY: (("storage/loss", ("storage", "loss")), ("real/imag", ("real", "imag")),
            ("magnitude/phase_deg", ("magnitude", "phase_deg")),
            ("magnitude/phase", ("magnitude", "phase")),
@@ -356,6 +360,7 @@ def choose(columns: list[Column], mapping: dict, kind: str | None, file_kind: st
             if all(picked.values()):
                 options.append((quantity, form, picked))
     if not options:
+        _refuse_mixed_units(cands, mapping, where)
         raise NotResponse(f"{where}: no response columns among {_names(columns[:30])}: need "
                          "storage and loss modulus (G', G'' or E', E''), storage and loss "
                          "compliance (J', J''), |G*| with the phase angle or tan δ, complex "
@@ -388,6 +393,32 @@ def choose(columns: list[Column], mapping: dict, kind: str | None, file_kind: st
             _unknown_unit(col, role, where)
     return Choice(frequency, form, response, quantity, kind, reason, others, check,
                   chosen["temperature"], chosen["block"], chosen["sigma"], chosen["series"])
+
+
+def _refuse_mixed_units(cands: dict, mapping: dict, where: str) -> None:
+    """Refuse, by name, the two parts of a response of which ``columns`` gave one a unit and
+    the other none or one of another quantity (``real="real [kPa]"`` beside a bare ``imag``):
+    they would be read in different units."""
+    for pair in (("storage", "loss"), ("real", "imag")):
+        cols = [cands[r][0] if len(cands[r]) == 1 else None for r in pair]
+        if None in cols or not any(mapping.get(r) for r in pair):
+            continue
+        a, b = cols
+        if a.quantity == b.quantity:
+            continue
+        unit = next(c.unit_text for c in cols if c.quantity in (_M, _C))
+
+        def what(c):
+            return f"in {quoted(c.unit_text)}" if c.unit_text else "without a unit"
+
+        text = (f"{where}: the {pair[0]} column {quoted(a.name)} is {what(a)} but the {pair[1]} "
+                f"column {quoted(b.name)} is {what(b)}; both parts of the response must be in "
+                "one unit: give both, e.g. ")
+        raise InputError(
+            text + f"columns={{{pair[0]!r}: '{a.name} [{unit}]', {pair[1]!r}: "
+                   f"'{b.name} [{unit}]'}}",
+            command_line=text + f'--columns {pair[0]}="{a.name} [{unit}]",'
+                                f'{pair[1]}="{b.name} [{unit}]"')
 
 
 def _unknown_unit(col: Column, role: str, where: str) -> None:

@@ -123,11 +123,40 @@ def read(path: str | os.PathLike, *, kind: str | None = None, columns: dict | No
         return select(sets, block, f"file '{path}'").data
     if len(sets) == 1:
         return sets[0].data
+    head = f"file '{path}' holds {len(sets)} data sets ({_summary(sets)}); "
+    tail = "; or, if the rows form one data set such as a master curve, ignore the grouping with "
     raise InputError(
-        f"file '{path}' holds {len(sets)} data sets ({_summary(sets)}); read one with "
-        f"block=N (--block N, N from 1), all with bayesfo.data.read_isotherms (bayesfo batch "
-        "FILE); or, if the rows form one data set such as a master curve, ignore the grouping "
-        "with columns={'temperature': None, 'block': None} (--columns temperature=,block=)")
+        f"{head}read one with {_choice_example(sets, 'block={}', repr)}, every one with "
+        f"bayesfo.data.read_isotherms{tail}columns={{'temperature': None, 'block': None}}",
+        command_line=f"{head}choose one with {_choice_example(sets, '--block {}', _quoted)}, "
+                     f"every one with bayesfo batch FILE{tail}--columns temperature=,block=")
+
+
+def _choice_example(sets, form: str, quote) -> str:
+    """How to choose one of ``sets``, ``form`` the option: by number from 1, and by temperature
+    or label where the first one has one (``block=N (N from 1, e.g. block=1) or its
+    temperature (block='20 °C')``)."""
+    first = sets[0]
+    by_name = (f"{first.temperature:g} °C" if first.temperature is not None
+               else first.label if first.label and not first.label.isdigit() else None)
+    text = f"{form.format('N')} (N from 1, e.g. {form.format(1)})"
+    if by_name is not None and quote(by_name) is not None:
+        kind = "temperature" if first.temperature is not None else "label"
+        text += f" or its {kind} ({form.format(quote(by_name))})"
+    return text
+
+
+def _quoted(text: str) -> str | None:
+    """``text`` as one shell word (in double quotes where needed: POSIX shells and Windows
+    alike); None where no simple quoting serves (or where the option parser would take it
+    for an option: a leading '-' without a space)."""
+    if text.startswith("-") and " " not in text:
+        return None
+    if re.fullmatch(r"[A-Za-z0-9_.+-]+", text):
+        return text
+    if any(c in text for c in '"$`\\!%\n'):
+        return None
+    return f'"{text}"'
 
 
 def select(sets: list[Isotherm], block: int | str, where: str) -> Isotherm:
@@ -148,13 +177,19 @@ def select(sets: list[Isotherm], block: int | str, where: str) -> Isotherm:
             hits = [s for s in sets if s.temperature is not None
                     and abs(s.temperature - float(match[1])) <= 0.5]
             if len(hits) > 1:
-                raise InputError(f"{where}: {len(hits)} data sets are at "
-                                 f"{show(str(block), ascii_only=False)}; the file holds "
-                                 f"{_summary(sets)}; give the number (--block N, N from 1)")
+                text = (f"{where}: {len(hits)} data sets are at "
+                        f"{show(str(block), ascii_only=False)}; the file holds "
+                        f"{_summary(sets)}; give the number")
+                raise InputError(f"{text} (block=N, N from 1)",
+                                 command_line=f"{text} (--block N, N from 1)")
     if not hits:
-        raise InputError(f"{where}: no data set {show(str(block), ascii_only=False)}; the file "
-                         f"holds {_summary(sets)}; give the number (--block N, N from 1), the "
-                         "label or the temperature (e.g. '20 °C')")
+        text = (f"{where}: no data set {show(str(block), ascii_only=False)}; the file holds "
+                f"{_summary(sets)}; give ")
+        raise InputError(
+            f"{text}the number (block=N, N from 1), the label or the temperature "
+            "(e.g. block='20 °C')",
+            command_line=f"{text}the number (--block N, N from 1), the label or the "
+                         'temperature (e.g. --block "20 °C")')
     return hits[0]
 
 
@@ -274,9 +309,9 @@ def columns_from_text(text: str | None) -> dict:
             raise InputError(f"--columns: unknown role {show(role)}; roles are {', '.join(ROLES)}")
         if role in out:
             raise InputError(f"--columns: role {show(role)} given twice")
-        column = column.strip().strip('"').strip("'") if len(column.strip()) > 1 and \
-            column.strip()[0] == column.strip()[-1] and column.strip()[0] in "\"'" else \
-            column.strip()
+        column = column.strip()
+        if len(column) > 1 and column[0] == column[-1] and column[0] in "\"'":
+            column = column[1:-1]  # one pair of quotes: storage="G'" is G', loss="G''" G''
         out[role] = column or None
     return out
 

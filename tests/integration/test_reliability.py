@@ -190,6 +190,78 @@ def test_a_directory_of_the_user_is_never_replaced(comparison, tmp_path, run_cli
     assert status == 2 and "holds a directory 'figures' that no bayesfo run recorded" in err
 
 
+def test_a_run_leaves_no_lock_file(comparison, tmp_path, fake_compare):
+    out = tmp_path / "out"
+    write_outputs(comparison, out, figures=False)
+    write_outputs(comparison, out, figures=False)  # over an earlier run
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [outdir.MANIFEST]
+    shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
+    res = run_batch(expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"}),
+                    tmp_path / "batch", workers=1, progress=False, write_combined=False)
+    assert res.outcomes[0].status == "ok"
+    assert not list((tmp_path / "batch").rglob(outdir.LOCK))
+
+
+def test_runs_take_turns_although_the_lock_file_is_removed(tmp_path, monkeypatch):
+    """A run that waited on the lock file its holder then removed must not go ahead while a
+    third run holds the new lock file (flock locks a file, not a path)."""
+    import fcntl
+    import threading
+
+    out = tmp_path / "out"
+    out.mkdir()
+    opened = {name: threading.Event() for name in ("b", "c")}
+    real_flock = fcntl.flock
+
+    def flock(fd, op):  # the run has opened the lock file and now waits for it
+        name = threading.current_thread().name
+        if name in opened:
+            opened[name].set()
+        return real_flock(fd, op)
+
+    monkeypatch.setattr(fcntl, "flock", flock)
+    inside, entered, leave = [], {n: threading.Event() for n in "abc"}, {
+        n: threading.Event() for n in "abc"}
+
+    def run(name):
+        with outdir._locked(out):
+            inside.append(name)
+            entered[name].set()
+            assert leave[name].wait(10)
+            inside.remove(name)
+
+    threads = {n: threading.Thread(target=run, args=(n,), name=n) for n in "abc"}
+    threads["a"].start()
+    assert entered["a"].wait(10)
+    threads["b"].start()
+    assert opened["b"].wait(10)  # b holds a descriptor of the file a locked
+    leave["a"].set()
+    threads["a"].join(10)
+    assert entered["b"].wait(10)
+    threads["c"].start()
+    assert opened["c"].wait(10)
+    assert not entered["c"].wait(0.5), "two runs hold the lock at once"
+    assert inside == ["b"]
+    leave["b"].set()
+    assert entered["c"].wait(10) and inside == ["c"]
+    leave["c"].set()
+    for t in threads.values():
+        t.join(10)
+    assert not (out / outdir.LOCK).exists()
+
+
+def test_a_link_named_like_the_lock_is_never_followed(tmp_path):
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / outdir.LOCK).symlink_to(elsewhere / "made-by-bayesfo")
+    with pytest.raises(OutputError, match=r"'.*\.bayesfo-lock' is a symbolic link, not "
+                                          "bayesfo's lock file; remove it"):
+        with outdir.staged_run(out) as stage:
+            (stage / "summary.json").write_text("{}")
+    assert list(elsewhere.iterdir()) == [] and not (out / "summary.json").exists()
+
+
 # ---------------------------------------------------------------------- nothing outside --out
 SUMMARY = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"],
            "structures": [{"name": "voigt", "n_params": 3, "log_evidence": -1.5,
@@ -328,9 +400,13 @@ def _wait_for(condition, timeout=120.0):
 
 
 def _workers(proc) -> list:
+    """The command's worker processes: spawned ones, and forked ones (which keep the command's
+    own command line; bayesfo.parallel.new_pool)."""
     try:
-        return [c for c in psutil.Process(proc.pid).children(recursive=True)
-                if "spawn_main" in " ".join(c.cmdline())]
+        parent = psutil.Process(proc.pid)
+        own = parent.cmdline()
+        return [c for c in parent.children(recursive=True)
+                if "spawn_main" in " ".join(c.cmdline()) or c.cmdline() == own]
     except psutil.Error:
         return []
 

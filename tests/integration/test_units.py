@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import json
+import math
 import warnings
 
 import matplotlib
@@ -27,6 +28,10 @@ import pytest  # noqa: E402
 
 import bayesfo as bf  # noqa: E402
 from bayesfo.comparison import RANKING_FIELDS  # noqa: E402
+from bayesfo.comparison.parameters import (  # noqa: E402
+    UNDETERMINED_DECADES,
+    not_determined,
+)
 from bayesfo.comparison.results import (  # noqa: E402
     parameter_units,
     physical_forms,
@@ -125,7 +130,9 @@ def test_the_parameters_block_is_unchanged_and_gains_units(zener_run):
     post = result["zener"].posterior
     units = {"a1": "s^q", "b0": "1/MPa", "b1": "s^q/MPa", "q": ""}
     for name, summary in post.summary.items():
-        assert s["parameters"][name] == summary.to_dict() | {"unit": units[name]}
+        # Keys are only ever added: whether the data determine the parameter.
+        assert s["parameters"][name] == summary.to_dict() | {
+            "unit": units[name], "not_determined": False, "not_determined_reason": None}
     # For modulus data the other form is the card's compliance coefficients, the same numbers.
     other = s["parameters_other_form"]
     assert list(other) == ["a1", "b0", "b1", "q"]
@@ -275,6 +282,85 @@ def test_report_shows_units_and_the_physical_form(zener_run):
     assert section.index("<td class=\"text\">G_e</td>") < section.index("<td class=\"text\">b0</td>")
     sentence = next(t for t, _ in verdict(result) if t.startswith("In physical parameters"))
     assert f"G_e = {g_e['median']:.3g} MPa" in sentence and "tau = " in sentence
+
+
+# ---------------------------------------------------------------------- not determined by the data
+def test_not_determined_reads_the_hdi_of_a_quantity_with_a_unit_on_a_log_scale():
+    assert UNDETERMINED_DECADES == 2.0
+    assert not_determined({"unit": "Pa", "hdi_low": 1.64e8, "hdi_high": 2.11e10}) == (
+        "its 94 % HDI spans 2.1 decades")
+    assert not_determined({"unit": "Pa", "hdi_low": 1.0e3, "hdi_high": 9.9e4}) is None
+    # As the fractional Maxwell's tau on the 20 °C adhesive isotherm: its order ran to 0.
+    assert not_determined({"unit": "s", "hdi_low": 0.0, "hdi_high": 2.1e61}) == (
+        "its 94 % HDI runs from 0 to 2.1e+61")
+    assert not_determined({"unit": "s", "hdi_low": 3e-11, "hdi_high": math.inf}) == (
+        "its 94 % HDI runs from 3e-11 to infinity")
+    # Orders are judged against their prior (poorly_determined); signed and undefined HDIs
+    # are not judged.
+    assert not_determined({"unit": "", "hdi_low": 2.6e-6, "hdi_high": 0.7}) is None
+    assert not_determined({"unit": "Pa", "hdi_low": -5.0, "hdi_high": 1e6}) is None
+    assert not_determined({"unit": "Pa", "hdi_low": math.nan, "hdi_high": math.nan}) is None
+
+
+@pytest.fixture(scope="module")
+def zener_on_voigt(tmp_path_factory):
+    """A Zener fitted to a fractional Kelvin-Voigt modulus (G_e = c_q = 1000 Pa, q = 0.5, 5 %
+    noise with σ known): the data do not fix its second spring G_m nor the time τ."""
+    g = 1 / get_structure("voigt").response([1.0, 1e-3, 0.5], W, "compliance")
+    noisy, sd = _noisy(g, 0.05, 0)
+    data = FrequencyResponse(W, noisy, sd, kind="modulus", units="Pa", name="voigt modulus")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
+        result = bf.compare(data, "zener", seed=0, workers=1, progress=False)
+    out = tmp_path_factory.mktemp("zener_on_voigt")
+    bf.write_outputs(result, out, figures=False)
+    return result, out
+
+
+def test_parameters_the_data_do_not_determine_are_marked(zener_on_voigt):
+    result, out = zener_on_voigt
+    (s,) = json.loads((out / "summary.json").read_text())["structures"]
+    phys = s["parameters_physical"]
+    marked = {n for n, p in phys.items() if p["not_determined"]}
+    assert marked == {"G_m", "tau"}
+    for name in ("G_m", "tau"):
+        p = phys[name]
+        decades = math.log10(p["hdi_high"] / p["hdi_low"])
+        assert decades > UNDETERMINED_DECADES
+        assert p["not_determined_reason"] == f"its 94 % HDI spans {decades:.1f} decades"
+    assert phys["G_e"]["not_determined_reason"] is None
+    assert phys["q"]["poorly_determined"] is False  # the order, judged against its prior
+    assert abs(phys["G_e"]["median"] - 1000.0) < 50.0  # what the data do fix, unmarked
+    with (out / "ranking.csv").open(newline="") as fh:
+        (row,) = list(csv.DictReader(fh))
+    cells = dict(part.split("=") for part in row["physical_parameters"].split("; "))
+    assert cells["G_m"].endswith(" Pa (not determined)")
+    assert cells["tau"].endswith(" s (not determined)") and cells["G_e"].endswith(" Pa")
+    # The result's own summary, the report and the verdict say so instead of a bare number.
+    r = result["zener"]
+    line = next(ln for ln in r.summary().splitlines() if ln.strip().startswith("G_m"))
+    assert line.endswith(f"Pa  (not determined: {phys['G_m']['not_determined_reason']})")
+    text = render_report(result)
+    assert (f"<td class='text flag'>not determined: {phys['tau']['not_determined_reason']}"
+            "</td>") in text
+    sentences = dict(verdict(result))
+    values = next(t for t in sentences if t.startswith("In physical parameters"))
+    assert "G_e = " in values and "G_m" not in values and "tau" not in values
+    vague = (f"The data do not determine G_m ({phys['G_m']['not_determined_reason']}) and tau "
+             f"({phys['tau']['not_determined_reason']}) of zener: their values are not "
+             "estimates.")
+    assert sentences[vague] is True  # flagged as a caution
+
+
+def test_compare_names_the_parameters_the_data_do_not_determine(zener_on_voigt, capsys):
+    from bayesfo.cli.compare import _print_undetermined
+
+    result, _ = zener_on_voigt
+    _print_undetermined(result)
+    assert capsys.readouterr().out == (
+        "not determined by the data (94 % HDI over more than 2 decades, or reaching 0 or "
+        "infinity; the values in the report, summary.json and ranking.csv are not estimates): "
+        "zener: G_m, tau\n")
 
 
 def _modulus_csv(tmp_path):

@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 import bayesfo as bf
 from bayesfo.data import (
     FrequencyResponse,
+    columns_from_text,
     contract_text,
     is_contract_csv,
     read,
@@ -251,6 +252,54 @@ def test_extra_temperature_column_of_a_contract_file_is_read(tmp_path):
     assert iso.temperature == 20.0 and iso.data.kind == "generic"
     _assert_data(iso.data, [1.0, 2.0], [1 + 1j, 1 + 0.5j], "generic")
     assert "kind generic: columns 'real', 'imag' do not say" in iso.reading.kind_reason
+
+
+def test_columns_with_a_unit_on_a_bayesfo_csv_are_honoured(tmp_path, run_cli):
+    """--columns real="real [kPa]",imag="imag [kPa]" on the contract's own columns: the unit makes
+    them a modulus in kPa (they used to be refused as 'no response columns')."""
+    path = tmp_path / "g.csv"
+    path.write_text("# kind: modulus\nomega,real,imag,sigma\n0.1,1.5,0.25,0.01\n"
+                    "1,2.5,0.75,0.01\n10,4,1.5,0.01\n", encoding="utf-8")
+    fr = read(path, columns={"real": "real [kPa]", "imag": "imag [kPa]"})
+    _assert_data(fr, [0.1, 1.0, 10.0], 1e3 * np.array([1.5 + 0.25j, 2.5 + 0.75j, 4 + 1.5j]),
+                 "modulus")
+    np.testing.assert_array_equal(fr.sigma, [10.0, 10.0, 10.0])  # in the response's unit
+    assert fr.units == "Pa"
+    status, out, err = run_cli("inspect", path, "--columns", 'real="real [kPa]",imag="imag [kPa]"',
+                               "--json")
+    assert status == 0, err
+    info = json.loads(out)
+    assert info["magnitude_max"] == pytest.approx(1e3 * abs(4 + 1.5j), rel=1e-15)
+    assert info["reading"]["columns"]["real"] == "real [kPa]"
+    # the contract's magnitude/phase_deg in a compliance unit; a unit in the header needs no
+    # --columns
+    path.write_text("omega,magnitude,phase_deg\n1,2,-10\n2,3,-20\n", encoding="utf-8")
+    fr = read(path, columns={"magnitude": "magnitude [1/kPa]"})
+    _assert_data(fr, [1.0, 2.0], 1e-3 * np.array([2, 3]) * np.exp(-1j * np.radians([10, 20])),
+                 "compliance", rtol=1e-14)
+    path.write_text("omega,real [Pa],imag [Pa]\n1,2,1\n2,3,1\n", encoding="utf-8")
+    _assert_data(read(path), [1.0, 2.0], [2 + 1j, 3 + 1j], "modulus")
+
+
+def test_columns_with_a_unit_on_one_part_only_are_refused_by_name(tmp_path, run_cli):
+    path = tmp_path / "g.csv"
+    path.write_text("omega,real,imag\n1,2,1\n2,3,1\n", encoding="utf-8")
+    text = (f"file '{path}', line 1: the real column 'real' is in 'kPa' but the imag column "
+            "'imag' is without a unit; both parts of the response must be in one unit: give "
+            "both, e.g. ")
+    status, _, err = run_cli("inspect", path, "--columns", 'real="real [kPa]"')
+    assert status == 2
+    assert err == f'bayesfo: error: {text}--columns real="real [kPa]",imag="imag [kPa]"\n'
+    with pytest.raises(InputError) as info:
+        read(path, columns={"real": "real [kPa]"})
+    assert str(info.value) == text + "columns={'real': 'real [kPa]', 'imag': 'imag [kPa]'}"
+
+
+def test_columns_text_keeps_the_primes_inside_quotes():
+    assert columns_from_text("""storage="G'",loss="G''",omega='w',block=""") == {
+        "storage": "G'", "loss": "G''", "omega": "w", "block": None}
+    fr = read(LAB / "ambiguous.csv", columns=columns_from_text('storage="E\'",loss="E\'\'"'))
+    _assert_data(fr, [1.0, 2.0], np.array([30.0, 36.0]) + 1j * np.array([15.0, 18.0]), "modulus")
 
 
 # ---------------------------------------------------------------------- round trips
@@ -524,7 +573,31 @@ def test_block_by_temperature_and_unicode_in_the_message(run_cli):
         assert status == 0 and json.loads(out)["temperature_C"] == 60.0, block
     status, _, err = run_cli("inspect", LAB / "trios_steps.csv", "--block", "61 °C")
     assert status == 2 and "no data set '61 °C'" in err and "\\xb0" not in err
-    assert "the temperature (e.g. '20 °C')" in err
+    assert 'the temperature (e.g. --block "20 °C")' in err and "block=" not in err
+
+
+def test_several_data_sets_are_refused_in_the_words_of_the_caller(run_cli):
+    """The command line names --block and --columns only; the API names block= and columns=."""
+    path = LAB / "trios_steps.csv"
+    head = (f"file '{path}' holds 2 data sets (1: Frequency sweep - 2 (25 °C), "
+            "2: Frequency sweep - 3 (60 °C)); ")
+    tail = "; or, if the rows form one data set such as a master curve, ignore the grouping with "
+    status, _, err = run_cli("compare", path, "--structures", "voigt")
+    assert status == 2
+    assert err == (f"bayesfo: error: {head}choose one with --block N (N from 1, e.g. --block 1) "
+                   f'or its temperature (--block "25 °C"), every one with bayesfo batch FILE'
+                   f"{tail}--columns temperature=,block=\n")
+    with pytest.raises(InputError) as info:
+        read(path)
+    assert str(info.value) == (
+        f"{head}read one with block=N (N from 1, e.g. block=1) or its temperature "
+        f"(block='25 °C'), every one with bayesfo.data.read_isotherms{tail}"
+        "columns={'temperature': None, 'block': None}")
+    assert read(path, block="25 °C").n_frequencies == read(path, block=1).n_frequencies
+    status, out, _ = run_cli("inspect", path, "--block", "25 °C", "--json")
+    assert status == 0 and json.loads(out)["temperature_C"] == 25.0
+    with pytest.raises(InputError, match=r"e\.g\. block='20 °C'\)$"):
+        read(path, block="61 °C")
 
 
 def test_inspect_of_several_data_sets_prints_each_note_once(run_cli):

@@ -1,7 +1,9 @@
 """The ``bayesfo`` command line.
 
 Exit status 0 on success, 2 on bad input (one line on stderr naming the file, column, row or
-argument), 1 on an internal error.
+argument), 1 on an internal error; 130 and 143 when interrupted or terminated, and 141 (as a
+shell reports a process ended by SIGPIPE) when whatever reads the output closes it early, as
+``bayesfo inspect FILE | head`` does, without a message.
 """
 
 from __future__ import annotations
@@ -82,7 +84,17 @@ def main(argv=None) -> int:
             return 2
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.showwarning = _one_line_warning
-            return importlib.import_module(f"{__name__}.{args.command}").run(args)
+            status = importlib.import_module(f"{__name__}.{args.command}").run(args)
+        sys.stdout.flush()  # a closed pipe shows here, not at the interpreter's exit
+        return status
+    except BrokenPipeError:
+        # The reader has gone (e.g. `| head`): nothing more to say, and the interpreter's own
+        # flush at exit must not fail again.
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return 141
     except InputError as exc:
         print(f"bayesfo: error: {getattr(exc, 'command_line', None) or exc}", file=sys.stderr)
         return 2

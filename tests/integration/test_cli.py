@@ -316,3 +316,17 @@ def test_compare_without_units_says_how_to_name_them(run_cli, gspec_csv, tmp_pat
                              "--out", tmp_path / "o2")
     assert status == 0, err
     assert "no unit" not in err
+
+
+def test_a_reader_that_closes_the_pipe_early_ends_the_command_quietly(gspec_csv):
+    """`bayesfo inspect FILE | head` closes the pipe before the command has written: the
+    command ends with 141 (as a shell reports SIGPIPE) and no 'internal error' message."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "bayesfo.cli", "inspect", str(gspec_csv)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # no reader left: the command's first write fails
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 141, stderr
+    assert stderr == b""

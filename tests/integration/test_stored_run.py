@@ -20,7 +20,13 @@ guide draws, reweighted to each rung, and advanced in lock-step, with ln P(S) es
 both: the Voigt's ladder posterior and the numbers computed from it moved within their Monte
 Carlo errors (ln Z −244.2362 ± 0.030, was −244.2362 ± 0.034; a1 sd 464, was 521; q 0.2381 ±
 0.0040, was 0.2378 ± 0.0040); the zener-int's numbers are as stored. The adequacy block gained
-the noise-dominated points (none here)."""
+the noise-dominated points (none here).
+
+Stored again when the ladder's moves came to aim at 5 accepted moves per particle and rung
+instead of 10 (and the summary gained the ``not_determined`` flags of quantities with units):
+the Voigt's ladder posterior moved within its Monte Carlo errors (ln Z −244.259 ± 0.037, was
+−244.236 ± 0.030; q 0.2378 ± 0.0040, was 0.2379 ± 0.0040; a1 sd 474, was 464); the
+zener-int's numbers are as stored."""
 
 from __future__ import annotations
 

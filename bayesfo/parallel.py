@@ -85,10 +85,14 @@ def fork_safe() -> bool:
     return threading.active_count() == 1
 
 
-def init_worker() -> None:
+def init_worker(parent: int | None = None) -> None:
     """Initializer of every worker process: Ctrl-C goes to the parent alone (which ends the
     workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL. A
-    forked worker also limits the BLAS it inherited, already loaded, to one thread."""
+    forked worker also limits the BLAS it inherited, already loaded, to one thread.
+
+    ``parent`` is the process id of the parent that started the worker: a parent that died
+    before the death signal was asked for (between the fork and the request) sends none, so
+    the worker then ends here (it has been adopted by another process)."""
     import threading
 
     from tqdm import tqdm
@@ -104,6 +108,8 @@ def init_worker() -> None:
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
     except (OSError, AttributeError):  # not Linux: the parent's own cleanup must do
         pass
+    if parent is not None and os.getppid() != parent:
+        os._exit(1)
     if "numpy" in sys.modules:  # forked: the environment came too late for the loaded BLAS
         from threadpoolctl import threadpool_limits
 
@@ -128,7 +134,7 @@ def new_pool(workers: int, *, fork: bool = False):
 
     method = "fork" if fork and fork_safe() else "spawn"
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context(method),
-                               initializer=init_worker)
+                               initializer=init_worker, initargs=(os.getpid(),))
 
 
 def terminate(pool) -> None:

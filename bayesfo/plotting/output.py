@@ -239,24 +239,36 @@ CHILD_TIMEOUT = 120.0
 _FREE, _HERE, _TAKEN, _DONE = 0, 1, 2, 3
 
 
-def _take(state, lock, mark: int):
-    """Index of the next free figure, marked ``mark``; ``None`` when none is left."""
-    with lock:
+def _take(state, lock, mark: int, child=None):
+    """Index of the next free figure, marked ``mark``; ``None`` when none is left.
+
+    With ``child`` (the forked process, given by the parent), a lock that the child still
+    holds after it has died (killed inside this short section, e.g. by the kernel's
+    out-of-memory killer) does not block the parent: once the child is gone the table is the
+    parent's alone, and a figure the child had marked is drawn by the parent afterwards."""
+    held = lock.acquire(timeout=None if child is None else 1.0)
+    while not held and child.is_alive():
+        held = lock.acquire(timeout=1.0)
+    try:
         for i in range(len(state)):
             if state[i] == _FREE:
                 state[i] = mark
                 return i
-    return None
+        return None
+    finally:
+        if held:
+            lock.release()
 
 
-def _draw_in_child(jobs: dict, order: list[str], state, lock, out_dir: Path, formats) -> None:
+def _draw_in_child(jobs: dict, order: list[str], state, lock, out_dir: Path, formats,
+                   parent: int | None = None) -> None:
     """The forked process: take figures until none is left. It ignores Ctrl-C and ends with
     its parent (:func:`bayesfo.parallel.init_worker`); on any error it stops quietly and the
     parent draws what it had taken (raising there whatever it raises)."""
     try:
         from ..parallel import init_worker
 
-        init_worker()
+        init_worker(parent)
         while (i := _take(state, lock, _TAKEN)) is not None:
             _save_all({order[i]: jobs[order[i]]}, out_dir, formats)
             state[i] = _DONE
@@ -317,7 +329,7 @@ def draw_forked(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
     with single_blas_thread():
         _load_before_fork(formats)
         child = ctx.Process(target=_draw_in_child, name="bayesfo-figures", daemon=True,
-                            args=(jobs, order, state, lock, out_dir, formats))
+                            args=(jobs, order, state, lock, out_dir, formats, os.getpid()))
         with warnings.catch_warnings():
             # Python 3.12+ warns at any fork of a process with several OS threads; those here
             # are idle BLAS threads (OpenBLAS re-creates its pool in a child, and both
@@ -328,7 +340,7 @@ def draw_forked(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
         try:
             if meanwhile is not None:
                 meanwhile()
-            while (i := _take(state, lock, _HERE)) is not None:
+            while (i := _take(state, lock, _HERE, child)) is not None:
                 drawn.update(_save_all({order[i]: jobs[order[i]]}, out_dir, formats))
             # The forked process draws one figure at most by now (a few seconds); one that
             # has not ended in CHILD_TIMEOUT (or holds no figure and has not ended at once) is

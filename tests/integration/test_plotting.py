@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import struct
 import warnings
 from dataclasses import replace
@@ -529,3 +530,30 @@ def test_the_response_legend_stays_inside_the_figure(names, columns):
         else:
             assert legend._ncols < 3
         plt.close(fig)
+
+
+def _die_holding(lock):
+    lock.acquire()
+    os._exit(0)  # killed inside the shared table's section: the lock is never released
+
+
+def test_a_forked_figure_process_that_dies_holding_the_lock_does_not_block_the_parent():
+    import multiprocessing
+    import threading
+
+    from bayesfo.plotting import output
+
+    ctx = multiprocessing.get_context("fork" if output.can_fork() else "spawn")
+    lock = ctx.Lock()
+    state = ctx.RawArray("b", 3)
+    state[0] = output._TAKEN
+    child = ctx.Process(target=_die_holding, args=(lock,))
+    child.start()
+    child.join()
+    got = []
+    taker = threading.Thread(target=lambda: got.append(output._take(state, lock, output._HERE,
+                                                                     child)), daemon=True)
+    taker.start()
+    taker.join(30)
+    assert not taker.is_alive(), "the parent waits forever on the dead child's lock"
+    assert got == [1] and list(state) == [output._TAKEN, output._HERE, output._FREE]

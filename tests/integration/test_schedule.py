@@ -261,3 +261,20 @@ def test_the_automatic_schedule_spawns_while_another_thread_runs(monkeypatch):
         other.join()
     assert not forked
     assert blas and set(blas) == {1}
+
+
+def test_a_worker_whose_parent_died_before_it_started_ends_itself():
+    """The death signal covers a parent dying after the worker asked for it; one that died
+    between the fork and the request sends none, so the worker checks its parent itself."""
+    import subprocess
+    import sys
+
+    code = ("import os; from bayesfo.parallel import init_worker; "
+            "init_worker(os.getppid() + 10**7); print('still running')")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 1 and "still running" not in done.stdout
+    code = "import os; from bayesfo.parallel import init_worker; init_worker(os.getppid()); print('ok')"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0 and done.stdout.strip() == "ok"

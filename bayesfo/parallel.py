@@ -76,19 +76,30 @@ def fork_safe() -> bool:
 
     if not sys.platform.startswith("linux"):
         return False
-    if "matplotlib.pyplot" in sys.modules:
-        import matplotlib
-
-        if matplotlib.get_backend().lower() not in OFF_SCREEN_BACKENDS:
+    if "matplotlib.pyplot" in sys.modules:  # (matplotlib is only looked at, not imported)
+        if sys.modules["matplotlib"].get_backend().lower() not in OFF_SCREEN_BACKENDS:
             return False
     _stop_tqdm_monitor()
     return threading.active_count() == 1
 
 
-def init_worker(parent: int | None = None) -> None:
+def _worker_blas_threads() -> int:
+    """The BLAS threads of a worker: what :func:`worker_environment` set (the user's value of
+    its variables where set, else 1)."""
+    for key in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
+        try:
+            return max(1, int(os.environ[key]))
+        except (KeyError, ValueError):
+            continue
+    return 1
+
+
+def init_worker(parent: int | None = None, forked: bool = False) -> None:
     """Initializer of every worker process: Ctrl-C goes to the parent alone (which ends the
     workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL. A
-    forked worker also limits the BLAS it inherited, already loaded, to one thread.
+    ``forked`` worker also sets the BLAS it inherited, already loaded with the parent's
+    threads, to the threads a spawned worker gets from the environment (one unless the user
+    set another number).
 
     ``parent`` is the process id of the parent that started the worker: a parent that died
     before the death signal was asked for (between the fork and the request) sends none, so
@@ -110,10 +121,10 @@ def init_worker(parent: int | None = None) -> None:
         pass
     if parent is not None and os.getppid() != parent:
         os._exit(1)
-    if "numpy" in sys.modules:  # forked: the environment came too late for the loaded BLAS
+    if forked:  # the environment came too late for the BLAS loaded before the fork
         from threadpoolctl import threadpool_limits
 
-        threadpool_limits(limits=1, user_api="blas")
+        threadpool_limits(limits=_worker_blas_threads(), user_api="blas")
 
 
 def new_pool(workers: int, *, fork: bool = False):
@@ -125,16 +136,20 @@ def new_pool(workers: int, *, fork: bool = False):
     manager thread): each then has the libraries this process has loaded, where a spawned one
     imports them again (measured: 1.9 s of CPU for a fresh interpreter to import what a
     worker needs, twice for the two workers of the full comparison of the thesis' G_spec
-    set-up, whose serial run takes 58 s of CPU). Only for pools that
-    live within one call: a forked worker holds copies of this process's open files, so a
-    long-lived pool (a batch's) would keep the locks of later output directories held.
+    set-up, whose serial run takes 58 s of CPU). The workers are forked at the first task
+    and hold copies of the descriptors open at that moment (an output directory's lock, if
+    one were held then, until they end): only for pools that live within one call, started
+    before any output is written, as :func:`lazy_process_pool` in ``compare``. ``fork_safe``
+    counts Python threads: the BLAS's own threads cope with a fork (OpenBLAS re-creates its
+    pool in the child).
     """
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     method = "fork" if fork and fork_safe() else "spawn"
     return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context(method),
-                               initializer=init_worker, initargs=(os.getpid(),))
+                               initializer=init_worker,
+                               initargs=(os.getpid(), method == "fork"))
 
 
 def terminate(pool) -> None:

@@ -64,6 +64,26 @@ def _on_sigterm(signum, frame):
     raise Terminated
 
 
+def _internal_error(exc: BaseException) -> int:
+    if os.environ.get("BAYESFO_DEBUG"):
+        raise exc
+    print(f"bayesfo: internal error: {type(exc).__name__}: {exc} "
+          "(set BAYESFO_DEBUG=1 for a traceback)", file=sys.stderr)
+    return 1
+
+
+def _stdout_gone() -> bool:
+    """Whether standard output is a pipe whose reader has closed it."""
+    import select
+
+    try:
+        poll = select.poll()
+        poll.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(event & select.POLLERR for _, event in poll.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), or no file descriptor
+        return False
+
+
 def main(argv=None) -> int:
     """Run the command line; returns the exit status."""
     import signal
@@ -87,11 +107,15 @@ def main(argv=None) -> int:
             status = importlib.import_module(f"{__name__}.{args.command}").run(args)
         sys.stdout.flush()  # a closed pipe shows here, not at the interpreter's exit
         return status
-    except BrokenPipeError:
+    except BrokenPipeError as exc:
+        if not _stdout_gone():  # another pipe (a FIFO given as a file, ...): a real failure
+            return _internal_error(exc)
         # The reader has gone (e.g. `| head`): nothing more to say, and the interpreter's own
         # flush at exit must not fail again.
         try:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
         except (OSError, ValueError):
             pass
         return 141
@@ -110,11 +134,7 @@ def main(argv=None) -> int:
               file=sys.stderr)
         return 143
     except Exception as exc:  # the contract: exit 1 on internal errors, no traceback by default
-        if os.environ.get("BAYESFO_DEBUG"):
-            raise
-        print(f"bayesfo: internal error: {type(exc).__name__}: {exc} "
-              "(set BAYESFO_DEBUG=1 for a traceback)", file=sys.stderr)
-        return 1
+        return _internal_error(exc)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -330,3 +330,19 @@ def test_a_reader_that_closes_the_pipe_early_ends_the_command_quietly(gspec_csv)
     _, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 141, stderr
     assert stderr == b""
+
+
+def test_a_broken_pipe_that_is_not_the_output_is_an_internal_error(gspec_csv, monkeypatch,
+                                                                   capsys):
+    """Only a reader of the output that has gone ends the command quietly; a broken pipe
+    elsewhere (a FIFO the command writes to, say) is a failure the user must see."""
+    import bayesfo.cli
+    import bayesfo.cli.inspect
+
+    def broken(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(bayesfo.cli.inspect, "run", broken)
+    monkeypatch.delenv("BAYESFO_DEBUG", raising=False)
+    assert bayesfo.cli.main(["inspect", str(gspec_csv)]) == 1
+    assert "internal error: BrokenPipeError" in capsys.readouterr().err

@@ -278,3 +278,48 @@ def test_a_worker_whose_parent_died_before_it_started_ends_itself():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=60)
     assert done.returncode == 0 and done.stdout.strip() == "ok"
+
+
+_POOLS_SCRIPT = '''
+import numpy  # the BLAS, loaded before any fork
+from threadpoolctl import threadpool_info
+
+MARK = []
+
+
+def state():
+    return bool(MARK), sorted({p["num_threads"] for p in threadpool_info()
+                               if p["user_api"] == "blas"})
+
+
+if __name__ == "__main__":
+    MARK.append(1)  # set in this process only: a forked worker has it, a spawned one not
+    from bayesfo.parallel import lazy_process_pool, process_pool
+
+    with lazy_process_pool(1) as pool:
+        print("lazy", *pool.submit(state).result())
+    with process_pool(1) as pool:
+        print("process_pool", *pool.submit(state).result())
+'''
+
+
+@pytest.mark.parametrize("blas_env, threads", [(None, 1), ("2", 2)])
+def test_pool_workers_in_a_fresh_command(tmp_path, blas_env, threads):
+    """In a fresh process (as the command line runs), the automatic schedule's pool forks its
+    workers and a process_pool spawns them; both run the BLAS threads of the worker
+    environment: one, or the number the user set."""
+    import os
+    import subprocess
+    import sys
+
+    script = tmp_path / "pools.py"
+    script.write_text(_POOLS_SCRIPT)
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")}
+    if blas_env is not None:
+        env["OPENBLAS_NUM_THREADS"] = blas_env
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == [f"lazy True [{threads}]",
+                                        f"process_pool False [{threads}]"]

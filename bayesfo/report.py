@@ -259,9 +259,12 @@ def _parameters_section(comparison) -> str:
             f"the data's; HDI: {HDI_PERCENT} % highest-density interval; MAP: the draw of "
             "highest posterior density (for a physical parameter, its value at that draw). "
             "'Poorly determined': the HDI covers more than half of the prior range. 'Not "
-            f"determined': the HDI of a quantity with a unit spans more than "
-            f"{UNDETERMINED_DECADES:g} decades or runs to 0 or infinity, so the data do not fix "
-            "even its order of magnitude and its numbers are not estimates. Each "
+            f"determined': the HDI of a quantity with a unit, taken on a log scale (of the "
+            f"logarithms of the draws, so that a quantity and its reciprocal agree), spans more "
+            f"than {UNDETERMINED_DECADES:g} decades or runs to 0 or infinity (for a signed "
+            "quantity: reaches across 0), or the quantity is undefined at more draws than the "
+            "HDI leaves out, so the data do not fix even its order of magnitude and its numbers "
+            "are not estimates. Each "
             "structure's parameters are given in the form natural to the data first (modulus "
             "data: moduli G [stress], quasi-properties c [stress·s^order], orders and times "
             "τ [s]; compliance data: the card's coefficients a, b and orders), then in the "
@@ -273,11 +276,10 @@ _PARAMETER_HEAD = ("<tr><th class='text'>parameter</th><th class='text'>unit</th
 
 
 def _flags(s: dict) -> list[str]:
-    """'not determined: …' or 'poorly determined' for one summary (of
+    """'not determined: …' and 'poorly determined', those that apply, for one summary (of
     :func:`~bayesfo.comparison.parameters.with_determination`)."""
-    if s.get("not_determined"):
-        return [f"not determined: {s['not_determined_reason']}"]
-    return ["poorly determined"] if s.get("poorly_determined") else []
+    return ([f"not determined: {s['not_determined_reason']}"] if s.get("not_determined")
+            else []) + (["poorly determined"] if s.get("poorly_determined") else [])
 
 
 def _physical_table(block: dict) -> str:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from .comparison.parameters import UNDETERMINED_DECADES
+from .comparison.parameters import UNDETERMINED_DECADES, flagged_names
 from .comparison.table import ORDER_SYMBOLS
 
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
@@ -193,12 +193,15 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     if poor:
         out.append(("The fractional order is poorly determined (HDI wider than half the prior "
                     f"range) for: {', '.join(poor)}.", True))
-    vague = [f"{r['structure']} ({', '.join(names)})" for r in rows[1:]
+    # Every ranked structure, the winner first, named as the terminal names them (the form
+    # natural to the data), whether or not a sentence above gave its values.
+    vague = [f"{r['structure']} ({', '.join(names)})" for r in rows
              if (names := _undetermined(comparison[r["structure"]]))]
     if vague:
         out.append((f"Parameters that the data do not determine ({HDI_PERCENT} % HDI over more "
-                    f"than {UNDETERMINED_DECADES:g} decades, or reaching 0 or infinity; their "
-                    f"numbers are not estimates): {'; '.join(vague)}.", True))
+                    f"than {UNDETERMINED_DECADES:g} decades on a log scale, reaching 0 or "
+                    "infinity, or undefined; their numbers are not estimates): "
+                    f"{'; '.join(vague)}.", True))
     if not best["converged"]:
         post = result.posterior
         out.append((f"Caution: the posterior of {name} did not converge (R-hat "
@@ -229,10 +232,11 @@ def verdict(comparison) -> list[tuple[str, bool]]:
 
 def _undetermined(result) -> list[str]:
     """The parameters of ``result``, in the form natural to the data, that the data do not
-    determine (:func:`~bayesfo.comparison.parameters.not_determined`)."""
+    determine (:func:`~bayesfo.comparison.parameters.not_determined`): the names the terminal
+    lists beneath the ranking."""
     if getattr(result, "posterior", None) is None:
         return []
-    return [n for n, s in result.natural_parameters.items() if s.get("not_determined")]
+    return flagged_names(result.natural_parameters)
 
 
 def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
@@ -243,10 +247,12 @@ def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
         return []
     parts, vague = [], []
     for p, s in phys["physical"].items():
-        if p == skip or not _finite(s.get("median")):
+        if p == skip:
             continue
-        if s.get("not_determined"):
+        if s.get("not_determined"):  # before the value: an undefined median is named too
             vague.append(f"{p} ({s['not_determined_reason']})")
+            continue
+        if not _finite(s.get("median")):
             continue
         unit = f" {s['unit']}" if s["unit"] else ""
         hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"

@@ -137,14 +137,14 @@ def _units_note(path, kind: str) -> str:
 def _print_undetermined(result) -> None:
     """Beneath the table: the parameters (in the form natural to the data) that the data do
     not determine, and the poorly determined orders, of each structure, best first."""
-    from ..comparison.parameters import UNDETERMINED_DECADES
+    from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names
 
     vague, poor = [], []
     for row in result.table():
         if row.get("error"):
             continue
         r = result[row["structure"]]
-        names = [n for n, s in r.natural_parameters.items() if s.get("not_determined")]
+        names = flagged_names(r.natural_parameters)
         if names:
             vague.append(f"{r.name}: {', '.join(names)}")
         orders = [n for n in r.structure.exponent_params
@@ -153,8 +153,8 @@ def _print_undetermined(result) -> None:
             poor.append(f"{r.name}: {', '.join(orders)}")
     if vague:
         print(f"not determined by the data (94 % HDI over more than {UNDETERMINED_DECADES:g} "
-              "decades, or reaching 0 or infinity; the values in the report, summary.json and "
-              "ranking.csv are not estimates): " + "; ".join(vague))
+              "decades on a log scale, reaching 0 or infinity, or undefined; the values in the "
+              "report, summary.json and ranking.csv are not estimates): " + "; ".join(vague))
     if poor:
         print("orders poorly determined (94 % HDI wider than half the prior range): "
               + "; ".join(poor))

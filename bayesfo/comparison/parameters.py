@@ -64,62 +64,143 @@ def summarise_draws(values, map_value, unit: str) -> dict:
                   "map": float(map_value)}
 
 
-#: A quantity with a unit is not determined by the data when its HDI spans more than this many
-#: decades (:func:`not_determined`).
+#: A quantity with a unit is not determined by the data when the 94 % HDI of its decimal
+#: logarithm spans more than this many decades (:func:`not_determined`).
 UNDETERMINED_DECADES = 2.0
 
 
-def not_determined(summary: dict) -> str | None:
+def not_determined(summary: dict, draws=None) -> str | None:
     """Why the data do not determine the quantity of ``summary`` (:func:`summarise_draws`), or
     None where they do.
 
+    Parameters
+    ----------
+    summary : dict
+        The quantity's summary: its ``unit`` and, where ``draws`` are not given, its
+        ``hdi_low`` and ``hdi_high``.
+    draws : array_like, optional
+        The quantity's posterior draws. Where given (as they are for every summary a comparison
+        writes), a positive quantity is judged on the HDI of ``log10(draws)``; without them,
+        on ``log10`` of the HDI's ends.
+
+    Returns
+    -------
+    str or None
+        The reason, in words (``"its 94 % HDI on a log scale spans 2.8 decades"``), or None.
+
+    Notes
+    -----
     Only quantities with a unit are judged here: moduli, quasi-properties, times, the card's
-    coefficients, σ. Such a quantity is positive, so its 94 % HDI is read on a log scale: it is
-    not determined when the HDI spans more than :data:`UNDETERMINED_DECADES` decades (a factor of
-    100), or runs to 0 or to infinity (draws that underflow or overflow, as a time
-    (b1/a1)^(1/α) does when the order α runs into its prior bound at 0).
+    coefficients, σ. Pure numbers (orders, ``sigma_rel``) are judged against their prior
+    instead (``poorly_determined``: the HDI covers more than half of the prior range).
+
+    *Positive quantities* (all draws ≥ 0; a draw at 0 or infinity is one that underflowed or
+    overflowed, as a time (b1/a1)^(1/α) does when the order α runs into its prior bound at 0)
+    are judged on a log scale: not determined when the 94 % HDI of ``log10(draws)`` spans more
+    than :data:`UNDETERMINED_DECADES` decades (a factor of 100), or runs to 0 or infinity.
+    The HDI is taken of the logarithms, not read off the HDI of the values, so that a quantity
+    and its reciprocal (b0 and G_e = 1/b0) get the same verdict: the HDI of the values leans
+    towards small values and spans more decades than that of the logarithms (for a lognormal
+    posterior with a log-scale HDI 1.50 decades wide, the values' HDI spans 1.98). The
+    ``hdi_low``/``hdi_high`` of the summary stay the HDI of the values.
+
+    *Signed quantities* (some draws below 0): not determined when the HDI of the values reaches
+    0 or across it (the data do not fix even the sign); otherwise, the sign being fixed, the
+    draws of that sign are judged as a positive quantity on their magnitudes. Draws that are
+    all ≤ 0 are judged on their magnitudes.
+
+    *Undefined draws*: a quantity that is NaN (undefined, e.g. a time of a negative ratio) at
+    more than 6 % of the draws, the share outside a 94 % HDI, has no 94 % HDI and is not
+    determined; so is one with fewer than two defined draws. Without draws, an HDI that is
+    NaN is likewise not determined. Fewer NaN draws are left out.
 
     The threshold is a judgement: a quantity known only to within more than a factor of 100
-    has no order of magnitude that the data fix. It lies in the gap seen on real data (the
-    default structures on the 20 °C isotherm of the 3M 468MP adhesive and on pyRheo's chia
-    gel): the quantities the data fix had HDIs of 0.01 to 1.6 decades, those of structures
-    with more freedom than the data need 2.1 decades or more, or ran to 0 (a Zener reduced
-    to a Voigt: G_m 2.1–2.5 and τ 2.9–5.3 decades; the fractional Maxwell's c_β, c_δ 3.3–4.0
-    decades, its τ and E from 0 to 1e38–1e72; the integer Maxwell on the gel, whose time
-    lies beyond the lowest frequency: c_β and τ 2.2 decades). A quantity near the threshold
-    can fall on either side from one seed to another. Pure numbers (orders, ``sigma_rel``)
-    are judged against their prior instead (``poorly_determined``: the HDI covers more than
-    half of the prior range). A quantity whose HDI reaches below 0 is a signed one and is
-    not judged.
+    has no order of magnitude that the data fix. It lies in the gap measured on real data, the
+    default structures at seed 0 on the 20 °C isotherm of the 3M 468MP adhesive and on pyRheo's
+    chia gel: the log-scale HDIs of the quantities with units spanned 0.009 to 1.85 decades
+    below the threshold and 2.9 or more above it. Above: the time τ of a Zener reduced to a
+    Voigt (2.9 and 4.6 decades) and every quantity of the fractional Maxwell, whose order ran to
+    0 (c_β 3.6–3.8, c_δ 3.2–4.0, b1 7.1–7.9, τ and E 42 to 251 decades: draws up to 1e250).
+    Highest below: the Zener's G_m and b1 (1.6–1.8 decades), which the data bound on one side
+    only, and the integer Maxwell on the gel, whose time lies beyond the lowest frequency (c_β
+    and τ 1.8); the HDIs of the values had put those at 2.0–2.5 decades. A quantity near the
+    threshold can fall on either side from one seed to another. A quantity bounded by the data
+    on one side only is judged by how far its posterior spreads on the log scale, which its
+    prior shapes: a coefficient under a uniform prior that the data bound only from above has
+    most of its draws within a decade or two of that bound.
     """
     if not summary.get("unit"):
         return None
-    lo, hi = summary.get("hdi_low"), summary.get("hdi_high")
-    if lo is None or hi is None or math.isnan(lo) or math.isnan(hi) or lo < 0:
-        return None
     percent = f"{100 * HDI_PROB:g} %"
+    if draws is None:
+        return _judged_on_summary(summary, percent)
+    x = np.asarray(draws, dtype=float).ravel()
+    defined = x[~np.isnan(x)]
+    share = 1.0 - defined.size / x.size if x.size else 1.0
+    if defined.size < 2 or share > 1.0 - HDI_PROB:
+        return f"it is undefined at {100 * share:.0f} % of the draws"
+    if np.any(defined < 0):
+        if np.all(defined <= 0):
+            defined = -defined
+        else:
+            lo, hi = (float(v) for v in _hdi(defined))
+            if lo <= 0 <= hi:
+                return (f"its {percent} HDI runs from {_bound(lo)} to {_bound(hi)}, across 0: "
+                        "the data do not fix its sign")
+            defined = np.abs(defined[defined > 0] if lo > 0 else defined[defined < 0])
+    with np.errstate(divide="ignore"):
+        lo, hi = (float(v) for v in _hdi(np.log10(defined)))
+    return _judged(10.0 ** lo if math.isfinite(lo) else (0.0 if lo < 0 else math.inf),
+                   10.0 ** hi if math.isfinite(hi) else (0.0 if hi < 0 else math.inf),
+                   hi - lo if math.isfinite(lo) and math.isfinite(hi) else math.inf, percent)
+
+
+def _hdi(x):
+    from ..inference._arviz import arviz
+
+    with np.errstate(invalid="ignore"):  # inf - inf among the candidate widths
+        return arviz().hdi(x, hdi_prob=HDI_PROB)
+
+
+def _judged_on_summary(summary: dict, percent: str) -> str | None:
+    """:func:`not_determined` from the ends of the HDI of the values alone (no draws)."""
+    lo, hi = summary.get("hdi_low"), summary.get("hdi_high")
+    if lo is None or hi is None or math.isnan(lo) or math.isnan(hi):
+        return f"its {percent} HDI is undefined"
+    if lo <= 0 <= hi and lo < 0:
+        return (f"its {percent} HDI runs from {_bound(lo)} to {_bound(hi)}, across 0: the "
+                "data do not fix its sign")
+    lo, hi = sorted((abs(lo), abs(hi)))
+    with np.errstate(divide="ignore"):
+        decades = float(np.log10(hi) - np.log10(lo)) if 0 < lo and hi < math.inf else math.inf
+    return _judged(lo, hi, decades, percent)
+
+
+def _judged(lo: float, hi: float, decades: float, percent: str) -> str | None:
     if lo == 0 or math.isinf(hi):
-        return (f"its {percent} HDI runs from {_bound(lo)} to {_bound(hi)}"
-                if hi > 0 else None)
-    decades = math.log10(hi) - math.log10(lo)
+        return f"its {percent} HDI runs from {_bound(lo)} to {_bound(hi)}"
     if decades > UNDETERMINED_DECADES:
-        return f"its {percent} HDI spans {decades:.1f} decades"
+        return f"its {percent} HDI on a log scale spans {decades:.1f} decades"
     return None
 
 
 def _bound(x: float) -> str:
-    return "infinity" if math.isinf(x) else "0" if x == 0 else f"{x:.3g}"
+    return ("infinity" if x == math.inf else "-infinity" if x == -math.inf
+            else "0" if x == 0 else f"{x:.3g}")
 
 
-def with_determination(block: dict, poorly_determined=None) -> dict:
+def with_determination(block: dict, poorly_determined=None, draws=None) -> dict:
     """``block`` (``{name: summary}``) with ``not_determined`` (bool) and
     ``not_determined_reason`` (:func:`not_determined`, None where determined) in each summary,
     and ``poorly_determined`` copied from ``poorly_determined`` (``{name: bool}`` of the
-    sampled parameters) for the names it holds."""
+    sampled parameters) for the names it holds. ``draws`` (``{name: draws}``) are the draws
+    each quantity is judged on (:func:`not_determined`); a name without them is judged on its
+    summary's HDI."""
     poorly_determined = poorly_determined or {}
+    draws = draws or {}
     out = {}
     for name, s in block.items():
-        reason = not_determined(s)
+        reason = not_determined(s, draws.get(name))
         out[name] = dict(s) | {"not_determined": reason is not None,
                                "not_determined_reason": reason}
         if name in poorly_determined:
@@ -166,7 +247,8 @@ def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: s
 
     def block(form, at):
         return with_determination({n: summarise_draws(v, at[n][0], u)
-                                   for n, (v, u) in form.items()}, poorly_determined)
+                                   for n, (v, u) in form.items()}, poorly_determined,
+                                  draws={n: v for n, (v, _) in form.items()})
 
     has_picture = bool(structure.pictures)
     phys = block(physical, map_physical) if has_picture else block(coefficients, map_coefficients)
@@ -180,14 +262,29 @@ def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: s
 
 def physical_text(block: dict, key: str = "median") -> str:
     """``"G_e=1.2e+05 Pa; c_q=3.4e+04 Pa s^q; q=0.57"``: one value of each parameter of a block
-    of :func:`physical_forms` (undefined values are left out), ``(not determined)`` or
-    ``(poorly determined)`` after a value the data do not fix."""
+    of :func:`physical_forms` (undefined values are left out). The text is ``name=value unit``
+    and nothing else (scripts parse it); whether the data determine a value is in the block's
+    flags (:func:`flagged_names`)."""
     parts = []
     for name, s in (block or {}).items():
         v = s.get(key)
         if v is None or not math.isfinite(v):
             continue
-        flag = (" (not determined)" if s.get("not_determined")
-                else " (poorly determined)" if s.get("poorly_determined") else "")
-        parts.append(f"{name}={v:.4g}" + (f" {s['unit']}" if s.get("unit") else "") + flag)
+        parts.append(f"{name}={v:.4g}" + (f" {s['unit']}" if s.get("unit") else ""))
     return "; ".join(parts)
+
+
+def flagged_names(block: dict, flag: str = "not_determined") -> list[str]:
+    """The names in ``block`` (``{name: summary}``) whose summary has ``flag`` set
+    (``"not_determined"`` or ``"poorly_determined"``), in the block's order."""
+    return [name for name, s in (block or {}).items() if s.get(flag)]
+
+
+def natural_block(record: dict) -> dict:
+    """The parameters of a structure's ``summary.json`` record in the form natural to the data:
+    ``parameters_physical`` where ``natural_form`` is ``"physical"``, else ``parameters`` (the
+    card's coefficients and the noise, as sampled). The terminal, the verdict and the
+    ``not_determined`` column of ``ranking.csv`` name the parameters of this form."""
+    if record.get("natural_form") == "physical" and record.get("parameters_physical"):
+        return record["parameters_physical"]
+    return record.get("parameters") or {}

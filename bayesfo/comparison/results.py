@@ -93,14 +93,17 @@ class StructureResult:
         """``{name: summary}`` of the parameters as sampled (the card's coefficients and the
         noise): ``ParameterSummary.to_dict()``, the unit where the data's kind is known, and
         ``not_determined``/``not_determined_reason``
-        (:func:`~bayesfo.comparison.parameters.not_determined`); empty without a posterior."""
+        (:func:`~bayesfo.comparison.parameters.not_determined`, judged on the draws); empty
+        without a posterior."""
         post = self.posterior
         if post is None:
             return {}
         units = self.units
         block = {k: v.to_dict() | ({"unit": units[k]} if k in units else {})
                  for k, v in post.summary.items()}
-        return with_determination(block)
+        draws = {k: post.samples[:, post.param_names.index(k)] for k in block
+                 if k in post.param_names}
+        return with_determination(block, draws=draws)
 
     @property
     def natural_parameters(self) -> dict:
@@ -181,7 +184,8 @@ class StructureResult:
                                         units.get(n, ""))
                      for n in post.param_names if n not in s.param_names}
             block.update(with_determination(
-                noise, {n: post.summary[n].poorly_determined for n in noise}))
+                noise, {n: post.summary[n].poorly_determined for n in noise},
+                draws={n: post.samples[:, post.param_names.index(n)] for n in noise}))
         else:
             block = self.sampled_parameters
         if block:
@@ -189,10 +193,11 @@ class StructureResult:
             lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI")
             for n, v in block.items():
                 unit = f" {v['unit']}" if v.get("unit") else ""
-                flag = (f"  (not determined: {v['not_determined_reason']})"
-                        if v.get("not_determined") else
-                        "  (poorly determined: the HDI covers more than half of the prior "
-                        "range)" if v.get("poorly_determined") else "")
+                flags = ([f"not determined: {v['not_determined_reason']}"]
+                         if v.get("not_determined") else []) + (
+                    ["poorly determined: the HDI covers more than half of the prior range"]
+                    if v.get("poorly_determined") else [])
+                flag = f"  ({'; '.join(flags)})" if flags else ""
                 lines.append(f"  {n:<{width}}  {_fmt(v.get('median'), '11.4g')}  "
                              f"[{_fmt(v.get('hdi_low'), '.4g')}, {_fmt(v.get('hdi_high'), '.4g')}]"
                              f"{unit}{flag}")

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-from .parameters import physical_text
+from .parameters import flagged_names, natural_block, physical_text
 
 #: The parameters that name a structure's fractional order, in order of preference: the
 #: commensurate order ``q``; ``beta`` (the generalised Maxwell model's order; the lower order
@@ -111,6 +111,11 @@ def ranking_rows(structures, ranking) -> list[dict]:
             "error": "",
             # Posterior medians of the physical parameters, with units, as one text cell.
             "physical_parameters": physical_text(s.get("parameters_physical")),
+            # The parameters (in the form natural to the data) that the data do not determine,
+            # and those whose HDI covers more than half of their prior range.
+            "not_determined": "; ".join(flagged_names(natural_block(s))),
+            "poorly_determined": "; ".join(flagged_names(natural_block(s),
+                                                         "poorly_determined")),
         })
     return rows
 
@@ -122,5 +127,6 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "holdout_lpd", "holdout_rmse", "q_mean",
                   "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
                   "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
-                  "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se")
+                  "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se",
+                  "not_determined", "poorly_determined")
 

@@ -16,6 +16,7 @@ import csv
 import dataclasses
 import json
 import math
+import re
 import warnings
 
 import matplotlib
@@ -31,6 +32,7 @@ from bayesfo.comparison import RANKING_FIELDS  # noqa: E402
 from bayesfo.comparison.parameters import (  # noqa: E402
     UNDETERMINED_DECADES,
     not_determined,
+    summarise_draws,
 )
 from bayesfo.comparison.results import (  # noqa: E402
     parameter_units,
@@ -38,6 +40,7 @@ from bayesfo.comparison.results import (  # noqa: E402
     physical_text,
 )
 from bayesfo.data import FrequencyResponse  # noqa: E402
+from bayesfo.inference._arviz import arviz  # noqa: E402
 from bayesfo.plotting import plot_corner, plot_trace  # noqa: E402
 from bayesfo.plotting._compute import param_symbol, unit_mathtext  # noqa: E402
 from bayesfo.report import render_report, verdict  # noqa: E402
@@ -145,7 +148,8 @@ def test_the_parameters_block_is_unchanged_and_gains_units(zener_run):
 def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_run):
     result, out = zener_run
     assert RANKING_FIELDS[: len(OLD_RANKING_FIELDS)] == OLD_RANKING_FIELDS
-    assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == ("physical_parameters", "delta_loo_se")
+    assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == (
+        "physical_parameters", "delta_loo_se", "not_determined", "poorly_determined")
     with (out / "ranking.csv").open(newline="") as fh:
         (row,) = list(csv.DictReader(fh))
     text = row["physical_parameters"]
@@ -287,19 +291,87 @@ def test_report_shows_units_and_the_physical_form(zener_run):
 # ---------------------------------------------------------------------- not determined by the data
 def test_not_determined_reads_the_hdi_of_a_quantity_with_a_unit_on_a_log_scale():
     assert UNDETERMINED_DECADES == 2.0
+    # Without draws (a summary alone), the decades between the ends of the HDI.
     assert not_determined({"unit": "Pa", "hdi_low": 1.64e8, "hdi_high": 2.11e10}) == (
-        "its 94 % HDI spans 2.1 decades")
+        "its 94 % HDI on a log scale spans 2.1 decades")
     assert not_determined({"unit": "Pa", "hdi_low": 1.0e3, "hdi_high": 9.9e4}) is None
     # As the fractional Maxwell's tau on the 20 °C adhesive isotherm: its order ran to 0.
     assert not_determined({"unit": "s", "hdi_low": 0.0, "hdi_high": 2.1e61}) == (
         "its 94 % HDI runs from 0 to 2.1e+61")
     assert not_determined({"unit": "s", "hdi_low": 3e-11, "hdi_high": math.inf}) == (
         "its 94 % HDI runs from 3e-11 to infinity")
-    # Orders are judged against their prior (poorly_determined); signed and undefined HDIs
-    # are not judged.
+    # Orders are judged against their prior (poorly_determined).
     assert not_determined({"unit": "", "hdi_low": 2.6e-6, "hdi_high": 0.7}) is None
-    assert not_determined({"unit": "Pa", "hdi_low": -5.0, "hdi_high": 1e6}) is None
-    assert not_determined({"unit": "Pa", "hdi_low": math.nan, "hdi_high": math.nan}) is None
+    # A signed quantity whose HDI reaches across 0: not even its sign is fixed.
+    assert not_determined({"unit": "Pa", "hdi_low": -5.0, "hdi_high": 1e6}) == (
+        "its 94 % HDI runs from -5 to 1e+06, across 0: the data do not fix its sign")
+    # An undefined HDI is not taken for a determined quantity.
+    assert not_determined({"unit": "Pa", "hdi_low": math.nan, "hdi_high": math.nan}) == (
+        "its 94 % HDI is undefined")
+
+
+def _lognormal(width: float, n: int = 40_000, seed: int = 0):
+    """Draws whose log10 is normal with a 94 % HDI ``width`` decades wide."""
+    from scipy.stats import norm
+
+    sd = width / (2 * norm.ppf(0.97))
+    return 10.0 ** np.random.default_rng(seed).normal(-3.0, sd, n)
+
+
+def test_not_determined_takes_the_hdi_of_the_logarithms_of_the_draws():
+    # The HDI of the values leans towards small values: for a log-scale width of 1.8 decades
+    # it spans about 2.5, and the rule read on it would flag a quantity the data fix to 1.8.
+    x = _lognormal(1.8)
+    s = summarise_draws(x, 1e-3, "Pa")
+    assert math.log10(s["hdi_high"] / s["hdi_low"]) > 2.3
+    assert not_determined(s, x) is None
+    y = _lognormal(2.2)
+    (width,) = re.fullmatch(r"its 94 % HDI on a log scale spans (\S+) decades",
+                            not_determined(summarise_draws(y, 1e-3, "Pa"), y)).groups()
+    assert float(width) == pytest.approx(2.2, abs=0.05)  # Monte Carlo error about 0.02
+
+
+def test_a_quantity_and_its_reciprocal_get_the_same_verdict():
+    # b0 of a Voigt and G_e = 1/b0 (as on the stored Tp150C run, whose b0 HDI spans 1.3
+    # decades and G_e's 2.8): a log10 with a long upper tail.
+    rng = np.random.default_rng(4)
+    voigt = get_structure("voigt")
+    for scale in (0.4, 0.8):
+        b0 = 10.0 ** (-4.0 + rng.gamma(2.0, scale, 20_000))
+        draws = {"a1": np.full(b0.size, 10.0), "b0": b0, "q": np.full(b0.size, 0.3)}
+        forms = physical_forms(voigt, draws, {"a1": 10.0, "b0": 1e-3, "q": 0.3}, "modulus", "Pa")
+        g_e, b = forms["physical"]["G_e"], forms["other"]["b0"]
+        # The values' HDIs disagree by 2 decades or more (b0's under 2, G_e's over it for
+        # the narrower posterior), ...
+        spans = [math.log10(p["hdi_high"] / p["hdi_low"]) for p in (b, g_e)]
+        assert spans[1] - spans[0] > 2.0
+        if scale == 0.4:
+            assert spans[0] < UNDETERMINED_DECADES < spans[1]
+        # ... the verdicts do not.
+        assert g_e["not_determined"] == b["not_determined"]
+        assert g_e["not_determined_reason"] == b["not_determined_reason"]
+        assert not_determined({"unit": "Pa"}, 1 / b0) == not_determined({"unit": "1/Pa"}, b0)
+    assert [forms["physical"]["G_e"]["not_determined"]] == [True]  # the wider of the two
+
+
+def test_undefined_zero_infinite_and_signed_draws():
+    x = _lognormal(1.0)
+    some_nan, many_nan = x.copy(), x.copy()
+    some_nan[:400] = np.nan  # 1 %: left out
+    many_nan[:4000] = np.nan  # 10 %, more than the 6 % outside a 94 % HDI
+    assert not_determined({"unit": "s"}, some_nan) is None
+    assert not_determined({"unit": "s"}, many_nan) == "it is undefined at 10 % of the draws"
+    assert not_determined({"unit": "s"}, np.full(100, np.nan)) == (
+        "it is undefined at 100 % of the draws")
+    overflow = np.r_[x, np.full(x.size // 5, np.inf)]  # a time whose order ran to 0
+    assert not_determined({"unit": "s"}, overflow).endswith("to infinity")
+    underflow = np.r_[x, np.zeros(x.size // 5)]
+    assert not_determined({"unit": "s"}, underflow).startswith("its 94 % HDI runs from 0 to ")
+    rng = np.random.default_rng(1)
+    assert not_determined({"unit": "Pa"}, rng.normal(0.0, 1.0, 5000)).endswith(
+        "across 0: the data do not fix its sign")
+    assert not_determined({"unit": "Pa"}, -x) is None  # negative, magnitude fixed
+    assert not_determined({"unit": "Pa"}, np.r_[-x[:10], x]) is None  # a few strays
 
 
 @pytest.fixture(scope="module")
@@ -323,21 +395,32 @@ def test_parameters_the_data_do_not_determine_are_marked(zener_on_voigt):
     phys = s["parameters_physical"]
     marked = {n for n, p in phys.items() if p["not_determined"]}
     assert marked == {"G_m", "tau"}
+    r = result["zener"]
+    post = r.posterior
+    draws = zener_by_hand(*(post.samples[:, post.param_names.index(n)]
+                            for n in ("a1", "b0", "b1", "q")))
     for name in ("G_m", "tau"):
         p = phys[name]
-        decades = math.log10(p["hdi_high"] / p["hdi_low"])
-        assert decades > UNDETERMINED_DECADES
-        assert p["not_determined_reason"] == f"its 94 % HDI spans {decades:.1f} decades"
+        lo, hi = arviz().hdi(np.log10(draws[name]), hdi_prob=0.94)
+        assert hi - lo > UNDETERMINED_DECADES
+        assert p["not_determined_reason"] == (
+            f"its 94 % HDI on a log scale spans {hi - lo:.1f} decades")
     assert phys["G_e"]["not_determined_reason"] is None
     assert phys["q"]["poorly_determined"] is False  # the order, judged against its prior
     assert abs(phys["G_e"]["median"] - 1000.0) < 50.0  # what the data do fix, unmarked
     with (out / "ranking.csv").open(newline="") as fh:
         (row,) = list(csv.DictReader(fh))
+    # ranking.csv: the physical_parameters column is name=value unit as before; the names the
+    # data do not determine are in a column of their own.
     cells = dict(part.split("=") for part in row["physical_parameters"].split("; "))
-    assert cells["G_m"].endswith(" Pa (not determined)")
-    assert cells["tau"].endswith(" s (not determined)") and cells["G_e"].endswith(" Pa")
+    assert list(cells) == ["G_e", "G_m", "c_q", "q", "tau"]
+    for name, cell in cells.items():
+        value, *unit = cell.split(" ", 1)
+        assert float(value) == pytest.approx(phys[name]["median"], rel=1e-3)
+        assert unit == ([phys[name]["unit"]] if phys[name]["unit"] else [])
+    assert row["not_determined"] == "G_m; tau"
+    assert row["poorly_determined"] == ""
     # The result's own summary, the report and the verdict say so instead of a bare number.
-    r = result["zener"]
     line = next(ln for ln in r.summary().splitlines() if ln.strip().startswith("G_m"))
     assert line.endswith(f"Pa  (not determined: {phys['G_m']['not_determined_reason']})")
     text = render_report(result)
@@ -350,6 +433,9 @@ def test_parameters_the_data_do_not_determine_are_marked(zener_on_voigt):
              f"({phys['tau']['not_determined_reason']}) of zener: their values are not "
              "estimates.")
     assert sentences[vague] is True  # flagged as a caution
+    # The list of every structure's undetermined parameters includes the winner's.
+    listed = next(t for t in sentences if t.startswith("Parameters that the data do not"))
+    assert listed.endswith(": zener (G_m, tau).") and sentences[listed] is True
 
 
 def test_compare_names_the_parameters_the_data_do_not_determine(zener_on_voigt, capsys):
@@ -358,9 +444,67 @@ def test_compare_names_the_parameters_the_data_do_not_determine(zener_on_voigt, 
     result, _ = zener_on_voigt
     _print_undetermined(result)
     assert capsys.readouterr().out == (
-        "not determined by the data (94 % HDI over more than 2 decades, or reaching 0 or "
-        "infinity; the values in the report, summary.json and ranking.csv are not estimates): "
-        "zener: G_m, tau\n")
+        "not determined by the data (94 % HDI over more than 2 decades on a log scale, reaching "
+        "0 or infinity, or undefined; the values in the report, summary.json and ranking.csv "
+        "are not estimates): zener: G_m, tau\n")
+
+
+@pytest.fixture(scope="module")
+def inverted_on_voigt():
+    """The zener-inv card (a modulus (b0 + b1 s^q) / (1 + a1 s^q), which has no physical
+    picture) alone on two decades of a Voigt modulus below its corner frequency: the data bound
+    a1 only from above, and its log-uniform prior spreads it over decades below."""
+    w = np.logspace(-2, 0, 12)
+    g = 1 / get_structure("voigt").response([1.0, 1e-3, 0.5], w, "compliance")
+    noisy, sd = _noisy(g, 0.05, 1)  # seed 0 gives a point of negative loss
+    data = FrequencyResponse(w, noisy, sd, kind="modulus", units="Pa", name="voigt modulus")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
+        return bf.compare(data, "zener-inv", seed=0, workers=1, progress=False)
+
+
+def test_the_verdict_names_the_undetermined_parameters_of_a_winner_without_a_picture(
+        inverted_on_voigt, capsys):
+    from bayesfo.cli.compare import _print_undetermined
+
+    r = inverted_on_voigt["zener-inv"]
+    assert r.physical["picture"] is None
+    names = [n for n, s in r.natural_parameters.items() if s["not_determined"]]
+    assert names == ["a1"]
+    listed = [t for t, flagged in verdict(inverted_on_voigt)
+              if t.startswith("Parameters that the data do not determine") and flagged]
+    assert listed == [
+        "Parameters that the data do not determine (94 % HDI over more than 2 decades on a log "
+        "scale, reaching 0 or infinity, or undefined; their numbers are not estimates): "
+        "zener-inv (a1)."]
+    _print_undetermined(inverted_on_voigt)  # the terminal names the same ones
+    assert "zener-inv: a1\n" in capsys.readouterr().out
+
+
+def test_a_parameter_without_a_finite_median_is_named_not_dropped():
+    from types import SimpleNamespace
+
+    from bayesfo.verdict import _physical_sentence
+
+    def summary(median, reason=None):
+        return {"unit": "s", "median": median, "hdi_low": 1.0, "hdi_high": math.inf,
+                "not_determined": reason is not None, "not_determined_reason": reason}
+
+    result = SimpleNamespace(physical={"picture": "p", "physical": {
+        "G_e": summary(10.0) | {"unit": "Pa", "hdi_high": 20.0},
+        "tau": summary(math.inf, "its 94 % HDI runs from 1 to infinity")}})
+    (values, _), (vague, flagged) = _physical_sentence("x", result)
+    assert "G_e = 10 Pa" in values and "tau" not in values
+    assert vague.startswith("The data do not determine tau (its 94 % HDI runs from 1 to "
+                            "infinity) of x") and flagged
+
+
+def test_the_report_shows_both_flags_of_a_parameter():
+    from bayesfo.report import _flags
+
+    s = {"not_determined": True, "not_determined_reason": "its 94 % HDI runs from 0 to 3",
+         "poorly_determined": True}
+    assert _flags(s) == ["not determined: its 94 % HDI runs from 0 to 3", "poorly determined"]
 
 
 def _modulus_csv(tmp_path):

@@ -75,18 +75,24 @@ def _noisy(g, rel_sd, seed):
     return g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size)), sd
 
 
+def _compared(tmp_path_factory, data, structures: str, *, seed: int, folder: str):
+    """``compare`` on ``data`` (predictive warnings ignored) and its outputs without figures in
+    a new folder: (result, folder)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
+        result = bf.compare(data, structures, seed=seed, workers=1, progress=False)
+    out = tmp_path_factory.mktemp(folder)
+    bf.write_outputs(result, out, figures=False)
+    return result, out
+
+
 @pytest.fixture(scope="module")
 def zener_run(tmp_path_factory):
     """A fractional Zener modulus in MPa, 1 % noise with σ known, run through compare."""
     g = get_structure("zener").response(np.array([ZENER]), W, "modulus")[0]
     noisy, sd = _noisy(g, 0.01, 1)
     data = FrequencyResponse(W, noisy, sd, kind="modulus", units="MPa", name="zener sim")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
-        result = bf.compare(data, "zener", seed=0, workers=1, progress=False)
-    out = tmp_path_factory.mktemp("zener")
-    bf.write_outputs(result, out, figures=False)
-    return result, out
+    return _compared(tmp_path_factory, data, "zener", seed=0, folder="zener")
 
 
 @pytest.fixture(scope="module")
@@ -381,12 +387,7 @@ def zener_on_voigt(tmp_path_factory):
     g = 1 / get_structure("voigt").response([1.0, 1e-3, 0.5], W, "compliance")
     noisy, sd = _noisy(g, 0.05, 0)
     data = FrequencyResponse(W, noisy, sd, kind="modulus", units="Pa", name="voigt modulus")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
-        result = bf.compare(data, "zener", seed=0, workers=1, progress=False)
-    out = tmp_path_factory.mktemp("zener_on_voigt")
-    bf.write_outputs(result, out, figures=False)
-    return result, out
+    return _compared(tmp_path_factory, data, "zener", seed=0, folder="zener_on_voigt")
 
 
 def test_parameters_the_data_do_not_determine_are_marked(zener_on_voigt):

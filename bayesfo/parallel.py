@@ -13,6 +13,7 @@ import ctypes
 import os
 import signal
 import sys
+import warnings
 from contextlib import contextmanager
 
 from .errors import InputError
@@ -246,7 +247,16 @@ class LazyPool:
         return self._pool
 
     def submit(self, fn, /, *args, **kwargs):
-        return self.start().submit(fn, *args, **kwargs)
+        if self._pool is not None:
+            return self._pool.submit(fn, *args, **kwargs)
+        pool = self.start()
+        with warnings.catch_warnings():
+            # The first task forks the workers. Python 3.12+ warns at any fork of a process
+            # with several OS threads; those here are the BLAS's idle threads, which cope
+            # with a fork (fork_safe: no other Python thread runs).
+            warnings.filterwarnings("ignore", message=".*multi-threaded.*fork",
+                                    category=DeprecationWarning)
+            return pool.submit(fn, *args, **kwargs)
 
 
 @contextmanager

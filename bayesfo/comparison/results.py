@@ -88,13 +88,14 @@ class StructureResult:
         except StructureError:
             return None
 
-    @property
+    @cached_property
     def sampled_parameters(self) -> dict:
         """``{name: summary}`` of the parameters as sampled (the card's coefficients and the
         noise): ``ParameterSummary.to_dict()``, the unit where the data's kind is known, and
         ``not_determined``/``not_determined_reason``
         (:func:`~bayesfo.comparison.parameters.not_determined`, judged on the draws); empty
-        without a posterior."""
+        without a posterior. Computed once, as :attr:`physical` is (the summary, the verdict
+        and the report all read it)."""
         post = self.posterior
         if post is None:
             return {}

@@ -36,11 +36,11 @@ import os
 import re
 import secrets
 import shutil
-import signal
 import time
 from pathlib import Path, PurePosixPath
 
 from ._io import atomic_write_text
+from ._signals import held
 from .errors import InputError, OutputError
 
 JOURNAL = ".bayesfo-swap.json"
@@ -311,19 +311,6 @@ def _locked(out_dir: Path):
 
 
 @contextlib.contextmanager
-def _signals_held():
-    """Ctrl-C and SIGTERM wait until the block is done (where the platform allows it)."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
-
-@contextlib.contextmanager
 def staged_run(out_dir):
     """Write one run's outputs into ``out_dir`` as one unit.
 
@@ -369,7 +356,7 @@ def staged_run(out_dir):
                 old.append(MANIFEST)
             # From the journal on, the swap only renames (milliseconds): Ctrl-C and SIGTERM
             # wait until it is done, and a SIGKILL in between is completed by the next run.
-            with _signals_held():
+            with held():
                 atomic_write_text(out_dir / JOURNAL, json.dumps(
                     {"format": _FORMAT, "staging": staging.name, "old": old,
                      "new": new + [MANIFEST]}))

@@ -41,7 +41,7 @@ import numpy as np
 
 from bayesfo.batch import expand_inputs, run_batch
 from bayesfo.data import FrequencyResponse
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.structures import get_structure
 
 
@@ -89,7 +89,7 @@ def main(argv=None):
                         help="also draw each data set's figures and report")
     args = parser.parse_args(argv)
 
-    arviz()
+    preload()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, "
           f"numpy {np.__version__}")
     with tempfile.TemporaryDirectory(prefix="bench-batch-") as tmp:

@@ -21,7 +21,7 @@ import warnings
 import numpy as np
 
 from bayesfo.comparison import compare
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.structures import resolve_structures
 from bayesfo.studies import g_spec_data
 
@@ -34,7 +34,7 @@ def main(argv=None):
     parser.add_argument("--workers", type=int, default=0, help="processes (default: one per CPU)")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    arviz()
+    preload()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}; "
           f"load {os.getloadavg()[0]:.2f}")
     data = g_spec_data(args.seed)

@@ -17,7 +17,7 @@ import numpy as np
 from bayesfo.comparison import compare, write_outputs
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.inference.evidence import nested_evidence
 from bayesfo.parallel import process_pool
 from bayesfo.structures import get_structure, resolve_structures
@@ -28,7 +28,7 @@ def main():
 
     matplotlib.use("Agg")
     warnings.simplefilter("ignore")
-    arviz()
+    preload()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}")
     w = np.logspace(-2, 3, 40)
     zener = get_structure("zener")

@@ -27,7 +27,7 @@ import numpy as np
 from bayesfo.comparison import compare
 from bayesfo.errors import InputError
 from bayesfo.inference import Likelihood
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.inference.evidence import ladder_evidence, nested_evidence
 from bayesfo.structures import resolve_structures
 from bayesfo.studies import g_spec_data
@@ -43,7 +43,7 @@ def main(argv=None):
     parser.add_argument("--no-nested", action="store_true", help="skip nested sampling")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    arviz()
+    preload()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}")
     data = g_spec_data(args.seed)
     print(f"{'structure':<12} {'bridge (draws)':>16} {'t [s]':>6} {'ladder':>16} {'t [s]':>6} "

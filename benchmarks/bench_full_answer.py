@@ -11,7 +11,7 @@
    worker processes start on demand, inside the clock) and, for comparison, two worker processes
    started before the clock, with both routes.
 
-Imports (arviz, emcee) are done before the clock starts. Usage: python benchmarks/bench_full_answer.py
+Imports (ArviZ, emcee) are done before the clock starts. Usage: python benchmarks/bench_full_answer.py
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 import bayesfo as bf
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.inference.evidence import nested_evidence
 from bayesfo.options import DEFAULT_STRUCTURES
 from bayesfo.parallel import process_pool
@@ -92,7 +92,7 @@ def six_structures() -> None:
 
 def main() -> None:
     warnings.simplefilter("ignore")
-    arviz()
+    preload()
     import emcee  # noqa: F401
 
     print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, python "

@@ -30,7 +30,7 @@ import numpy as np
 
 from bayesfo.identify.optimize import fit_structure
 from bayesfo.inference import Likelihood
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.importance import importance_posterior
 from bayesfo.inference.results import posterior_from_particles
@@ -55,7 +55,7 @@ def main(argv=None):
     parser.add_argument("variants", nargs="*", default=["{}", '{"max_moves": 50}'])
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    arviz()
+    preload()
     variants = [json.loads(v) for v in args.variants]
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy "
           f"{np.__version__}; load {os.getloadavg()[0]:.2f}")

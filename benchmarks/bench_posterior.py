@@ -13,12 +13,12 @@ import numpy as np
 
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import run_posterior
-from bayesfo.inference._arviz import arviz
+from bayesfo.inference._arviz import preload
 from bayesfo.structures import get_structure
 
 
 def main():
-    arviz()
+    preload()
     print(f"machine: {platform.machine()}, python {platform.python_version()}, numpy {np.__version__}")
     s = get_structure("zener")
     truth = np.array([0.5, 1.0, 0.05, 0.6])

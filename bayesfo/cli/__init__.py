@@ -17,6 +17,7 @@ import warnings
 import numpy as np
 
 from .. import __version__
+from .._signals import cause
 from ..errors import InputError, OutputError
 
 #: The commands, in the order of ``bayesfo --help``; each is the module ``bayesfo.cli.<name>``
@@ -62,6 +63,13 @@ class Terminated(BaseException):
 
 def _on_sigterm(signum, frame):
     raise Terminated
+
+
+def _interrupted(exc: BaseException) -> int:
+    """Exit status 130 after Ctrl-C, 143 after SIGTERM, with a one-line message."""
+    what, status = ("terminated", 143) if isinstance(exc, Terminated) else ("interrupted", 130)
+    print(f"bayesfo: {what} (no output is left half-written)", file=sys.stderr)
+    return status
 
 
 def _internal_error(exc: BaseException) -> int:
@@ -125,15 +133,14 @@ def main(argv=None) -> int:
     except OutputError as exc:
         print(f"bayesfo: error: {exc}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("bayesfo: interrupted (no output is left half-written)",
-              file=sys.stderr)
-        return 130
-    except Terminated:
-        print("bayesfo: terminated (no output is left half-written)",
-              file=sys.stderr)
-        return 143
+    except (KeyboardInterrupt, Terminated) as exc:
+        return _interrupted(exc)
     except Exception as exc:  # the contract: exit 1 on internal errors, no traceback by default
+        # A signal that broke an import (or a library's clean-up) shows as another exception
+        # raised from it: the user interrupted, and is told so.
+        signalled = cause(exc, (KeyboardInterrupt, Terminated))
+        if signalled is not None:
+            return _interrupted(signalled)
         return _internal_error(exc)
     finally:
         if previous is not None:

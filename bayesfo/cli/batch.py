@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from .._signals import load_libraries
 from ..batch import OK, BatchResult, expand_inputs, run_batch
 from ..options import (
     KINDS,
@@ -73,6 +74,7 @@ def run(args) -> int:
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,
                              seed=args.seed, exclude=args.out)
     progress = not args.quiet and sys.stderr.isatty()
+    load_libraries()  # the data sets are compared here or in processes forked from this one
     result = run_batch(datasets, args.out, workers=args.workers, scheduler=args.scheduler,
                        progress=progress)
     for o in result.failed:

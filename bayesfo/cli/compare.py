@@ -167,6 +167,7 @@ def _num(x, fmt: str = ".2f") -> str:
 
 
 def run(args) -> int:
+    from .._signals import load_libraries
     from ..outdir import check_output_directory
     from ..parallel import available_cpus
     from ..structures import resolve_structures
@@ -198,6 +199,7 @@ def run(args) -> int:
     target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
     created = not target.exists()
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
+    load_libraries(formats or ())
     try:
         result = _compare(data, structures, out, n_proc, args.workers, formats, args.no_figures,
                           options)

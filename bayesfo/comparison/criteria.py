@@ -11,11 +11,12 @@ from dataclasses import replace
 import numpy as np
 
 from ..data import FrequencyResponse
-from ..errors import EvidenceWarning, InputError, PredictiveWarning
+from ..errors import InputError, PredictiveWarning
 from ..identify.optimize import FitResult
 from ..inference import Likelihood, PosteriorResult
-from ..inference._arviz import arviz
-from ..inference.evidence import bridge_evidence, ladder_runs, nested_evidence
+from ..inference._arviz import loo as psis_loo
+from ..inference._arviz import waic as waic_of
+from ..inference.certified import LADDER_SHORTFALL  # noqa: F401  (bayesfo.comparison's name)
 
 PARETO_K_WARN = 0.7
 
@@ -28,28 +29,33 @@ def _frequencies(omega, shown: int = 6) -> str:
     return f"omega = {text} rad/s"
 
 
+def fit_log_likelihood(lik: Likelihood, fit: FitResult) -> float:
+    """The log-likelihood at the optimiser's optimum (with the maximum-likelihood noise for it);
+    -inf where the optimum is not admissible or lies outside the prior's support."""
+    theta_fit = np.atleast_2d(fit.theta_scaled)
+    if lik.noise_param:
+        theta_fit = np.column_stack([theta_fit, lik.noise_estimate(theta_fit)])
+    if not (fit.admissible and lik.in_support(theta_fit)[0]):
+        return -math.inf
+    return float(lik(theta_fit)[0])
+
+
 def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
-    az = arviz()
     n_real = 2 * lik.data.n_frequencies
     k = lik.ndim
     # Maximum log-likelihood: the sampler's best draw or the optimiser's optimum (with the
     # maximum-likelihood noise for that optimum), whichever is higher.
-    theta_fit = np.atleast_2d(fit.theta_scaled)
-    if lik.noise_param:
-        theta_fit = np.column_stack([theta_fit, lik.noise_estimate(theta_fit)])
-    ll_fit = float(lik(theta_fit)[0]) if fit.admissible and lik.in_support(theta_fit)[0] else -np.inf
-    max_ll = max(post.max_log_likelihood, ll_fit)
+    max_ll = max(post.max_log_likelihood, fit_log_likelihood(lik, fit))
     aic = 2 * k - 2 * max_ll
     aicc = aic + (2 * k * (k + 1) / (n_real - k - 1) if n_real - k - 1 > 0 else math.inf)
     bic = k * math.log(n_real) - 2 * max_ll
     warn = []
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
-        waic = az.waic(post.idata, pointwise=True)
-        loo = az.loo(post.idata, pointwise=True)
-    # arviz warns that WAIC is unreliable on most real data sets (5 of the 6 demo structures);
-    # WAIC estimates the same as PSIS-LOO, whose Pareto k̂ says where it fails, so the
-    # warning is not repeated per structure (WAIC stays in summary.json and ranking.csv).
+        loo = psis_loo(post.idata)
+        waic = waic_of(post.idata.log_likelihood["G"].values)
+    # WAIC estimates the same as PSIS-LOO, whose Pareto k̂ says where it fails (WAIC stays in
+    # summary.json and ranking.csv).
     pareto_k = np.asarray(loo.pareto_k)
     k_max = float(np.max(pareto_k))
     if k_max > PARETO_K_WARN:
@@ -58,8 +64,7 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
                "PSIS-LOO is unreliable there")
         warn.append(msg)
         warnings.warn(msg, PredictiveWarning, stacklevel=3)
-    elpd = {"waic": (float(waic.elpd_waic), float(waic.se)),
-            "loo": (float(loo.elpd_loo), float(loo.se))}
+    elpd = {"waic": waic, "loo": (float(loo.elpd), float(loo.se))}
     for name, (value, se) in elpd.items():
         if not (math.isfinite(value) and math.isfinite(se)):
             # Pointwise log-likelihoods that differ by more than ~700 nats between draws
@@ -80,7 +85,7 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
         "max_log_likelihood": max_ll, "aic": aic, "aicc": aicc, "bic": bic,
         "waic": elpd["waic"][0], "waic_se": elpd["waic"][1],
         "loo": elpd["loo"][0], "loo_se": elpd["loo"][1], "pareto_k_max": k_max,
-        "pareto_k": pareto_k.tolist(), "loo_pointwise": np.asarray(loo.loo_i).tolist(),
+        "pareto_k": pareto_k.tolist(), "loo_pointwise": np.asarray(loo.elpd_i).tolist(),
         "rmse": rmse, "warnings": warn,
         "priors": lik.describe_priors(),
     }
@@ -100,81 +105,6 @@ def _holdout(lik, post, test: FrequencyResponse) -> dict:
     rmse = float(np.sqrt(np.sum(np.abs(test.response - model) ** 2)) / test.n_frequencies)
     return {"holdout_lpd": float(lpd.sum()), "holdout_lpd_pointwise": lpd.tolist(),
             "holdout_rmse": rmse, "holdout_omega": test.omega.tolist()}
-
-
-#: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by the
-#: optimiser and the sampler has missed part of the posterior (1 000 particles of a posterior
-#: reach within a few nats of its maximum).
-LADDER_SHORTFALL = 5.0
-
-
-def _evidence(lik, post, seed, check: bool, route: str = "auto", *,
-              best_log_likelihood: float | None = None, importance=None) -> dict:
-    out = {"evidence": None, "evidence_check": None, "evidence_agree": None, "warnings": [],
-           "ladder_runs": None}
-    # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
-    # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
-    # from the prior instead (ladder_evidence), proposing from the draws as well so that it
-    # keeps the narrow modes the walkers found.
-    # Importance draws are a resample (duplicates): without the weights' own ln Z (k̂ ≥ 0.5)
-    # they go to the ladder, not to bridge sampling.
-    ladder = route == "ladder" or (route == "auto" and (
-        not post.converged or getattr(post, "sampler", "emcee") == "importance"))
-    try:
-        if importance is not None and route == "auto":
-            # The certified importance weights that gave the posterior give ln Z too.
-            out["evidence"] = importance
-        elif ladder:
-            try:
-                out["evidence"], out["ladder_runs"] = ladder_runs(lik, seed=seed, guide=post)
-            except InputError as exc:
-                if route == "ladder":
-                    raise
-                warnings.warn(f"{post.structure}: tempered ladder failed ({exc}); ln Z from the "
-                              "emcee draws instead", EvidenceWarning, stacklevel=3)
-                out["evidence"] = bridge_evidence(lik, post, seed=seed)
-        else:
-            out["evidence"] = bridge_evidence(lik, post, seed=seed)
-    except InputError as exc:
-        warnings.warn(f"{post.structure}: no evidence: {exc}", EvidenceWarning, stacklevel=3)
-        return out
-    ev = out["evidence"]
-    if (ev.reached_log_likelihood is not None and best_log_likelihood is not None
-            and ev.reached_log_likelihood < best_log_likelihood - LADDER_SHORTFALL):
-        message = (f"{post.structure}: a tempered-ladder run ended "
-                   f"{best_log_likelihood - ev.reached_log_likelihood:.1f} nats below the best "
-                   "fit, so its ln Z may be too low")
-        out["warnings"].append(message)
-        warnings.warn(message, EvidenceWarning, stacklevel=3)
-    if not post.converged and ev.method == "bridge":
-        out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is unreliable")
-    if check:
-        checked = _evidence_check(lik, post, out["evidence"], seed)
-        out["warnings"].extend(checked.pop("warnings"))
-        out.update(checked)
-    return out
-
-
-def _evidence_check(lik, post, evidence, seed) -> dict:
-    """ln Z by dynesty nested sampling beside ``evidence``, and whether they agree within twice
-    their combined error."""
-    out = {"warnings": []}
-    # Uniform draws from bounding ellipsoids where the posterior is one compact mode; slice
-    # sampling where the walkers did not converge (ridges, several modes), on which uniform
-    # draws stall (see nested_evidence).
-    how = {} if post.converged else {"sample": "rslice", "slices": max(25, 5 * lik.ndim)}
-    nested = nested_evidence(lik, seed=seed, **how)
-    out["evidence_check"] = nested
-    combined = math.hypot(evidence.log_z_err, nested.log_z_err)
-    agree = abs(evidence.log_z - nested.log_z) <= 2 * combined
-    out["evidence_agree"] = bool(agree)
-    if not agree:
-        out["warnings"].append(f"{post.structure}: {evidence.method} and nested ln Z disagree")
-        warnings.warn(
-            f"{post.structure}: {evidence.method} ln Z = {evidence.log_z:.2f} ± "
-            f"{evidence.log_z_err:.2f} and nested ln Z = {nested.log_z:.2f} ± "
-            f"{nested.log_z_err:.2f} disagree", EvidenceWarning, stacklevel=3)
-    return out
 
 
 def delta_loo_se(results) -> dict[str, float]:

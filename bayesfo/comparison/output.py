@@ -98,7 +98,7 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
                   ) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
-    One NetCDF per structure (arviz InferenceData with the attributes that :func:`load` needs,
+    One NetCDF per structure (an ArviZ DataTree with the attributes that :func:`load` needs,
     see :mod:`bayesfo.comparison.stored`), the figures (``formats``; see
     :func:`bayesfo.plotting.write_figures`), ``report.html`` (self-contained, figures embedded),
     ``ranking.csv`` and ``summary.json``. Everything is written into a staging directory inside

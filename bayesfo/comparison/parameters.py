@@ -44,7 +44,7 @@ def summarise_draws(values, map_value, unit: str) -> dict:
     the posterior summarises its parameters (94 % HDI by arviz). A draw at ±inf (an order at
     its bound makes a time overflow) leaves mean and sd undefined (NaN, null in JSON); the HDI
     and the median are those of all draws."""
-    from ..inference._arviz import arviz
+    from ..inference._arviz import hdi
 
     x = np.asarray(values, dtype=float).ravel()
     x = x[~np.isnan(x)]
@@ -53,7 +53,7 @@ def summarise_draws(values, map_value, unit: str) -> dict:
         return out | dict.fromkeys(("mean", "sd", "hdi_low", "hdi_high", "median"), math.nan) \
             | {"map": float(map_value)}
     finite = bool(np.all(np.isfinite(x)))
-    lo, hi = arviz().hdi(x, hdi_prob=HDI_PROB)
+    lo, hi = hdi(x, HDI_PROB)
     # Finite draws can still overflow the moments (a time b1**(1/alpha) near alpha = 0 reaches
     # 1e200): those moments are undefined too.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -156,10 +156,10 @@ def not_determined(summary: dict, draws=None) -> str | None:
 
 
 def _hdi(x):
-    from ..inference._arviz import arviz
+    from ..inference._arviz import hdi
 
     with np.errstate(invalid="ignore"):  # inf - inf among the candidate widths
-        return arviz().hdi(x, hdi_prob=HDI_PROB)
+        return hdi(x, HDI_PROB)
 
 
 def _judged_on_summary(summary: dict, percent: str) -> str | None:

@@ -19,7 +19,7 @@ promises a quick certified posterior and in worker processes, started only then,
 does not; each step runs with the same seed, so the numbers do not depend on where.
 
 Outputs (:func:`~bayesfo.comparison.output.write_outputs`, staged and swapped in as one run by
-:mod:`bayesfo.outdir`): one ``<structure>.nc`` (arviz InferenceData) per structure,
+:mod:`bayesfo.outdir`): one ``<structure>.nc`` (ArviZ DataTree) per structure,
 ``figures/`` and ``report.html`` (:mod:`bayesfo.plotting`, :mod:`bayesfo.report`),
 ``ranking.csv`` and ``summary.json`` (the contract of DESIGN.md).
 """
@@ -33,14 +33,13 @@ from dataclasses import replace
 import numpy as np
 
 from ..data import MAX_FREQUENCIES, FrequencyResponse
-from ..errors import CertifiedWarning, ConvergenceWarning, DataWarning, InputError, NoiseWarning
+from ..errors import DataWarning, InputError, NoiseWarning
 from ..identify.optimize import fit_structure
-from ..inference import Likelihood, run_posterior
+from ..inference import Likelihood, starting_points
 from ..inference.adequacy import check_adequacy
-from ..inference.evidence import ladder_runs
-from ..inference.importance import K_HAT_MAX, importance_posterior, screen_noise
+from ..inference.certified import certified_posterior, evidence_check
+from ..inference.importance import K_HAT_MAX, screen_noise
 from ..inference.likelihood import NOISE_PRIORS
-from ..inference.posterior import posterior_from_particles
 from ..options import EVIDENCE_ROUTES, SAMPLERS
 from ..parallel import (
     LazyPool,
@@ -50,7 +49,7 @@ from ..parallel import (
     single_blas_thread,
 )
 from ..structures import Structure, resolve_structures
-from .criteria import _criteria, _evidence, _evidence_check, _holdout, _model_probabilities
+from .criteria import _criteria, _holdout, _model_probabilities, fit_log_likelihood
 from .criteria_types import Criteria
 from .results import Comparison, StructureResult, data_problems
 
@@ -235,31 +234,6 @@ def remedy(lik) -> str:
             f"(--walkers {2 * walkers}; API: n_walkers={2 * walkers}){prior}")
 
 
-def _certified_by_ladder(lik, fit, post, criteria, runs, seed):
-    """Where the emcee walkers did not converge, the final particles of the independent
-    tempered-ladder runs (which gave ln Z) are the posterior, if the runs agree: summaries,
-    HDIs, figures, LOO and WAIC then come from them, and the warnings of emcee's draws are
-    replaced by one that says why they were set aside (:func:`_sample`). Returns
-    (posterior, criteria)."""
-    ladder = posterior_from_particles(lik, runs, seed=seed)
-    if not ladder.converged:
-        note = (f"{lik.structure.name}: the tempered-ladder runs do not certify the posterior "
-                f"either ({'; '.join(m.split(': ', 1)[1] for m in ladder.messages)}); the "
-                f"emcee draws are reported, flagged. {remedy(lik)}")
-        warnings.warn(note, ConvergenceWarning, stacklevel=3)
-        criteria["warnings"].append(note)
-        return post, criteria
-    why = "; ".join(m.split(": ", 1)[-1] for m in post.messages)
-    note = (f"{lik.structure.name}: the posterior reported is that of {ladder.n_walkers} "
-            f"independent tempered-ladder runs of {ladder.samples.shape[0] // ladder.n_walkers} "
-            f"particles, which agree (R-hat {ladder.rhat_max:.3f}, ESS {ladder.ess_min:.0f}); "
-            "the emcee walkers did not converge" + (f" ({why})" if why else ""))
-    criteria = _criteria(lik, fit, ladder)
-    criteria["warnings"].append(note)
-    warnings.warn(note, CertifiedWarning, stacklevel=3)
-    return ladder, criteria
-
-
 def _noise_candidates(data: FrequencyResponse, noise: str) -> tuple[str, ...]:
     """The noise models a structure is run with: the one asked for; ``auto`` (which the
     likelihood resolves to ``known``, saying why) when the data carry σ; else both
@@ -277,81 +251,23 @@ NOISE_CANDIDATES = ("constant", "proportional")
 
 def _sample(s: Structure, data: FrequencyResponse, noise: str, fit, options: dict) -> dict:
     """Posterior, criteria and evidence of one structure under one noise model."""
-    seed = options["seed"]
     own = {k: v for k, v in (options["priors"] or {}).items()
            if k in s.param_names or k == NOISE_PRIORS.get(noise, ("",))[0]}
     lik = Likelihood(s, data, noise=noise, priors=own)
-    post = ev = tried = None
-    # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
-    if options["sampler"] == "auto" and options["evidence"] != "bridge" and fit.optima.size:
-        modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling),
-                                        lik.scaling)
-        try:
-            post, ev, info = importance_posterior(lik, modes, seed=seed)
-        except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
-            post, ev, info = None, None, {}
-        if post is None and options["evidence"] == "auto" and not options["sampler_kwargs"]:
-            post, ev, tried = _ladder_first(lik, seed, info.get("proposal_draws"))
-    # The warnings of emcee's draws (convergence, Pareto k) are held until it is known whether
-    # they are the posterior reported: a ladder that certifies it instead replaces them.
-    with warnings.catch_warnings(record=True) as held:
-        warnings.simplefilter("always")
-        if post is None:
-            post, _ = run_posterior(lik.structure, data, noise=noise, priors=own, seed=seed,
-                                    fit=fit, progress=False,
-                                    **{"give_up": True, **options["sampler_kwargs"]})
-        criteria = _criteria(lik, fit, post)
-        of_draws = len(held)
-        if post.sampler == "emcee" and tried:
-            # Why the ladder tried first did not give the posterior (the emcee route followed).
-            tried = (f"{s.name}: the tempered-ladder runs tried first did not certify the "
-                     f"posterior ({tried}); emcee ran instead")
-            criteria["warnings"].append(tried)
-        if post.sampler == "importance":
-            criteria["importance"] = info
-        # ln Z of the importance weights or of the ladder that gave the posterior.
-        extra = _evidence(lik, post, seed, False, options["evidence"],
-                          best_log_likelihood=criteria["max_log_likelihood"], importance=ev)
-        runs = extra.pop("ladder_runs")
-        replaced = False
-        if runs is not None and not post.converged:
-            post, criteria = _certified_by_ladder(lik, fit, post, criteria, runs, seed)
-            replaced = post.sampler == "ladder"
-            if replaced and tried:
-                criteria["warnings"].insert(0, tried)
-    for w in held[of_draws if replaced else 0:]:
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    criteria["warnings"].extend(extra.pop("warnings"))
-    criteria.update(extra)
+    modes, starts = starting_points(lik, fit)
+    # Without optima (none admissible) there is no importance proposal: emcee from the best fit.
+    sampler = options["sampler"] if fit.optima.size else "emcee"
+    found = certified_posterior(
+        lik, modes, starts=starts, sampler=sampler, evidence=options["evidence"],
+        seed=options["seed"], fit_log_likelihood=fit_log_likelihood(lik, fit), remedy=remedy(lik),
+        sampler_options=options["sampler_kwargs"])
+    post = found.posterior
+    criteria = _criteria(lik, fit, post)
+    criteria["warnings"].extend(found.notes)
+    criteria.update(evidence=found.evidence, evidence_check=None, evidence_agree=None)
+    if found.importance is not None:
+        criteria["importance"] = found.importance
     return {"lik": lik, "post": post, "criteria": criteria}
-
-
-def _ladder_first(lik, seed: int, guide=None):
-    """Where importance sampling does not certify the posterior (ridges, several regions), the
-    tempered ladder's two independent runs: their final particles are the posterior when the
-    runs agree (R-hat < 1.01, ESS ≥ 400; see
-    :func:`~bayesfo.inference.results.posterior_from_particles`), and their ln Z the evidence.
-    Returns (posterior, evidence, None), or (None, None, reason) when the runs disagree or the
-    ladder fails: emcee then runs, and a ladder guided by its walkers.
-
-    Measured on the Maxwell of the bundled 20 °C isotherm under constant noise (two arms where
-    either springpot vanishes), where emcee's walkers stop uncertified after 3 250 steps and a
-    guided ladder followed: the ladder alone certifies it on six seeds out of six, with 1.6
-    million likelihood evaluations in large batches (5–10 s on the loaded 2-core machine, where
-    the emcee route took 12–15 s).
-
-    ``guide``: the importance proposal's draws (sampling coordinates), which cover every optimum
-    found; the ladder's independence moves propose from them too, so that a narrow mode with
-    little prior mass that the optimiser found is not lost (see
-    :func:`~bayesfo.inference.smc.ladder_run`)."""
-    try:
-        ev, runs = ladder_runs(lik, seed=seed, guide=guide)
-        post = posterior_from_particles(lik, runs, seed=seed)
-    except (InputError, np.linalg.LinAlgError, FloatingPointError) as exc:  # to emcee
-        return None, None, str(exc)
-    if not post.converged:
-        return None, None, "; ".join(m.split(": ", 1)[-1] for m in post.messages)
-    return post, ev, None
 
 
 def _exponent_intervals(run: dict) -> dict:
@@ -569,7 +485,7 @@ def _conclude(s: Structure, data: FrequencyResponse, fit, screened, runs: list[d
                 dict.fromkeys(message for _, message, _, _ in other["caught"]))
     criteria["noise_models"] = record
     if options["evidence_check"] and criteria["evidence"] is not None:
-        check = _evidence_check(lik, post, criteria["evidence"], seed)
+        check = evidence_check(lik, post, criteria["evidence"], seed)
         criteria["warnings"].extend(check.pop("warnings"))
         criteria.update(check)
     try:

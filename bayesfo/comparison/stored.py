@@ -49,15 +49,11 @@ _HOLDOUT = ("holdout_lpd", "holdout_rmse", "holdout_lpd_pointwise", "holdout_ome
 
 # ---------------------------------------------------------------------- writing
 def netcdf_for(comparison: Comparison, result: StructureResult):
-    """The InferenceData of ``result`` as its NetCDF stores it: a shallow copy of
+    """The DataTree of ``result`` as its NetCDF stores it: a shallow copy of
     ``result.posterior.idata`` (the result is left as it was) with the attributes
     :func:`load` needs (see the module's docstring)."""
-    from ..inference._arviz import arviz
-
     post = result.posterior
-    idata = post.idata
-    groups = {g: idata[g].copy(deep=False) for g in idata.groups()}
-    copy = arviz().InferenceData(attrs=dict(getattr(idata, "attrs", {}) or {}), **groups)
+    copy = post.idata.copy(deep=False)
     stats = {"bayesfo_format": NETCDF_FORMAT, "n_steps": int(post.n_steps),
              "burn": int(post.burn), "thin": int(post.thin),
              "acceptance": float(post.acceptance),
@@ -93,7 +89,7 @@ def load(directory, *, models=()) -> Comparison:
 
     Everything comes from those files: the data (frequencies, response, σ, held-out points,
     kind, units, name, source and notes), each structure's posterior (the draws, the
-    pointwise log-likelihood and the InferenceData as stored; summaries, diagnostics, noise
+    pointwise log-likelihood and the DataTree as stored; summaries, diagnostics, noise
     model and sampler details), its criteria (with the evidence, the nested-sampling check,
     the noise-model record, the adequacy checks and the warnings) and the optimiser's optimum.
     ``load(d).to_summary()`` is the ``summary.json`` of ``d``, and ``load(d).table()`` the
@@ -156,21 +152,20 @@ def _num(value) -> float:
 
 
 def _read_netcdf(path: Path, name: str):
-    from ..inference._arviz import arviz
+    from ..inference._arviz import group_names, open_tree
 
     if not path.is_file():
         raise InputError(f"'{path}': missing (summary.json lists structure '{name}' with a "
                          "posterior)")
-    az = arviz()
     try:
-        with az.rc_context({"data.load": "eager"}), warnings.catch_warnings():
+        with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            idata = az.from_netcdf(path)
+            idata = open_tree(path)
     except Exception as exc:  # h5py, h5netcdf and xarray raise many kinds on a damaged file
         raise InputError(f"'{path}': cannot be read as NetCDF ({type(exc).__name__}: "
                          f"{exc})") from None
     missing = [g for g in ("posterior", "log_likelihood", "observed_data")
-               if g not in idata.groups()]
+               if g not in group_names(idata)]
     if missing:
         raise InputError(f"'{path}': no '{missing[0]}' group: not a NetCDF of bayesfo compare")
     if idata.posterior.attrs.get("bayesfo_format") is None:

@@ -1,7 +1,9 @@
-"""Bayesian inference: likelihood and noise models, posterior sampling, diagnostics.
+"""Bayesian inference: likelihood and noise models, certified posteriors, evidence, diagnostics.
 
-:func:`run_posterior` is the one-call entry point: global optimisation (the modes), linear
-seeds, then emcee.
+:func:`certified_posterior` (:mod:`.certified`) is the entry point that ``compare`` uses: from
+the optima of a likelihood, a posterior certified by importance sampling, the tempered ladder
+or emcee, with its ln Z and, in words, how it was reached. :func:`run_posterior` runs emcee
+alone from the global optimisation and the linear seeds.
 """
 
 from __future__ import annotations
@@ -9,13 +11,27 @@ from __future__ import annotations
 import numpy as np
 
 from ..identify.optimize import fit_structure, linear_seeds
+from .certified import CertifiedPosterior, certified_posterior
 from .likelihood import NOISE_MODELS, Likelihood, choose_noise
 from .posterior import ConvergenceWarning, PosteriorResult, sample_posterior, save_netcdf
 
 __all__ = [
-    "ConvergenceWarning", "Likelihood", "NOISE_MODELS", "PosteriorResult", "choose_noise",
-    "run_posterior", "sample_posterior", "save_netcdf",
+    "CertifiedPosterior", "ConvergenceWarning", "Likelihood", "NOISE_MODELS", "PosteriorResult",
+    "certified_posterior", "choose_noise", "run_posterior", "sample_posterior", "save_netcdf",
+    "starting_points",
 ]
+
+
+def starting_points(lik: Likelihood, fit) -> tuple[np.ndarray, np.ndarray]:
+    """(modes, more starts) of a posterior in the scaled coordinates of ``lik``: the optima of
+    the global optimisation ``fit`` (its best point where it kept none) and the linear
+    estimates of the structure's coefficients (none where the structure has no linear form)."""
+    # Through physical units: the fit may have used another scaling than the likelihood.
+    modes = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
+    modes = lik.structure.to_scaled(lik.structure.to_physical(modes, fit.scaling), lik.scaling)
+    lin = linear_seeds(lik.structure, lik.data)
+    starts = lik.structure.to_scaled(lin, lik.scaling) if lin.size else np.empty((0, modes.shape[1]))
+    return modes, starts
 
 
 def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: int = 0,
@@ -47,11 +63,6 @@ def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: in
     lik = Likelihood(structure, data, noise=noise, priors=dict(priors or {}), scaling=scaling)
     if fit is None:
         fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True, scaling=lik.scaling)
-    # Modes go through physical units: a fit passed in may have used another scaling.
-    modes = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
-    seeds = [lik.structure.to_scaled(lik.structure.to_physical(modes, fit.scaling), lik.scaling)]
-    lin = linear_seeds(lik.structure, data)
-    if lin.size:
-        seeds.append(lik.structure.to_scaled(lin, lik.scaling))
-    result = sample_posterior(lik, np.vstack(seeds), seed=seed, **kwargs)
+    modes, starts = starting_points(lik, fit)
+    result = sample_posterior(lik, np.vstack([modes, starts]), seed=seed, **kwargs)
     return result, fit

@@ -1,13 +1,130 @@
-"""arviz, imported without its announcement of a future refactor (a FutureWarning on import)."""
+"""The diagnostics and the posterior container, from the ArviZ libraries (arviz-base, arviz-stats).
+
+Draws and everything stored beside them (pointwise log-likelihood, posterior predictive, observed
+data, sample statistics) live in an :class:`xarray.DataTree` with ArviZ's groups; the statistics
+are arviz-stats' array functions, given plain arrays:
+
+- :func:`rhat_max`, :func:`ess_min`: rank-normalised split R-hat, bulk and tail ESS;
+- :func:`hdi`: highest-density interval of a sample;
+- :func:`psis`: Pareto-smoothed importance weights and their k̂;
+- :func:`loo`, :func:`waic`: the predictive criteria from the pointwise log-likelihood.
+"""
 
 from __future__ import annotations
 
-import warnings
+from pathlib import Path
+
+import numpy as np
+
+#: The quantiles of the tail ESS (ArviZ's: the 5 % and 95 % quantiles).
+TAIL_PROB = (0.05, 0.95)
 
 
-def arviz():
-    """The arviz module."""
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message="ArviZ is undergoing", category=FutureWarning)
-        import arviz as az
-    return az
+def _stats():
+    from arviz_stats.base import array_stats
+
+    return array_stats
+
+
+def _by_parameter(chains) -> np.ndarray:
+    """(chain, draw, parameter) → (parameter, chain, draw); a 2-D array is one parameter."""
+    a = np.asarray(chains, dtype=float)
+    return a[None] if a.ndim == 2 else np.moveaxis(a, -1, 0)
+
+
+def rhat_max(chains) -> float:
+    """The largest rank-normalised split R-hat over the parameters of ``chains`` (chain, draw,
+    parameter)."""
+    return float(np.max(_stats().rhat(_by_parameter(chains))))
+
+
+def ess_min(chains, method: str = "bulk") -> float:
+    """The smallest bulk (``method="bulk"``) or tail (``"tail"``) effective sample size over
+    the parameters of ``chains`` (chain, draw, parameter; (chain, draw) for one quantity)."""
+    kwargs = {"prob": TAIL_PROB} if method == "tail" else {}
+    return float(np.min(_stats().ess(_by_parameter(chains), method=method, **kwargs)))
+
+
+def ess_draws(x) -> float:
+    """Effective size of one sequence of draws of a scalar (one chain)."""
+    return ess_min(np.asarray(x, dtype=float).reshape(1, -1))
+
+
+def hdi(x, prob: float) -> tuple[float, float]:
+    """The ``prob`` highest-density interval of the draws ``x`` (one dimension)."""
+    lo, hi = _stats().hdi(np.asarray(x, dtype=float), prob)
+    return float(lo), float(hi)
+
+
+def hdi_columns(values, prob: float) -> tuple[np.ndarray, np.ndarray]:
+    """The ``prob`` highest-density interval of each column of ``values`` (draws along the
+    rows); NaN for a column with a draw that is not finite."""
+    values = np.asarray(values, dtype=float)
+    lo = np.full(values.shape[1], np.nan)
+    hi = np.full(values.shape[1], np.nan)
+    ok = np.all(np.isfinite(values), axis=0)
+    if ok.any():
+        ends = np.asarray(_stats().hdi(values[:, ok], prob, axis=0))
+        lo[ok], hi[ok] = ends[..., 0], ends[..., 1]
+    return lo, hi
+
+
+def psis(log_w) -> tuple[np.ndarray, float]:
+    """Pareto-smoothed log importance weights (normalised) and the Pareto k̂ of their tail."""
+    # arviz-stats smooths the ratios 1/p of a log-likelihood p (leave-one-out): ratios w are
+    # passed as the log-likelihood -log w.
+    smoothed, k_hat = _stats().psislw(-np.asarray(log_w, dtype=float))
+    return np.asarray(smoothed), float(k_hat)
+
+
+def loo(tree):
+    """PSIS-LOO from the ``log_likelihood`` group of ``tree`` (variable ``G``, per frequency):
+    arviz-stats' ``ELPDData`` (``elpd``, ``se``, ``pareto_k``, ``elpd_i``)."""
+    from arviz_stats import loo as _loo
+
+    return _loo(tree, pointwise=True, var_name="G")
+
+
+def waic(log_lik) -> tuple[float, float]:
+    """WAIC (elpd scale) and its standard error from the pointwise log-likelihood, draws along
+    every axis but the last (Watanabe 2010; Vehtari, Gelman & Gabry 2017, eq. 11-13)."""
+    from scipy.special import logsumexp
+
+    ll = np.asarray(log_lik, dtype=float)
+    ll = ll.reshape(-1, ll.shape[-1])
+    lppd = logsumexp(ll, axis=0) - np.log(ll.shape[0])
+    elpd_i = lppd - ll.var(axis=0)
+    return float(elpd_i.sum()), float(np.sqrt(elpd_i.size * elpd_i.var()))
+
+
+def from_dict(groups: dict, *, coords: dict | None = None, dims: dict | None = None):
+    """A DataTree with ArviZ's groups from ``{group: {name: array}}``."""
+    from arviz_base import from_dict as _from_dict
+
+    return _from_dict(groups, coords=coords, dims=dims)
+
+
+def group_names(tree) -> tuple[str, ...]:
+    """The groups (child nodes) of a DataTree."""
+    return tuple(tree.children)
+
+
+def open_tree(path: Path):
+    """A DataTree read from a NetCDF file (arviz 1.x or 0.x), loaded into memory and the file
+    closed."""
+    import xarray as xr
+
+    with xr.open_datatree(path, engine="h5netcdf") as tree:
+        return tree.load()
+
+
+def write_tree(tree, path) -> None:
+    """Write a DataTree to NetCDF (HDF5, one group per ArviZ group)."""
+    tree.to_netcdf(path, engine="h5netcdf")
+
+
+def preload() -> None:
+    """Import the ArviZ libraries and xarray now, not on first use."""
+    import arviz_base  # noqa: F401
+    import arviz_stats  # noqa: F401
+    import xarray  # noqa: F401

@@ -100,9 +100,9 @@ def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_
 
 def _ess(x: np.ndarray) -> float:
     """Effective size of the draws (walker-major rows) of a scalar, by arviz."""
-    from ._arviz import arviz
+    from ._arviz import ess_draws
 
-    return float(arviz().ess(x))
+    return ess_draws(x)
 
 
 def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 0,

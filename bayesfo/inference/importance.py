@@ -37,7 +37,7 @@ import numpy as np
 from scipy.special import gammaln, logsumexp
 
 from ..errors import InputError
-from ._arviz import arviz
+from ._arviz import psis
 from .likelihood import Likelihood
 
 #: Certificate of the importance weights: Pareto k̂ below this (Vehtari et al.'s threshold of
@@ -208,7 +208,7 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     n_draws, chains : int
         Posterior draws resampled from the weights, stored as ``chains`` chains.
     predictive : bool
-        Store the posterior predictive and the model response in the InferenceData.
+        Store the posterior predictive and the model response in the DataTree.
 
     Returns
     -------
@@ -230,12 +230,10 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)
     if isinstance(out, dict):
         return None, None, out
-    az = arviz()
     rounds = 1
     while True:
         x, log_w, finite, n_modes, _ = out
-        smoothed, k_hat = az.psislw(log_w[finite].copy())
-        k_hat = float(k_hat)
+        smoothed, k_hat = psis(log_w[finite])
         w = np.exp(smoothed - logsumexp(smoothed))
         ess = float(1.0 / np.sum(w**2))
         if (k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE) or rounds == MAX_ROUNDS:
@@ -338,7 +336,7 @@ def _adapted(first, n_proposals: int, rng: np.random.Generator):
     the first round's draws are too few to estimate a covariance."""
     x, log_w, finite, n_modes, prop = first
     xs = x[finite]
-    smoothed, _ = arviz().psislw(log_w[finite].copy())
+    smoothed, _ = psis(log_w[finite])
     w = np.exp(smoothed - logsumexp(smoothed))
     d = xs.shape[1]
     if 1.0 / np.sum(w**2) < 10 * d:
@@ -391,7 +389,7 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
         return None
     x, log_w, finite, _, _ = out
     lw = log_w[finite]
-    smoothed, k_hat = arviz().psislw(lw.copy())
+    smoothed, k_hat = psis(lw)
     try:
         log_s, _ = _log_support(lik, rng)
     except InputError:

@@ -1,5 +1,5 @@
 """A posterior as the rest of bayesfo uses it (:class:`PosteriorResult`: draws, summaries,
-diagnostics, InferenceData), built from whichever route produced the draws (emcee, the
+diagnostics, an ArviZ DataTree), built from whichever route produced the draws (emcee, the
 tempered ladder's particles, importance sampling), and written as NetCDF."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import publish
-from ._arviz import arviz
+from ._arviz import ess_min, from_dict, group_names, hdi, rhat_max, write_tree
 from .likelihood import Likelihood
 from .transform import _log_prob_fn, _Transform
 
@@ -89,7 +89,7 @@ class PosteriorResult:
         ``"importance"`` for draws resampled from certified importance weights
         (:func:`bayesfo.inference.importance.importance_posterior`; R-hat does not apply, the
         ESS is that of the weights).
-    idata : arviz.InferenceData
+    idata : xarray.DataTree
         Posterior, log_likelihood (per frequency), posterior_predictive, observed_data and
         sample_stats, coordinates named by frequency.
     """
@@ -163,7 +163,7 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
     seed : int
         Seed of the shuffle and of the posterior predictive draws.
     predictive : bool
-        Store the posterior predictive and the model response in the InferenceData.
+        Store the posterior predictive and the model response in the DataTree.
 
     Returns
     -------
@@ -171,7 +171,6 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
         With ``sampler="ladder"``; ``n_walkers`` is the number of runs, ``n_steps`` 0 and
         ``tau`` NaN (no chain); ``converged`` when R-hat < 1.01 and the ESS ≥ 400.
     """
-    az = arviz()
     rng = np.random.default_rng(seed)
     tr = _Transform(lik)
     chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
@@ -179,21 +178,20 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
     if n_runs < 2:
         raise ValueError("at least two runs are needed to certify the posterior")
     chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
-    chains = az.convert_to_dataset({name: tr.to_theta(chain_u)[:, :, i]
-                                    for i, name in enumerate(lik.param_names)})
-    rhat_max = max(float(v) for v in az.rhat(chains).data_vars.values())
+    chains = tr.to_theta(chain_u)
+    r_hat = rhat_max(chains)
     distinct = float(len(np.unique(chain_u.reshape(-1, chain_u.shape[2]), axis=0)))
-    ess_bulk = min(distinct, min(float(v) for v in az.ess(chains, method="bulk").data_vars.values()))
-    ess_tail = min(distinct, min(float(v) for v in az.ess(chains, method="tail").data_vars.values()))
+    ess_bulk = min(distinct, ess_min(chains, "bulk"))
+    ess_tail = min(distinct, ess_min(chains, "tail"))
     messages = []
-    if not rhat_max < RHAT_MAX:
+    if not r_hat < RHAT_MAX:
         messages.append(f"{lik.structure.name}: the tempered-ladder runs disagree (R-hat "
-                        f"{rhat_max:.3f} is not below {RHAT_MAX})")
+                        f"{r_hat:.3f} is not below {RHAT_MAX})")
     if not min(ess_bulk, ess_tail) >= ESS_MIN:
         messages.append(f"{lik.structure.name}: the tempered-ladder particles give an effective "
                         f"sample size of {min(ess_bulk, ess_tail):.0f}, below {ESS_MIN}")
     acceptance = [float(np.mean(r.acceptance[-1:])) for r in runs if hasattr(r, "acceptance")]
-    post = result_from_draws(lik, chain_u, sampler="ladder", rhat=rhat_max, ess_bulk=ess_bulk,
+    post = result_from_draws(lik, chain_u, sampler="ladder", rhat=r_hat, ess_bulk=ess_bulk,
                              ess_tail=ess_tail, messages=tuple(messages),
                              converged=not messages, seed=seed, predictive=predictive,
                              acceptance=float(np.mean(acceptance)) if acceptance else np.nan)
@@ -284,17 +282,15 @@ def _binned_density(u: np.ndarray, lo: float, hi: float, n_grid: int = 512) -> n
 
 
 def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:
-    az = arviz()
-
     out = {}
     for i, (name, prior) in enumerate(zip(lik.param_names, lik.prior_list)):
         x = flat_phys[:, i]
-        lo, hi = az.hdi(x, hdi_prob=HDI_PROB)
+        lo, hi = hdi(x, HDI_PROB)
         plo, phi = prior.bounds
         if tr.log[i]:
             plo, phi = math.log(plo), math.log(phi)
         u = flat_u[:, i]
-        ulo, uhi = az.hdi(u, hdi_prob=HDI_PROB)
+        ulo, uhi = hdi(u, HDI_PROB)
         wide = bool(np.isfinite(phi - plo) and (uhi - ulo) > 0.5 * (phi - plo))
         out[name] = ParameterSummary(
             mean=float(x.mean()), sd=float(x.std(ddof=1)), hdi_low=float(lo), hdi_high=float(hi),
@@ -305,8 +301,6 @@ def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:
 
 
 def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kept, rng):
-    az = arviz()
-
     omega = lik.data.omega
     shape = (n_walkers, n_kept, omega.size)
     g = lik.data.response
@@ -335,7 +329,7 @@ def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kep
         groups["posterior_predictive"] = {"G_real": rep.real.reshape(shape), "G_imag": rep.imag.reshape(shape)}
         groups["posterior"] = dict(post, model_real=model.real.reshape(shape), model_imag=model.imag.reshape(shape))
     dims = {k: ["omega"] for k in ("G", "G_real", "G_imag", "model_real", "model_imag")}
-    idata = az.from_dict(**groups, coords={"omega": omega}, dims=dims)
+    idata = from_dict(groups, coords={"omega": omega}, dims=dims)
     idata.posterior.attrs.update(
         structure=lik.structure.name, noise=lik.noise, kind=lik.data.kind,
         units=lik.data.units or "", omega_units="rad/s", data=lik.data.label,
@@ -347,14 +341,14 @@ def _netcdf_bytes_needed(idata) -> int:
     """An upper bound of the size of ``idata`` as NetCDF: its arrays uncompressed, plus the
     HDF5 headers of every variable and group."""
     total = 0
-    for group in idata.groups():
-        ds = idata[group]
+    for group in group_names(idata):
+        ds = idata[group].dataset
         total += ds.nbytes + 16_384 * (len(ds.variables) + 1)
     return total + 65_536
 
 
 def save_netcdf(idata, path) -> Path:
-    """Write InferenceData to NetCDF through a temporary file and an atomic rename.
+    """Write a DataTree (ArviZ groups) to NetCDF through a temporary file and an atomic rename.
 
     Raises
     ------
@@ -373,7 +367,7 @@ def save_netcdf(idata, path) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".nc", dir=path.parent)
     os.close(fd)
     try:
-        idata.to_netcdf(tmp)
+        write_tree(idata, tmp)
         publish(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

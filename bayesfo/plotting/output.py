@@ -276,6 +276,14 @@ def _draw_in_child(jobs: dict, order: list[str], state, lock, out_dir: Path, for
         os._exit(1)
 
 
+def preload(formats) -> None:
+    """Import what drawing and saving the figures in ``formats`` needs (matplotlib's pyplot,
+    corner, the backends), now rather than at the first figure."""
+    import matplotlib.pyplot  # noqa: F401
+
+    _load_before_fork(formats)
+
+
 def _load_before_fork(formats) -> None:
     """Import, before forking, the modules every figure needs that nothing has imported yet
     (corner, the PDF backend and its font subsetter, the PNG writer) and build the mathtext

@@ -289,7 +289,7 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
 def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     """Trace of every walker for each parameter (and the log posterior density).
 
-    Uses the stored InferenceData (``posterior.idata``: chain = walker), i.e. the draws kept
+    Uses the stored DataTree (``posterior.idata``: chain = walker), i.e. the draws kept
     after burn-in and thinning. Parameters with a log-uniform prior are drawn as log10, as in
     :func:`plot_corner`, and labelled with their units as there.
 
@@ -315,13 +315,13 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     Raises
     ------
     InputError
-        If the structure failed or has no posterior InferenceData.
+        If the structure failed or has no posterior DataTree.
     """
     _check_result(result)
     post = result.posterior
     if post.idata is None or not hasattr(post.idata, "posterior"):
-        raise InputError(f"argument 'result': structure '{result.name}' has no InferenceData")
-    ds = post.idata.posterior
+        raise InputError(f"argument 'result': structure '{result.name}' has no posterior draws")
+    ds = post.idata.posterior.dataset
     _, labels, is_log = sampling_coordinates(result)
     lp = None
     if hasattr(post.idata, "sample_stats") and "lp" in post.idata.sample_stats:

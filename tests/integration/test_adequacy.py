@@ -12,7 +12,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import time
 import warnings
 from pathlib import Path
 
@@ -268,9 +267,9 @@ def test_to_dict_is_json_with_finite_numbers(springpot_fits):
     json.dumps(out, allow_nan=False)
 
 
-def test_one_check_costs_well_under_a_second():
-    # 40 frequencies, 400 of 2000 draws: the brief's budget is well under a second; 1 s here,
-    # the best of three, leaves room for a loaded machine.
+def test_one_check_uses_a_subset_of_the_draws_and_is_reproducible():
+    # 40 frequencies, 2000 draws: a check takes 400 of them (its cost is measured in
+    # benchmarks/bench_full_answer.py, not here), and the same seed gives the same numbers.
     omega = np.logspace(-1, 2, 40)
     data = zener_data(seed=3, omega=omega)
     lik = Likelihood(get_structure("zener"), data, noise="proportional")
@@ -278,13 +277,9 @@ def test_one_check_costs_well_under_a_second():
     rng = np.random.default_rng(0)
     draws = truth * (1 + 0.01 * rng.normal(size=(2000, truth.size)))
     post = _stub_posterior(lik, draws)
-    times = []
-    for seed in range(3):
-        t0 = time.perf_counter()
-        result = check_adequacy(lik, post, seed=seed)
-        times.append(time.perf_counter() - t0)
-    assert result.n_draws == 400
-    assert min(times) < 1.0
+    first, again = (check_adequacy(lik, post, seed=3) for _ in range(2))
+    assert first.n_draws == again.n_draws == 400
+    assert first.p_values == again.p_values and first.summary == again.summary
 
 
 def _stub_posterior(lik, draws):

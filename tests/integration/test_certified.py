@@ -153,15 +153,15 @@ def test_a_ladder_that_fails_first_hands_over_to_emcee_and_says_why(monkeypatch)
     # Importance sampling and the ladder tried first both made to fail: emcee gives the
     # posterior, and the criteria keep why the ladder did not (a linear-algebra failure in its
     # mixture fit is a reason to hand over, not an error of the comparison).
-    import bayesfo.comparison.run as run
+    import bayesfo.inference.certified as route
 
-    monkeypatch.setattr(run, "importance_posterior",
+    monkeypatch.setattr(route, "importance_posterior",
                         lambda *a, **k: (None, None, {"reason": "forced"}))
 
     def failing(*args, **kwargs):
         raise np.linalg.LinAlgError("Matrix is not positive definite")
 
-    monkeypatch.setattr(run, "ladder_runs", failing)
+    monkeypatch.setattr(route, "ladder_runs", failing)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PredictiveWarning)
         r = bf.compare(bf.read(DATA), "zener", seed=1, workers=1, progress=False,

@@ -441,12 +441,12 @@ def test_single_isotherm_gets_a_sensible_temperature_axis():
 
 
 def _with_trace(result):
-    from bayesfo.inference._arviz import arviz
+    from arviz_base import from_dict
 
     post = result.posterior
     n_walkers = post.n_walkers
     draws = post.samples.reshape(n_walkers, -1, post.samples.shape[1])
-    idata = arviz().from_dict(posterior={p: draws[:, :, i] for i, p in enumerate(post.param_names)})
+    idata = from_dict({"posterior": {p: draws[:, :, i] for i, p in enumerate(post.param_names)}})
     post.idata = idata
     return result
 

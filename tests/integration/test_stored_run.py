@@ -26,7 +26,14 @@ Stored again when the ladder's moves came to aim at 5 accepted moves per particl
 instead of 10 (and the summary gained the ``not_determined`` flags of quantities with units):
 the Voigt's ladder posterior moved within its Monte Carlo errors (ln Z −244.259 ± 0.037, was
 −244.236 ± 0.030; q 0.2378 ± 0.0040, was 0.2379 ± 0.0040; a1 sd 474, was 464); the
-zener-int's numbers are as stored."""
+zener-int's numbers are as stored.
+
+Stored again when the diagnostics came from arviz-stats (ArviZ 1.x) instead of arviz 0.x:
+PSIS-LOO and its Pareto k̂ (a generalised Pareto fit of its own) moved within their Monte Carlo
+errors (Voigt elpd −228.2231, was −228.2244, se 3.73; zener-int −319.3421, was −319.3473, se
+3.80; k̂ max 0.837 and 0.843, were 0.849 and 0.852), and the zener-int's bridge ln Z, whose
+error uses the effective sample size, −331.8834 ± 0.0117, was −331.8846 ± 0.0113. R-hat, ESS,
+the posteriors and every other number are as stored."""
 
 from __future__ import annotations
 

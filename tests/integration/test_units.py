@@ -40,7 +40,7 @@ from bayesfo.comparison.results import (  # noqa: E402
     physical_text,
 )
 from bayesfo.data import FrequencyResponse  # noqa: E402
-from bayesfo.inference._arviz import arviz  # noqa: E402
+from bayesfo.inference._arviz import hdi  # noqa: E402
 from bayesfo.plotting import plot_corner, plot_trace  # noqa: E402
 from bayesfo.plotting._compute import param_symbol, unit_mathtext  # noqa: E402
 from bayesfo.report import render_report, verdict  # noqa: E402
@@ -402,7 +402,7 @@ def test_parameters_the_data_do_not_determine_are_marked(zener_on_voigt):
                             for n in ("a1", "b0", "b1", "q")))
     for name in ("G_m", "tau"):
         p = phys[name]
-        lo, hi = arviz().hdi(np.log10(draws[name]), hdi_prob=0.94)
+        lo, hi = hdi(np.log10(draws[name]), 0.94)
         assert hi - lo > UNDETERMINED_DECADES
         assert p["not_determined_reason"] == (
             f"its 94 % HDI on a log scale spans {hi - lo:.1f} decades")

@@ -1,0 +1,272 @@
+"""The certified-posterior policy: which route gives a likelihood's posterior and its ln Z.
+
+:func:`certified_posterior` is the one entry point; ``compare`` calls it for every structure
+and noise model, and any new likelihood with the :class:`~bayesfo.inference.Likelihood`
+interface gets its posterior the same way.
+
+The routes, in order, with ``sampler="auto"``:
+
+1. importance sampling from a proposal centred on the optima
+   (:func:`~bayesfo.inference.importance.importance_posterior`): certified when the Pareto k̂
+   of the weights is below 0.7 and their ESS at least 1000; ln Z from the same weights where
+   k̂ < 0.5;
+2. where the weights do not certify it (ridges, several regions), two independent runs of the
+   tempered ladder guided by the proposal's draws: their final particles are the posterior
+   when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence;
+3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its
+   draws where the walkers converged, else by a tempered ladder guided by them, whose
+   particles replace the walkers' draws when its runs agree. A posterior that no route
+   certifies is returned flagged (``posterior.converged`` False), with the reason.
+
+``sampler="emcee"`` starts at 3. Sampler settings (``max_steps``, ``n_walkers``) or
+``evidence="ladder"`` skip route 2; ``evidence="bridge"`` implies emcee (bridge sampling
+needs its draws); ``evidence="ladder"`` takes ln Z from a ladder whatever gave the posterior.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import CertifiedWarning, ConvergenceWarning, EvidenceWarning, InputError
+from ..options import EVIDENCE_ROUTES, SAMPLERS
+from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
+from .importance import importance_posterior
+from .likelihood import Likelihood
+from .posterior import sample_posterior
+from .results import PosteriorResult, posterior_from_particles
+
+#: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by
+#: the optimiser and the sampler has missed part of the posterior (1 000 particles of a
+#: posterior reach within a few nats of its maximum).
+LADDER_SHORTFALL = 5.0
+
+
+@dataclass(frozen=True)
+class CertifiedPosterior:
+    """What :func:`certified_posterior` found.
+
+    Attributes
+    ----------
+    posterior : PosteriorResult
+        Certified unless ``posterior.converged`` is False (``posterior.messages`` say why).
+    evidence : Evidence or None
+        ln Z by the route that gave the posterior (or the one asked for); None where none
+        could be computed (a warning says why).
+    evidence_check : Evidence or None
+        ln Z by dynesty nested sampling, when asked for (``check=True``).
+    evidence_agree : bool or None
+        Whether the two ln Z agree within twice their combined error (with the check).
+    notes : tuple of str
+        How the posterior was reached where the first route did not give it, and what the
+        evidence's checks found, in words for the user.
+    importance : dict or None
+        The importance route's certificate (k̂, ESS, proposal modes, seconds) where it gave the
+        posterior.
+    best_log_likelihood : float
+        The highest log-likelihood seen: the optimiser's (as given) or any posterior draw's.
+    """
+
+    posterior: PosteriorResult
+    evidence: Evidence | None
+    evidence_check: Evidence | None = None
+    evidence_agree: bool | None = None
+    notes: tuple[str, ...] = ()
+    importance: dict | None = None
+    best_log_likelihood: float = -math.inf
+
+
+def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "auto",
+                        evidence: str = "auto", seed: int = 0, check: bool = False,
+                        fit_log_likelihood: float = -math.inf, remedy: str = "",
+                        sampler_options: dict | None = None) -> CertifiedPosterior:
+    """The certified posterior of ``lik`` and its ln Z, by the routes of this module.
+
+    Parameters
+    ----------
+    lik : Likelihood
+        Or any object with its interface (``pointwise``, ``in_support``, priors, scaling).
+    modes : ndarray, shape (n_modes, ndim_structure)
+        The optima found (scaled coordinates of ``lik``, without the noise parameter): the
+        centres of the importance proposal and starts of emcee.
+    starts : ndarray, optional
+        More starting points for emcee (e.g. linear estimates); ``modes`` are always used.
+    sampler : {"auto", "emcee"}
+    evidence : {"auto", "bridge", "ladder"}
+    seed : int
+        Every random step is seeded from it: the same seed gives the same numbers.
+    check : bool
+        Also compute ln Z by dynesty nested sampling, and say whether the two agree.
+    fit_log_likelihood : float
+        The optimiser's best log-likelihood: a ladder that ends far below it is flagged.
+    remedy : str
+        What to try when no route certifies the posterior (appended to that note).
+    sampler_options : dict, optional
+        emcee settings (``max_steps``, ``n_walkers``, ...; see
+        :func:`~bayesfo.inference.posterior.sample_posterior`).
+
+    Returns
+    -------
+    CertifiedPosterior
+    """
+    if sampler not in SAMPLERS:
+        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}")
+    if evidence not in EVIDENCE_ROUTES:
+        raise InputError(f"evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
+                         f"got {evidence!r}")
+    sampler_options = dict(sampler_options or {})
+    modes = np.atleast_2d(np.asarray(modes, dtype=float))
+    name = lik.structure.name
+    post = ev = tried = info = None
+    # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
+    if sampler == "auto" and evidence != "bridge" and modes.size:
+        try:
+            post, ev, info = importance_posterior(lik, modes, seed=seed)
+        except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
+            post, ev, info = None, None, {}
+        if post is None and evidence == "auto" and not sampler_options:
+            post, ev, tried = _ladder_first(lik, seed, info.get("proposal_draws"))
+    notes = []
+    # The warnings of emcee's draws are held until it is known whether they are the posterior
+    # reported: a ladder that certifies it instead replaces them.
+    with warnings.catch_warnings(record=True) as held:
+        warnings.simplefilter("always")
+        if post is None:
+            x0 = modes if starts is None or not np.size(starts) else np.vstack([modes, starts])
+            post = sample_posterior(lik, x0, seed=seed, progress=False,
+                                    **{"give_up": True, **sampler_options})
+        if post.sampler == "emcee" and tried:
+            notes.append(f"{name}: the tempered-ladder runs tried first did not certify the "
+                         f"posterior ({tried}); emcee ran instead")
+        best = max(post.max_log_likelihood, fit_log_likelihood)
+        of_draws = len(held)
+        found = _evidence(lik, post, seed, evidence, best_log_likelihood=best, importance=ev)
+        runs = found.pop("ladder_runs")
+        replaced = False
+        if runs is not None and not post.converged:
+            post, note, replaced = _certified_by_ladder(lik, post, runs, seed, remedy)
+            notes.append(note)
+            warnings.warn(note, CertifiedWarning if replaced else ConvergenceWarning,
+                          stacklevel=2)
+    # Replaced, emcee's draws and their warnings are set aside; everything after them stands.
+    for w in held[of_draws if replaced else 0:]:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    notes += found["warnings"]
+    checked = {}
+    if check and found["evidence"] is not None:
+        checked = evidence_check(lik, post, found["evidence"], seed)
+        notes += checked.pop("warnings")
+    return CertifiedPosterior(
+        posterior=post, evidence=found["evidence"],
+        evidence_check=checked.get("evidence_check"),
+        evidence_agree=checked.get("evidence_agree"), notes=tuple(notes),
+        importance=info if post.sampler == "importance" else None,
+        best_log_likelihood=max(best, post.max_log_likelihood))
+
+
+def _ladder_first(lik, seed: int, guide=None):
+    """Where importance sampling does not certify the posterior (ridges, several regions), the
+    tempered ladder's two independent runs: their final particles are the posterior when the
+    runs agree (R-hat < 1.01, ESS ≥ 400; see
+    :func:`~bayesfo.inference.results.posterior_from_particles`), and their ln Z the evidence.
+    Returns (posterior, evidence, None), or (None, None, reason) when the runs disagree or the
+    ladder fails: emcee then runs, and a ladder guided by its walkers.
+
+    ``guide``: the importance proposal's draws (sampling coordinates), which cover every optimum
+    found; the ladder's independence moves propose from them too, so that a narrow mode with
+    little prior mass that the optimiser found is not lost (see
+    :func:`~bayesfo.inference.smc.ladder_run`)."""
+    try:
+        ev, runs = ladder_runs(lik, seed=seed, guide=guide)
+        post = posterior_from_particles(lik, runs, seed=seed)
+    except (InputError, np.linalg.LinAlgError, FloatingPointError) as exc:  # to emcee
+        return None, None, str(exc)
+    if not post.converged:
+        return None, None, "; ".join(m.split(": ", 1)[-1] for m in post.messages)
+    return post, ev, None
+
+
+def _certified_by_ladder(lik, post, runs, seed, remedy: str):
+    """Where the emcee walkers did not converge, the final particles of the independent
+    tempered-ladder runs (which gave ln Z) are the posterior, if the runs agree. Returns
+    (posterior, note, whether the ladder certified it)."""
+    name = lik.structure.name
+    ladder = posterior_from_particles(lik, runs, seed=seed)
+    if not ladder.converged:
+        note = (f"{name}: the tempered-ladder runs do not certify the posterior "
+                f"either ({'; '.join(m.split(': ', 1)[1] for m in ladder.messages)}); the "
+                "emcee draws are reported, flagged." + (f" {remedy}" if remedy else ""))
+        return post, note, False
+    why = "; ".join(m.split(": ", 1)[-1] for m in post.messages)
+    note = (f"{name}: the posterior reported is that of {ladder.n_walkers} "
+            f"independent tempered-ladder runs of {ladder.samples.shape[0] // ladder.n_walkers} "
+            f"particles, which agree (R-hat {ladder.rhat_max:.3f}, ESS {ladder.ess_min:.0f}); "
+            "the emcee walkers did not converge" + (f" ({why})" if why else ""))
+    return ladder, note, True
+
+
+def _evidence(lik, post: PosteriorResult, seed: int, route: str = "auto", *,
+              best_log_likelihood: float | None = None, importance=None) -> dict:
+    """ln Z of ``post`` by ``route``: ``{"evidence", "ladder_runs", "warnings"}``."""
+    out = {"evidence": None, "warnings": [], "ladder_runs": None}
+    # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
+    # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
+    # from the prior instead, proposing from the draws as well so that it keeps the narrow modes
+    # the walkers found. Importance draws are a resample (duplicates): without the weights' own
+    # ln Z (k̂ ≥ 0.5) they go to the ladder, not to bridge sampling.
+    ladder = route == "ladder" or (route == "auto" and (
+        not post.converged or getattr(post, "sampler", "emcee") == "importance"))
+    try:
+        if importance is not None and route == "auto":
+            out["evidence"] = importance  # the certified weights that gave the posterior
+        elif ladder:
+            try:
+                out["evidence"], out["ladder_runs"] = ladder_runs(lik, seed=seed, guide=post)
+            except InputError as exc:
+                if route == "ladder":
+                    raise
+                warnings.warn(f"{post.structure}: tempered ladder failed ({exc}); ln Z from the "
+                              "emcee draws instead", EvidenceWarning, stacklevel=3)
+                out["evidence"] = bridge_evidence(lik, post, seed=seed)
+        else:
+            out["evidence"] = bridge_evidence(lik, post, seed=seed)
+    except InputError as exc:
+        warnings.warn(f"{post.structure}: no evidence: {exc}", EvidenceWarning, stacklevel=3)
+        return out
+    ev = out["evidence"]
+    if (ev.reached_log_likelihood is not None and best_log_likelihood is not None
+            and ev.reached_log_likelihood < best_log_likelihood - LADDER_SHORTFALL):
+        message = (f"{post.structure}: a tempered-ladder run ended "
+                   f"{best_log_likelihood - ev.reached_log_likelihood:.1f} nats below the best "
+                   "fit, so its ln Z may be too low")
+        out["warnings"].append(message)
+        warnings.warn(message, EvidenceWarning, stacklevel=3)
+    if not post.converged and ev.method == "bridge":
+        out["warnings"].append(f"{post.structure}: posterior not converged, so its evidence is "
+                               "unreliable")
+    return out
+
+
+def evidence_check(lik, post, evidence, seed: int) -> dict:
+    """ln Z by dynesty nested sampling beside ``evidence``, and whether they agree within twice
+    their combined error: ``{"evidence_check", "evidence_agree", "warnings"}``."""
+    out = {"warnings": []}
+    # Uniform draws from bounding ellipsoids where the posterior is one compact mode; slice
+    # sampling where the walkers did not converge (ridges, several modes), on which uniform
+    # draws stall (see nested_evidence).
+    how = {} if post.converged else {"sample": "rslice", "slices": max(25, 5 * lik.ndim)}
+    nested = nested_evidence(lik, seed=seed, **how)
+    out["evidence_check"] = nested
+    combined = math.hypot(evidence.log_z_err, nested.log_z_err)
+    agree = abs(evidence.log_z - nested.log_z) <= 2 * combined
+    out["evidence_agree"] = bool(agree)
+    if not agree:
+        out["warnings"].append(f"{post.structure}: {evidence.method} and nested ln Z disagree")
+        warnings.warn(
+            f"{post.structure}: {evidence.method} ln Z = {evidence.log_z:.2f} ± "
+            f"{evidence.log_z_err:.2f} and nested ln Z = {nested.log_z:.2f} ± "
+            f"{nested.log_z_err:.2f} disagree", EvidenceWarning, stacklevel=3)
+    return out

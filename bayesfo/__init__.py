@@ -5,8 +5,9 @@ data support, and how sure can I be?". The data flow, module by module:
 
 ``data`` (FrequencyResponse, CSV reader) → ``structures`` (model cards in ``models/*.toml``,
 evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optimisation: the seeds)
-→ ``inference`` (likelihood, emcee posterior, diagnostics, evidence) → ``comparison`` (run,
-criteria, results, output files) → ``report`` and ``plotting``. ``options`` checks the options
+→ ``inference`` (likelihood, certified posteriors, diagnostics, evidence) → ``comparison`` (run,
+criteria, results, output files) → ``predictions`` (material functions with credible bands) →
+``report`` and ``plotting``. ``options`` checks the options
 of a comparison before any work; ``outdir`` keeps each output directory the output of one run;
 ``parallel`` runs worker processes; ``batch`` runs comparisons over many data sets; ``cli`` is
 the command line, one module per command. ``sine`` analyses one sine record and ``records``
@@ -40,12 +41,13 @@ from .structures import get_structure, list_structures, resolve_structures  # no
 #: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
 #: ``import bayesfo`` and ``bayesfo --help`` stay fast.
 _LAZY = {"compare": "comparison", "write_outputs": "comparison", "load": "comparison",
-         "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison"}
+         "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison",
+         "predict": "predictions", "Prediction": "predictions"}
 
 
 #: Subpackages reachable as attributes without an import of their own (``bf.plotting``), loaded
 #: on first use: matplotlib is imported only by a program that draws.
-_LAZY_MODULES = ("plotting", "inference", "identify", "batch")
+_LAZY_MODULES = ("plotting", "inference", "identify", "batch", "predictions")
 
 
 def __getattr__(name):
@@ -62,9 +64,11 @@ __all__ = [
     "Comparison",
     "Criteria",
     "OutputError",
+    "Prediction",
     "StructureResult",
     "compare",
     "load",
+    "predict",
     "read",
     "write_outputs",
     "FrequencyResponse",

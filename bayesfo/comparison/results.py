@@ -339,6 +339,14 @@ class Comparison:
 
         return [r.name for r in sorted(ok, key=key)]
 
+    def predict(self, quantity: str, x, *, structure: str | None = None,
+                average: str | None = None, seed: int = 0):
+        """A material function with its credible band: :func:`bayesfo.predict` of this
+        comparison (G′, G″, tan δ, J′, J″, |η*| at ω; G(t), J(t); spectra H(τ), L(τ))."""
+        from ..predictions import predict
+
+        return predict(self, quantity, x, structure=structure, average=average, seed=seed)
+
     def __getitem__(self, name: str) -> StructureResult:
         for r in self.results:
             if r.name == name:

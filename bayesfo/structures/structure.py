@@ -267,6 +267,39 @@ class Structure:
                 out = power_ratio(omega, nc, ne, dc, de)
         return out[0] if single else out
 
+    def laplace(self, theta, s) -> np.ndarray:
+        """The transfer function as written in the card at complex ``s`` (any shape), with the
+        fractional powers on their principal branch (cut along the negative real axis).
+
+        Returns
+        -------
+        ndarray of complex, shape ``s.shape`` or ``(n_sets, *s.shape)``
+        """
+        s = np.asarray(s, dtype=complex)
+        vals, single = self.values(theta)
+        n_sets = np.atleast_2d(np.asarray(theta, float)).shape[0]
+        log_s = np.log(s)
+        shape = (n_sets,) + (1,) * s.ndim
+        powers = {}  # s^e once per distinct exponent column (s^q on both sides, s^0, s^1)
+
+        def power(e):
+            key = e.tobytes()
+            if key not in powers:
+                powers[key] = (1.0 if not e.any() else s if np.all(e == 1.0)
+                               else np.exp(e.reshape(shape) * log_s))
+            return powers[key]
+
+        sides = []
+        with np.errstate(all="ignore"):
+            for terms in (self.numerator, self.denominator):
+                coef, expo = self._side_arrays(terms, vals, n_sets)
+                total = np.zeros((n_sets, *s.shape), dtype=complex)
+                for k in range(coef.shape[1]):
+                    total += coef[:, k].reshape(shape) * power(expo[:, k])
+                sides.append(total)
+            out = sides[0] / sides[1]
+        return out[0] if single else out
+
     def power_terms(self, theta) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
         """(coefficient, exponent) pairs of numerator and denominator for one parameter set,
         as :func:`bayesfo.timedomain.simulate` takes them."""

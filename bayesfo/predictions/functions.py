@@ -1,0 +1,387 @@
+"""Material functions of a compared structure, or of an average over structures, with credible
+bands from the certified posterior draws.
+
+A card describes a compliance C(s) = J̄*(s) (the Laplace-domain creep compliance times s); the
+complex modulus is G*(s) = 1/C(s). From them, for every posterior draw:
+
+- storage and loss modulus G′(ω) = Re G*(iω), G″(ω) = Im G*(iω), loss tangent G″/G′;
+- storage and loss compliance J′(ω) = Re C(iω), J″(ω) = −Im C(iω) (J* = J′ − iJ″);
+- the magnitude of the complex viscosity |η*|(ω) = |G*(iω)|/ω;
+- the relaxation modulus G(t) = L⁻¹[G*(s)/s](t) and the creep compliance J(t) = L⁻¹[C(s)/s](t)
+  (:mod:`.laplace`; a flow term t/η or an unbounded G(t) near 0 come out as they are);
+- the relaxation and retardation spectra H(τ) = Im G*(e^{iπ}/τ)/π and
+  L(τ) = −Im C(e^{iπ}/τ)/π (the Stieltjes inversion of G(t) = G_e + ∫ H e^{−t/τ} d ln τ and
+  J(t) = J_g + ∫ L (1 − e^{−t/τ}) d ln τ + t/η): continuous for fractional orders; a structure
+  of integer orders has a discrete spectrum (lines at its relaxation times), which this
+  continuous density cannot show (it is 0 between the lines).
+
+The band of a quantity at each x is the highest-density interval of its values over the draws
+(the posterior of the mean function; measurement noise is not added), the centre line their
+median. Averages over structures mix the structures' draws in proportion to their weights: the
+posterior model probabilities (Bayesian model averaging, ``"bma"``) or stacking weights on the
+pointwise PSIS-LOO (``"stacking"``, arviz-stats).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from . import laplace
+
+#: quantity: (the argument it takes, its symbol, the dimension of its values).
+QUANTITIES = {
+    "storage": ("omega", "G′", "modulus"),
+    "loss": ("omega", "G″", "modulus"),
+    "tan_delta": ("omega", "tan δ", "none"),
+    "storage_compliance": ("omega", "J′", "compliance"),
+    "loss_compliance": ("omega", "J″", "compliance"),
+    "complex_viscosity": ("omega", "|η*|", "viscosity"),
+    "relaxation_modulus": ("time", "G(t)", "modulus"),
+    "creep_compliance": ("time", "J(t)", "compliance"),
+    "relaxation_spectrum": ("tau", "H(τ)", "modulus"),
+    "retardation_spectrum": ("tau", "L(τ)", "compliance"),
+}
+#: The unit of each kind of argument.
+X_UNITS = {"omega": "rad/s", "time": "s", "tau": "s"}
+#: Ways of averaging over structures.
+AVERAGES = ("bma", "stacking")
+#: Probability of the credible band (the highest-density interval, as everywhere in bayesfo).
+BAND = 0.94
+#: Posterior draws used per prediction (a random subset where a posterior has more).
+MAX_DRAWS = 2000
+#: Draws evaluated at once in the time domain (the contour's nodes multiply the work).
+_CHUNK = 250
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """A material function with its credible band.
+
+    Attributes
+    ----------
+    quantity : str
+        One of :data:`QUANTITIES`.
+    unit, x_unit : str
+    x : ndarray
+        Where it was evaluated (angular frequencies in rad/s, times or relaxation times in s).
+    median, hdi_low, hdi_high : ndarray
+        The median over the draws and the ends of their 94 % highest-density interval, per x.
+    extrapolated : ndarray of bool
+        Where x lies outside the window the data cover (ω outside [ω_min, ω_max]; t and τ
+        outside [1/ω_max, 1/ω_min]).
+    structure : str or None
+        The structure predicted from; None for an average.
+    weights : dict or None
+        ``{structure: weight}`` of an average (``average`` says which weights).
+    average : str or None
+    notes : tuple of str
+        What the user should know (an inadequate structure carrying weight, the two
+        weightings disagreeing, a discrete spectrum).
+    values : ndarray, shape (n_draws, n_x)
+        The quantity for each draw used.
+    """
+
+    quantity: str
+    unit: str
+    x: np.ndarray
+    x_unit: str
+    median: np.ndarray
+    hdi_low: np.ndarray
+    hdi_high: np.ndarray
+    extrapolated: np.ndarray
+    structure: str | None = None
+    weights: dict | None = None
+    average: str | None = None
+    notes: tuple[str, ...] = ()
+    values: np.ndarray = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        """The JSON form (``bayesfo predict --json``): plain lists, NaN as None."""
+        def plain(a):
+            return [None if not math.isfinite(v) else float(v) for v in np.asarray(a, float)]
+
+        out = {"quantity": self.quantity, "unit": self.unit, "x": plain(self.x),
+               "x_unit": self.x_unit, "median": plain(self.median),
+               "hdi_low": plain(self.hdi_low), "hdi_high": plain(self.hdi_high),
+               "extrapolated": [bool(v) for v in self.extrapolated]}
+        if self.weights is None:
+            out["structure"] = self.structure
+        else:
+            out["average"] = self.average
+            out["weights"] = {k: float(v) for k, v in self.weights.items()}
+        out["notes"] = list(self.notes)
+        return out
+
+
+def predict(result, quantity: str, x, *, structure: str | None = None,
+            average: str | None = None, seed: int = 0) -> Prediction:
+    """A material function of a comparison's structure, or of an average, with its band.
+
+    Parameters
+    ----------
+    result : Comparison
+        From :func:`bayesfo.compare` or :func:`bayesfo.load`, on modulus or compliance data.
+    quantity : str
+        One of :data:`QUANTITIES`: ``storage``, ``loss``, ``tan_delta``,
+        ``storage_compliance``, ``loss_compliance``, ``complex_viscosity`` (at angular
+        frequencies), ``relaxation_modulus``, ``creep_compliance`` (at times),
+        ``relaxation_spectrum``, ``retardation_spectrum`` (at relaxation times).
+    x : array_like
+        Angular frequencies [rad/s], times [s] or relaxation times [s], all > 0.
+    structure : str, optional
+        The structure to predict from (default: the best ranked); not with ``average``.
+    average : {"bma", "stacking"}, optional
+        Average over the ranked structures with posterior model probabilities or stacking
+        weights.
+    seed : int
+        Seeds the choice of draws where a posterior has more than :data:`MAX_DRAWS`, and the
+        mixing of an average.
+
+    Returns
+    -------
+    Prediction
+
+    Raises
+    ------
+    InputError
+        An unknown quantity or structure, x not positive and finite, data that are not a
+        modulus or a compliance, or an average with nothing to average.
+
+    Examples
+    --------
+    >>> import bayesfo as bf
+    >>> result = bf.compare(bf.read("examples/data/adhesive_468mp/Tp020C.csv"), "voigt,zener")  # doctest: +SKIP
+    >>> g_t = bf.predict(result, "relaxation_modulus", [0.01, 0.1, 1.0])  # doctest: +SKIP
+    >>> g_t.median, g_t.hdi_low, g_t.hdi_high, g_t.unit  # doctest: +SKIP
+    """
+    quantity = _check_quantity(quantity)
+    domain = QUANTITIES[quantity][0]
+    x = _check_x(x, domain)
+    data = result.data
+    if data.kind not in ("modulus", "compliance"):
+        raise InputError(f"predict: the data are a {data.kind} transfer function; material "
+                         "functions follow from modulus or compliance data only")
+    if structure is not None and average is not None:
+        raise InputError("predict: give a structure or an average, not both")
+    rng = np.random.default_rng(seed)
+    notes = []
+    if average is None:
+        name = structure if structure is not None else _best(result)
+        weights = {_usable(result, name).name: 1.0}
+    else:
+        weights, notes = _weights(result, average)
+    counts = _draw_counts(weights, rng)
+    parts = []
+    for name, n in counts.items():
+        if n == 0:
+            continue
+        r = result[name]
+        theta = _draws(r, n, rng)
+        parts.append(_evaluate(r.structure, theta, quantity, x))
+    values = np.concatenate(parts, axis=0)
+    if quantity in ("relaxation_spectrum", "retardation_spectrum"):
+        discrete = [n for n in weights if result[n].structure.integer and weights[n] > 0]
+        if discrete:
+            notes.append(f"{', '.join(discrete)}: integer orders give a discrete spectrum "
+                         "(lines at the relaxation times), which a continuous density shows "
+                         "as 0 between them")
+    median, lo, hi = _band(values)
+    return Prediction(
+        quantity=quantity, unit=_unit(quantity, data), x=x, x_unit=X_UNITS[domain],
+        median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, data.omega),
+        structure=next(iter(weights)) if average is None else None,
+        weights=dict(weights) if average is not None else None, average=average,
+        notes=tuple(notes), values=values)
+
+
+# ---------------------------------------------------------------------------- checks
+def _check_quantity(quantity) -> str:
+    if quantity not in QUANTITIES:
+        raise InputError(f"predict: unknown quantity {quantity!r}; one of "
+                         + ", ".join(QUANTITIES))
+    return quantity
+
+
+def _check_x(x, domain: str) -> np.ndarray:
+    what = {"omega": "angular frequencies", "time": "times", "tau": "relaxation times"}[domain]
+    try:
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(f"predict: the {what} must be numbers") from None
+    if x.ndim != 1 or x.size == 0:
+        raise InputError(f"predict: give one or more {what}")
+    bad = ~np.isfinite(x) | (x <= 0)
+    if bad.any():
+        raise InputError(f"predict: the {what} must be finite and > 0; got {x[bad][0]:g}")
+    return x
+
+
+def _best(result) -> str:
+    if not result.ranking:
+        raise InputError("predict: the comparison has no structure with a posterior")
+    return result.ranking[0]
+
+
+def _usable(result, name: str):
+    try:
+        r = result[name]
+    except KeyError:
+        raise InputError(f"predict: no structure {name!r} in the comparison; it has "
+                         + ", ".join(x.name for x in result.results)) from None
+    if r.error is not None or r.posterior is None:
+        raise InputError(f"predict: structure {name!r} has no posterior ({r.error})")
+    return r
+
+
+# ---------------------------------------------------------------------------- weights
+def _weights(result, average: str) -> tuple[dict, list]:
+    """``{structure: weight}`` (summing to 1) and notes, for ``average``."""
+    if average not in AVERAGES:
+        raise InputError(f"predict: average must be one of {', '.join(AVERAGES)}, got "
+                         f"{average!r}")
+    ranked = [result[n] for n in result.ranking]
+    if len(ranked) < 2:
+        raise InputError("predict: an average needs two or more structures with a posterior")
+    bma = {r.name: r.criteria.get("posterior_probability") for r in ranked}
+    if any(v is None for v in bma.values()):
+        bma = None
+    notes = []
+    stacking = _stacking(ranked)
+    if average == "bma":
+        if bma is None:
+            raise InputError("predict: some structures have no evidence, so no posterior "
+                             "model probabilities; use average='stacking'")
+        weights = bma
+    else:
+        if stacking is None:
+            raise InputError("predict: stacking needs the pointwise log-likelihood of every "
+                             "structure (a comparison loaded from an older run lacks it)")
+        weights = stacking
+    if bma is not None and stacking is not None:
+        apart = max(abs(bma[n] - stacking[n]) for n in bma)
+        if apart > 0.5:
+            notes.append(f"the posterior model probabilities and the stacking weights disagree "
+                         f"(by up to {apart:.2f} for one structure): the average depends on "
+                         "which is taken")
+    for r in ranked:
+        adequacy = r.criteria.get("adequacy")
+        if weights[r.name] >= 0.1 and adequacy is not None and not adequacy.adequate:
+            how = ("misses the data systematically, if by little" if adequacy.misfit_small
+                   else "does not fit the data")
+            notes.append(f"{r.name} carries weight {weights[r.name]:.2f} but {how} (posterior "
+                         "predictive checks)")
+    return weights, notes
+
+
+def _stacking(ranked) -> dict | None:
+    """Stacking weights of the structures (arviz-stats on their pointwise log-likelihood)."""
+    from arviz_stats import compare
+
+    trees = {r.name: r.posterior.idata for r in ranked}
+    if any(t is None or "log_likelihood" not in t.children for t in trees.values()):
+        return None
+    import warnings
+
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore")  # Pareto k̂ warnings: compare() flags them already
+        table = compare(trees, method="stacking", var_name="G")
+    w = {name: float(table.loc[name, "weight"]) for name in trees}
+    total = sum(w.values())
+    return {k: v / total for k, v in w.items()}
+
+
+def _draw_counts(weights: dict, rng) -> dict:
+    """How many of :data:`MAX_DRAWS` draws each structure gives to the mixture."""
+    names = list(weights)
+    p = np.array([weights[n] for n in names], dtype=float)
+    p = np.clip(p, 0.0, None) / p.sum()
+    counts = rng.multinomial(MAX_DRAWS, p) if len(names) > 1 else [MAX_DRAWS]
+    return dict(zip(names, (int(c) for c in counts), strict=True))
+
+
+def _draws(r, n: int, rng) -> np.ndarray:
+    """``n`` posterior draws (physical units, without the noise parameter), without
+    replacement where the posterior has as many, else all of them repeated as needed."""
+    samples = np.asarray(r.posterior.samples, dtype=float)[:, :r.structure.n_params]
+    if samples.shape[0] >= n:
+        return samples[np.sort(rng.choice(samples.shape[0], size=n, replace=False))]
+    return samples[rng.choice(samples.shape[0], size=n, replace=True)]
+
+
+# ---------------------------------------------------------------------------- evaluation
+def evaluate(structure, theta, quantity: str, x) -> np.ndarray:
+    """``quantity`` of ``structure`` at ``x`` for each parameter set of ``theta`` (physical
+    units): shape (n_sets, n_x).
+
+    Examples
+    --------
+    A springpot relaxes as G(t) = c t^(−α)/Γ(1 − α):
+
+    >>> import numpy as np
+    >>> from bayesfo.structures import get_structure
+    >>> g = evaluate(get_structure("springpot"), [2.0, 0.5], "relaxation_modulus", [1.0])
+    >>> bool(np.isclose(g[0, 0], 2.0 / np.sqrt(np.pi)))
+    True
+    """
+    quantity = _check_quantity(quantity)
+    return _evaluate(structure, np.atleast_2d(np.asarray(theta, float)), quantity,
+                     _check_x(x, QUANTITIES[quantity][0]))
+
+
+def _evaluate(structure, theta, quantity: str, x) -> np.ndarray:
+    domain = QUANTITIES[quantity][0]
+    with np.errstate(all="ignore"):
+        if domain == "omega":
+            c = structure.laplace(theta, 1j * x)  # the compliance C(iω)
+            g = 1.0 / c
+            return {"storage": lambda: g.real, "loss": lambda: g.imag,
+                    "tan_delta": lambda: g.imag / g.real,
+                    "storage_compliance": lambda: c.real, "loss_compliance": lambda: -c.imag,
+                    "complex_viscosity": lambda: np.abs(g) / x}[quantity]()
+        if domain == "tau":
+            c = structure.laplace(theta, -1.0 / x + 0j)  # on the upper side of the cut
+            # s^α at s = e^{iπ}/τ: np.log of a negative real with +0 imaginary part is ln|s|+iπ.
+            if quantity == "relaxation_spectrum":
+                return (1.0 / c).imag / np.pi
+            return -c.imag / np.pi
+        out = np.empty((theta.shape[0], x.size))
+        for i in range(0, theta.shape[0], _CHUNK):
+            part = theta[i:i + _CHUNK]
+            if quantity == "relaxation_modulus":
+                out[i:i + _CHUNK] = laplace.invert(lambda s: 1.0 / (structure.laplace(part, s) * s), x)
+            else:
+                out[i:i + _CHUNK] = laplace.invert(lambda s: structure.laplace(part, s) / s, x)
+        return out
+
+
+def _band(values) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Median and the ends of the 94 % HDI per column; NaN where a column has NaN draws."""
+    from ..inference._arviz import hdi_columns
+
+    with np.errstate(all="ignore"):
+        median = np.median(values, axis=0)
+        lo, hi = hdi_columns(values, BAND)
+    bad = ~np.all(np.isfinite(values), axis=0)
+    for a in (median, lo, hi):
+        a[bad] = np.nan
+    return median, lo, hi
+
+
+def _outside(x, domain: str, omega) -> np.ndarray:
+    w_lo, w_hi = float(np.min(omega)), float(np.max(omega))
+    if domain == "omega":
+        return (x < w_lo) | (x > w_hi)
+    return (x < 1.0 / w_hi) | (x > 1.0 / w_lo)
+
+
+def _unit(quantity: str, data) -> str:
+    from ..structures.physical import _wrap, stress_unit
+
+    modulus = stress_unit(data.kind, data.units or "")
+    kind = QUANTITIES[quantity][2]
+    return {"modulus": modulus, "compliance": f"1/{_wrap(modulus)}",
+            "viscosity": f"{modulus} s", "none": ""}[kind]

@@ -42,6 +42,7 @@ def load_libraries(formats=()) -> None:
     with held():
         import emcee  # noqa: F401
         import h5netcdf  # noqa: F401
+        import h5py  # noqa: F401
         import scipy.optimize  # noqa: F401
         import scipy.special  # noqa: F401
         import scipy.stats  # noqa: F401

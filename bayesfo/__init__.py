@@ -6,8 +6,9 @@ data support, and how sure can I be?". The data flow, module by module:
 ``data`` (FrequencyResponse, CSV reader) → ``structures`` (model cards in ``models/*.toml``,
 evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optimisation: the seeds)
 → ``inference`` (likelihood, certified posteriors, diagnostics, evidence) → ``comparison`` (run,
-criteria, results, output files) → ``predictions`` (material functions with credible bands) →
-``report`` and ``plotting``. ``options`` checks the options
+criteria, results, output files) and ``tts`` (master curves: one posterior of a master
+structure and the isotherms' shift factors) → ``predictions`` (material functions with credible
+bands) → ``report`` and ``plotting``. ``options`` checks the options
 of a comparison before any work; ``outdir`` keeps each output directory the output of one run;
 ``parallel`` runs worker processes; ``batch`` runs comparisons over many data sets; ``cli`` is
 the command line, one module per command. ``sine`` analyses one sine record and ``records``
@@ -42,12 +43,13 @@ from .structures import get_structure, list_structures, resolve_structures  # no
 #: ``import bayesfo`` and ``bayesfo --help`` stay fast.
 _LAZY = {"compare": "comparison", "write_outputs": "comparison", "load": "comparison",
          "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison",
-         "predict": "predictions", "Prediction": "predictions"}
+         "predict": "predictions", "Prediction": "predictions",
+         "mastercurve": "tts", "MasterCurve": "tts"}
 
 
 #: Subpackages reachable as attributes without an import of their own (``bf.plotting``), loaded
 #: on first use: matplotlib is imported only by a program that draws.
-_LAZY_MODULES = ("plotting", "inference", "identify", "batch", "predictions")
+_LAZY_MODULES = ("plotting", "inference", "identify", "batch", "predictions", "tts")
 
 
 def __getattr__(name):
@@ -68,11 +70,13 @@ __all__ = [
     "StructureResult",
     "compare",
     "load",
+    "mastercurve",
     "predict",
     "read",
     "write_outputs",
     "FrequencyResponse",
     "InputError",
+    "MasterCurve",
     "NonlinearityWarning",
     "StructureError",
     "__version__",

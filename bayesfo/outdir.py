@@ -51,7 +51,7 @@ _FORMAT = 1
 
 #: Top-level names a bayesfo run may own in an output directory.
 _OUTPUT_NAME = re.compile(
-    r"^(?:summary\.json|ranking\.csv|report\.html|figures|batch\.json|error\.txt"
+    r"^(?:summary\.json|ranking\.csv|report\.html|figures|batch\.json|error\.txt|master\.csv"
     r"|[A-Za-z0-9][A-Za-z0-9_.+\-]*\.nc)$")
 #: The names of a run's entries, in the order they are moved out (and, reversed, in).
 _FIRST_OUT = ("summary.json", "batch.json")

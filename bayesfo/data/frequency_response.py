@@ -59,6 +59,9 @@ class FrequencyResponse:
         A label for reports and plots.
     source : str
         Where the data came from (a path), for reports.
+    distinct_frequencies : bool
+        Refuse a frequency that appears twice (default). Joint data sets of several isotherms
+        (:mod:`bayesfo.tts`) repeat the frequencies of the sweep.
 
     Raises
     ------
@@ -85,6 +88,7 @@ class FrequencyResponse:
     name: str = ""
     source: str = ""
     notes: tuple[str, ...] = field(default=())
+    distinct_frequencies: bool = True
 
     def __post_init__(self):
         omega = _as_1d(self.omega, "omega", float)
@@ -105,7 +109,8 @@ class FrequencyResponse:
             raise InputError(
                 f"argument 'omega' must be positive: omega[{bad[0]}] = {omega[bad[0]]:g} rad/s"
             )
-        _check_distinct(omega, "omega")
+        if self.distinct_frequencies:
+            _check_distinct(omega, "omega")
         sigma = None
         if self.sigma is not None:
             sigma = _as_1d(self.sigma, "sigma", float)

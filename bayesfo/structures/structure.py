@@ -267,19 +267,28 @@ class Structure:
                 out = power_ratio(omega, nc, ne, dc, de)
         return out[0] if single else out
 
-    def laplace(self, theta, s) -> np.ndarray:
+    def laplace(self, theta, s, *, per_set: bool = False) -> np.ndarray:
         """The transfer function as written in the card at complex ``s`` (any shape), with the
         fractional powers on their principal branch (cut along the negative real axis).
 
+        With ``per_set``, row i of ``s`` (shape ``(n_sets, ...)``) belongs to parameter set i
+        alone (e.g. frequencies shifted by each set's own factor).
+
         Returns
         -------
-        ndarray of complex, shape ``s.shape`` or ``(n_sets, *s.shape)``
+        ndarray of complex, shape ``s.shape`` (one set, or ``per_set``) or ``(n_sets, *s.shape)``
         """
         s = np.asarray(s, dtype=complex)
         vals, single = self.values(theta)
         n_sets = np.atleast_2d(np.asarray(theta, float)).shape[0]
         log_s = np.log(s)
-        shape = (n_sets,) + (1,) * s.ndim
+        if per_set:
+            if s.ndim == 0 or s.shape[0] != n_sets:
+                raise StructureError(f"laplace(per_set=True) takes one row of s per parameter "
+                                     f"set: {n_sets} sets, s of shape {s.shape}")
+            shape, out_shape, single = (n_sets,) + (1,) * (s.ndim - 1), s.shape, False
+        else:
+            shape, out_shape = (n_sets,) + (1,) * s.ndim, (n_sets, *s.shape)
         powers = {}  # s^e once per distinct exponent column (s^q on both sides, s^0, s^1)
 
         def power(e):
@@ -293,7 +302,7 @@ class Structure:
         with np.errstate(all="ignore"):
             for terms in (self.numerator, self.denominator):
                 coef, expo = self._side_arrays(terms, vals, n_sets)
-                total = np.zeros((n_sets, *s.shape), dtype=complex)
+                total = np.zeros(out_shape, dtype=complex)
                 for k in range(coef.shape[1]):
                     total += coef[:, k].reshape(shape) * power(expo[:, k])
                 sides.append(total)

@@ -1,0 +1,132 @@
+"""``bayesfo mastercurve``: time–temperature superposition of isotherms as one posterior."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import InputError
+
+
+def add_parser(subparsers):
+    """Register ``bayesfo mastercurve``."""
+    p = subparsers.add_parser(
+        "mastercurve", help="master curve of isotherms: shift factors, WLF/Arrhenius laws and "
+                            "the master structure, in one posterior",
+        description="Fit one master structure and every isotherm's shift log10 a_T jointly "
+                    "(a certified posterior, as compare computes it), fit the WLF and "
+                    "Arrhenius laws to the shifts, and write summary.json, master.csv (the "
+                    "reduced data, which 'bayesfo compare' reads) and figures/mastercurve.png.")
+    p.add_argument("data", nargs="+", metavar="DATA",
+                   help="files of isotherms: a lab export with several (TRIOS steps, a "
+                        "temperature column, pyvisco), or one file per temperature (the "
+                        "temperature from a '# temperature:' line or the name, e.g. Tp020C.csv), "
+                        "or directories of such files")
+    p.add_argument("--structure", default="zener", metavar="S",
+                   help="the master structure (default zener; 'bayesfo structures' lists them)")
+    p.add_argument("--reference-temperature", type=float, default=None, metavar="T",
+                   help="reference temperature [°C], an isotherm's (default: the middle one)")
+    p.add_argument("--noise", default="proportional", choices=("proportional", "constant",
+                                                               "known"),
+                   help="noise model (default proportional: isotherms span decades)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory (default bayesfo-mastercurve)")
+    p.add_argument("--no-figures", action="store_true", help="skip figures/mastercurve.png")
+    p.add_argument("--json", action="store_true", help="print summary.json's shift block")
+    return p
+
+
+def read_isotherm_files(paths) -> list[tuple]:
+    """(FrequencyResponse, temperature or None) of every isotherm in ``paths`` (files, or
+    directories of ``*.csv``)."""
+    from ..batch.temperature import temperature_of_file
+    from ..data import read_isotherms
+
+    files = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            found = sorted(p.glob("*.csv"))
+            if not found:
+                raise InputError(f"'{p}': a directory without *.csv files")
+            files.extend(found)
+        elif p.is_file():
+            files.append(p)
+        else:
+            raise InputError(f"'{p}': no such file or directory")
+    out = []
+    for f in files:
+        sets = read_isotherms(f)
+        if len(sets) == 1 and sets[0].temperature is None:
+            t = temperature_of_file(f)
+            if t is None:
+                raise InputError(f"'{f}': no temperature (give a '# temperature: 20 C' line or "
+                                 "name the file by it, e.g. Tp020C.csv)")
+            out.append((sets[0].data, t))
+        else:
+            for s in sets:
+                if s.temperature is None:
+                    raise InputError(f"'{f}', data set {s.label!r}: no temperature")
+                out.append((s.data, s.temperature))
+    return out
+
+
+def run(args) -> int:
+    from .._signals import load_libraries
+    from ..outdir import check_output_directory, staged_run
+    from ..structures import get_structure
+    from ..tts import mastercurve
+
+    get_structure(args.structure)  # an unknown name fails before any reading
+    isotherms = read_isotherm_files(args.data)
+    target = Path(args.out or "bayesfo-mastercurve")
+    out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
+    load_libraries(() if args.no_figures else ("png",))
+    mc = mastercurve(isotherms, args.structure, reference_temperature=args.reference_temperature,
+                     noise=args.noise, seed=args.seed)
+    summary = {"data": mc.data.to_dict(), **mc.to_dict()}
+    master = mc.master_data()
+    law = mc.shift_law()
+    comments = [f"master curve at {mc.reference_temperature:g} C of {len(mc.temperatures)} "
+                f"isotherms ({min(mc.temperatures):g} to {max(mc.temperatures):g} C), shifted "
+                f"by the posterior mean log10 a_T of bayesfo mastercurve ({mc.structure})",
+                f"temperature: {mc.reference_temperature:g} C",
+                f"shift law: {law['name']} "
+                + ", ".join(f"{k} = {v['mean']:.6g} {v['unit']}".rstrip()
+                            for k, v in law["parameters"].items())]
+    with staged_run(out) as stage:
+        (stage / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False)
+                                            + "\n")
+        (stage / "master.csv").write_text(master.to_csv_text(comments))
+        if not args.no_figures:
+            from ..plotting.mastercurve import plot_mastercurve
+            from ..plotting.output import save_figure
+
+            (stage / "figures").mkdir()
+            drawn = plot_mastercurve(mc)
+            save_figure(drawn.figure, stage / "figures" / "mastercurve.png")
+    if args.json:
+        print(json.dumps({k: summary[k] for k in ("shift_factors", "shift_law")}, indent=1,
+                         ensure_ascii=False))
+        return 0
+    _print(mc, out)
+    return 0
+
+
+def _print(mc, out) -> None:
+    status = "certified" if mc.posterior.converged else "NOT certified"
+    print(f"{mc.data.label}: master structure {mc.structure}, ln Z {mc.log_evidence:.2f} ± "
+          f"{mc.log_evidence_err:.2f}, joint posterior {status} ({mc.posterior.sampler})")
+    print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}")
+    for f in mc.shift_factors():
+        a = f["log10_aT"]
+        hdi = f"[{a['hdi_low']:.3f}, {a['hdi_high']:.3f}]"
+        print(f"{f['temperature']:8g} {a['mean']:10.3f} {a['sd']:7.3f} {hdi:>20}")
+    for name, law in mc.laws.items():
+        text = ", ".join(f"{k} = {v['mean']:.4g} ± {v['sd']:.2g} {v['unit']}".rstrip()
+                         for k, v in law["parameters"].items())
+        print(f"{name:>10}: {text}; probability {law['probability']:.3f}")
+    for n in mc.notes:
+        print(f"note: {n}")
+    print(f"wrote {out}/summary.json, master.csv" + ("" if not (out / "figures").exists()
+                                                     else " and figures/mastercurve.png"))

@@ -1,0 +1,88 @@
+"""Figures of a master curve: the isotherms on the reduced frequency axis with the master
+structure's band, and the shift factors against temperature with the fitted laws."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._base import Drawn, new_figure
+
+
+def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
+    """G′ and G″ (or J′ and J″) of every isotherm against a_T·ω at the posterior mean shifts,
+    coloured by temperature, with the master structure's posterior median and 94 % band; and
+    log10 a_T against temperature (posterior mean and 94 % HDI) with the WLF and Arrhenius
+    laws at their posterior means.
+
+    Returns
+    -------
+    Drawn
+        Axes: (storage, loss, shifts). Values: ``"omega_reduced"``, ``"storage_median"``,
+        ``"loss_median"`` (the master's median on a grid), ``"temperature"``,
+        ``"log10_aT_mean"``, ``"log10_aT_low"``, ``"log10_aT_high"``.
+    """
+    import matplotlib as mpl
+
+    from ..predictions import evaluate
+    from ..structures import get_structure
+
+    fig = new_figure(fig, (11.0, 3.8))
+    axes = fig.subplots(1, 3)
+    modulus = mc.data.kind == "modulus"
+    parts = ("storage", "loss") if modulus else ("storage_compliance", "loss_compliance")
+    symbols = ("G′", "G″") if modulus else ("J′", "J″")
+    unit = mc.data.units or ("[G]" if modulus else "[J]")
+    temps = np.asarray(mc.temperatures)
+    cmap = mpl.colormaps["coolwarm"]
+    norm = mpl.colors.Normalize(temps.min(), temps.max())
+    shifts = mc.log_shift_mean
+    lo_w, hi_w = np.inf, 0.0
+    artists = {}
+    for i, (d, t) in enumerate(zip(mc.isotherms, temps, strict=True)):
+        w = d.omega * 10.0 ** shifts[i]
+        lo_w, hi_w = min(lo_w, w.min()), max(hi_w, w.max())
+        loss = d.response.imag if modulus else -d.response.imag
+        for ax, name, part in zip(axes[:2], ("storage", "loss"), (d.response.real, loss),
+                                  strict=True):
+            artists[f"{t:g}/{name}"] = ax.loglog(w, np.abs(part), "o", ms=3,
+                                                 color=cmap(norm(t)), alpha=0.8)[0]
+    grid = np.logspace(np.log10(lo_w), np.log10(hi_w), n_grid)
+    structure = get_structure(mc.structure)
+    rng = np.random.default_rng(0)
+    rows = rng.choice(mc.master_draws.shape[0], size=min(500, mc.master_draws.shape[0]),
+                      replace=False)
+    values = {"omega_reduced": grid}
+    for ax, q, sym in zip(axes[:2], parts, symbols, strict=True):
+        v = evaluate(structure, mc.master_draws[rows], q, grid)
+        med = np.median(v, axis=0)
+        lo, hi = np.percentile(v, [3, 97], axis=0)
+        ax.fill_between(grid, lo, hi, color="0.3", alpha=0.25, lw=0)
+        ax.loglog(grid, med, "k-", lw=1.2, label=f"{mc.structure} (median, 94 %)")
+        ax.set_xlabel(f"a_T ω [rad/s] (T_ref = {mc.reference_temperature:g} °C)")
+        ax.set_ylabel(f"{sym} [{unit}]")
+        values[f"{q.split('_')[0]}_median"] = med
+    axes[0].legend(loc="best", fontsize=8)
+    fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes[1], label="T [°C]")
+    factors = mc.shift_factors()
+    mean = np.array([f["log10_aT"]["mean"] for f in factors])
+    low = np.array([f["log10_aT"]["hdi_low"] for f in factors])
+    high = np.array([f["log10_aT"]["hdi_high"] for f in factors])
+    ax = axes[2]
+    ax.errorbar(temps, mean, yerr=[mean - low, high - mean], fmt="o", color="k", ms=3,
+                capsize=2, label="posterior (94 % HDI)")
+    tt = np.linspace(temps.min(), temps.max(), 200)
+    from ..tts import arrhenius, wlf
+
+    laws = mc.laws
+    c1, c2 = (laws["wlf"]["parameters"][k]["mean"] for k in ("C1", "C2"))
+    ea = laws["arrhenius"]["parameters"]["Ea"]["mean"]
+    t_ref = mc.reference_temperature
+    ax.plot(tt, wlf(tt, t_ref, c1, c2), "-", color="#0072B2",
+            label=f"WLF C1 {c1:.3g}, C2 {c2:.3g} °C (P {laws['wlf']['probability']:.2f})")
+    ax.plot(tt, arrhenius(tt, t_ref, ea), "--", color="#D55E00",
+            label=f"Arrhenius Ea {ea / 1e3:.3g} kJ/mol (P {laws['arrhenius']['probability']:.2f})")
+    ax.set_xlabel("T [°C]")
+    ax.set_ylabel("log10 a_T")
+    ax.legend(loc="best", fontsize=7)
+    values.update(temperature=temps, log10_aT_mean=mean, log10_aT_low=low, log10_aT_high=high)
+    return Drawn.build(fig, axes, values, artists)

@@ -1,0 +1,587 @@
+"""Time–temperature superposition as one posterior: a master structure and every isotherm's
+horizontal shift log10 a_T, on all isotherms' complex data at once.
+
+Isotherm i, measured at temperature T_i, is modelled as the master function at reduced
+frequency: G_i(ω) = G_master(a_T,i · ω), with a_T = 1 at the reference temperature. The
+parameters are the master structure's, one log10 a_T per other isotherm (uniform prior over
+±:data:`SHIFT_RANGE` decades: no bound on the step between neighbours, and a shift the data do
+not fix, over a featureless plateau, comes out wide rather than pinned) and the noise. The
+posterior and ln Z come from :func:`bayesfo.inference.certified_posterior`, as in ``compare``.
+
+Seeds: the shift between neighbouring isotherms that best overlays their log|G*| and phase
+(where their reduced windows overlap), then the master structure fitted to the data so
+reduced, then a joint least-squares fit of everything.
+
+The shift laws are fitted to the posterior draws of the shifts, draw by draw, so that their
+parameters carry the shifts' uncertainty: WLF, log10 a_T = −C1 (T − T_ref)/(C2 + T − T_ref),
+and Arrhenius, log10 a_T = E_a/(R ln 10) · (1/T − 1/T_ref) (T in kelvin). Their relative
+support is judged by BIC on the posterior mean and covariance of the shifts (an approximation
+of their evidence: the shifts' posterior taken as a Gaussian measurement).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..errors import InputError
+from ..priors import Uniform
+from ..structures.structure import Parameter
+
+#: Prior of each log10 a_T: uniform over ±SHIFT_RANGE decades around the reference.
+SHIFT_RANGE = 15.0
+#: Gas constant [J/(mol K)].
+GAS_CONSTANT = 8.314462618
+#: Kelvin of 0 °C.
+KELVIN = 273.15
+#: Posterior draws to which the shift laws are fitted (a seeded subset).
+LAW_DRAWS = 400
+#: A law whose χ²/dof against the shifts' posterior exceeds this misses them: a note says so
+#: (the 99.9 % point of χ²/dof for 5 degrees of freedom is 4.1).
+LAW_MISS = 4.0
+
+
+def shift_name(temperature: float) -> str:
+    """The parameter name of the shift of the isotherm at ``temperature`` [°C]:
+    ``log10_aT_80C``, ``log10_aT_m40C``, ``log10_aT_12p5C``."""
+    text = f"{temperature:g}".replace("-", "m").replace(".", "p")
+    return f"log10_aT_{text}C"
+
+
+@dataclass(frozen=True, eq=False)
+class ShiftedStructure:
+    """A master structure seen through the isotherms: the structure's parameters followed by
+    one log10 a_T per isotherm other than the reference, evaluated on the joint data's points
+    (each at its own isotherm's reduced frequency). It offers what the inference routes use of
+    a :class:`~bayesfo.structures.Structure`."""
+
+    master: object
+    temperatures: tuple[float, ...]
+    reference: int
+    #: Isotherm of each point of the joint data, in its order.
+    point_isotherm: np.ndarray
+    #: The dissipation grid of the master (scaled), spanning the reduced window.
+    master_grid: np.ndarray | None = None
+
+    @property
+    def name(self) -> str:
+        return self.master.name
+
+    @property
+    def shifted(self) -> tuple[int, ...]:
+        """Isotherms with a shift parameter (all but the reference), in parameter order."""
+        return tuple(i for i in range(len(self.temperatures)) if i != self.reference)
+
+    @cached_property
+    def parameters(self) -> tuple:
+        shifts = tuple(Parameter(shift_name(self.temperatures[i]), "shift",
+                                 Uniform(-SHIFT_RANGE, SHIFT_RANGE)) for i in self.shifted)
+        return tuple(self.master.parameters) + shifts
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def n_params(self) -> int:
+        return len(self.parameters)
+
+    @property
+    def fixed(self) -> dict:
+        return self.master.fixed
+
+    @property
+    def inverted(self) -> bool:
+        return self.master.inverted
+
+    @property
+    def commensurate_order(self):
+        return None
+
+    def check_data(self, data) -> None:
+        if data.n_frequencies < self.n_params + 1:
+            raise InputError(f"{data.n_frequencies} points for {self.n_params} parameters of "
+                             f"the master curve of {self.name}: too few")
+
+    def with_priors(self, priors: dict) -> ShiftedStructure:
+        from dataclasses import replace
+
+        own = {k: v for k, v in priors.items() if k in self.master.param_names}
+        if set(priors) - set(own):
+            raise InputError("priors of the shifts cannot be overridden")
+        return replace(self, master=self.master.with_priors(own))
+
+    def log_shifts(self, theta) -> np.ndarray:
+        """log10 a_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        k = self.master.n_params
+        out = np.zeros((theta.shape[0], len(self.temperatures)))
+        out[:, list(self.shifted)] = theta[:, k:k + len(self.shifted)]
+        return out
+
+    def response(self, theta, omega, kind: str = "compliance") -> np.ndarray:
+        """The master's response at each point's reduced frequency a_T·ω (``omega`` are the
+        joint data's points, in their order)."""
+        theta2 = np.atleast_2d(np.asarray(theta, float))
+        omega = np.asarray(omega, float)
+        if omega.shape != self.point_isotherm.shape:
+            raise InputError("a master curve is evaluated on its own data's points only")
+        a = 10.0 ** self.log_shifts(theta2)[:, self.point_isotherm]
+        with np.errstate(all="ignore"):
+            c = self.master.laplace(theta2[:, :self.master.n_params], 1j * omega * a,
+                                    per_set=True)
+            out = 1.0 / c if kind == "modulus" else c
+        return out[0] if np.ndim(theta) == 1 else out
+
+    def in_support(self, theta) -> np.ndarray:
+        theta2 = np.atleast_2d(np.asarray(theta, float))
+        k = self.master.n_params
+        ok = np.atleast_1d(self.master.in_support(theta2[:, :k])).copy()
+        ok &= np.all(np.abs(theta2[:, k:]) <= SHIFT_RANGE, axis=1)
+        return ok if np.ndim(theta) == 2 else ok[0]
+
+    def constraints_hold(self, theta, kind: str, omega_grid=None, where=None) -> np.ndarray:
+        theta2 = np.atleast_2d(np.asarray(theta, float))
+        return self.master.constraints_hold(theta2[:, :self.master.n_params], kind,
+                                            self.master_grid, where=where)
+
+    def admissible(self, theta, kind: str, omega_grid=None) -> np.ndarray:
+        theta2 = np.atleast_2d(np.asarray(theta, float))
+        ok = self.in_support(theta2)
+        ok &= self.constraints_hold(theta2, kind, where=ok)
+        return ok if np.ndim(theta) == 2 else ok[0]
+
+    def _convert(self, theta, scaling, to_physical: bool) -> np.ndarray:
+        theta2 = np.atleast_2d(np.asarray(theta, float))
+        out = theta2.copy()
+        k = self.master.n_params
+        convert = self.master.to_physical if to_physical else self.master.to_scaled
+        out[:, :k] = convert(theta2[:, :k], scaling)  # a_T is a ratio: no units
+        return out if np.ndim(theta) == 2 else out[0]
+
+    def to_physical(self, theta, scaling) -> np.ndarray:
+        return self._convert(theta, scaling, True)
+
+    def to_scaled(self, theta, scaling) -> np.ndarray:
+        return self._convert(theta, scaling, False)
+
+
+# ---------------------------------------------------------------------------- inputs
+@dataclass(frozen=True)
+class _Isotherms:
+    """The isotherms in order of temperature, checked."""
+
+    data: tuple[FrequencyResponse, ...]
+    temperatures: tuple[float, ...]
+    reference: int
+
+    @cached_property
+    def joint(self) -> FrequencyResponse:
+        omega = np.concatenate([d.omega for d in self.data])
+        response = np.concatenate([d.response for d in self.data])
+        sigma = (np.concatenate([d.sigma for d in self.data])
+                 if all(d.sigma is not None for d in self.data) else None)
+        first = self.data[0]
+        return FrequencyResponse(
+            omega, response, sigma, kind=first.kind, units=first.units,
+            name=f"{first.label.split(',')[0]}: {len(self.data)} isotherms, "
+                 f"{min(self.temperatures):g} to {max(self.temperatures):g} °C",
+            source=first.source, distinct_frequencies=False)
+
+    @cached_property
+    def point_isotherm(self) -> np.ndarray:
+        return np.concatenate([np.full(d.n_frequencies, i) for i, d in enumerate(self.data)])
+
+
+def _isotherms(isotherms, reference_temperature) -> _Isotherms:
+    """Check and sort the isotherms: (FrequencyResponse, temperature) pairs or objects with
+    ``data`` and ``temperature`` (:class:`bayesfo.data.Isotherm`)."""
+    pairs = []
+    for k, item in enumerate(isotherms):
+        if hasattr(item, "data") and hasattr(item, "temperature"):
+            data, temperature = item.data, item.temperature
+        else:
+            try:
+                data, temperature = item
+            except (TypeError, ValueError):
+                raise InputError(f"isotherm {k + 1}: give (FrequencyResponse, temperature in °C) "
+                                 "or an Isotherm of bayesfo.read_isotherms") from None
+        if not isinstance(data, FrequencyResponse):
+            raise InputError(f"isotherm {k + 1}: the data must be a FrequencyResponse")
+        if temperature is None or not math.isfinite(float(temperature)):
+            raise InputError(f"isotherm {k + 1} ({data.label}): no temperature; give each "
+                             "isotherm's temperature in °C")
+        pairs.append((data, float(temperature)))
+    if len(pairs) < 2:
+        raise InputError(f"a master curve needs two or more isotherms, got {len(pairs)}")
+    pairs.sort(key=lambda p: p[1])
+    temps = [t for _, t in pairs]
+    for a, b in zip(temps, temps[1:]):
+        if abs(a - b) < 0.5:
+            raise InputError(f"two isotherms at {a:g} and {b:g} °C: temperatures must differ "
+                             "(by 0.5 °C or more); merge or drop one")
+    kinds = {d.kind for d, _ in pairs}
+    if len(kinds) > 1 or kinds & {"generic"}:
+        raise InputError("the isotherms must all be modulus or all compliance data, got "
+                         + ", ".join(sorted(kinds)))
+    units = {d.units for d, _ in pairs}
+    if len(units) > 1:
+        raise InputError("the isotherms are in different units (" + ", ".join(sorted(units))
+                         + "); convert them to one")
+    if reference_temperature is None:
+        ref = len(pairs) // 2
+    else:
+        ref = int(np.argmin([abs(t - reference_temperature) for t in temps]))
+        if abs(temps[ref] - reference_temperature) > 0.5:
+            raise InputError(f"reference temperature {reference_temperature:g} °C: no isotherm "
+                             f"there; the isotherms are at {', '.join(f'{t:g}' for t in temps)} °C")
+    return _Isotherms(tuple(d for d, _ in pairs), tuple(temps), ref)
+
+
+# ---------------------------------------------------------------------------- seeds
+def _pair_shift(lower: FrequencyResponse, upper: FrequencyResponse) -> float:
+    """log10 of the factor by which ``upper``'s frequencies are multiplied to lie on
+    ``lower``'s curve (log|G*| and phase overlaid where the two overlap), by a grid search."""
+    def curve(d):
+        order = np.argsort(d.omega)
+        return (np.log10(d.omega[order]), np.log10(np.abs(d.response[order])),
+                np.angle(d.response[order]))
+
+    xl, ml, pl = curve(lower)
+    xu, mu, pu = curve(upper)
+    span = max(xl.max(), xu.max()) - min(xl.min(), xu.min())
+    best, best_cost = 0.0, np.inf
+    for d in np.arange(-span - 2.0, span + 2.0, 0.02):
+        x = xu + d
+        inside = (x >= xl.min()) & (x <= xl.max())
+        if inside.sum() < 2:
+            continue
+        cost = (np.mean((np.interp(x[inside], xl, ml) - mu[inside]) ** 2)
+                + np.mean((np.interp(x[inside], xl, pl) - pu[inside]) ** 2))
+        # Fewer overlapping points are worth less: a shift that overlays one point trivially
+        # must not beat one that overlays the whole sweep.
+        cost *= 1.0 + 1.0 / inside.sum()
+        if cost < best_cost:
+            best, best_cost = float(d), cost
+    return best
+
+
+def _seed_shifts(iso: _Isotherms) -> np.ndarray:
+    """log10 a_T of each isotherm from the pairwise overlays, 0 at the reference."""
+    n = len(iso.data)
+    steps = [_pair_shift(iso.data[i], iso.data[i + 1]) for i in range(n - 1)]
+    shifts = np.zeros(n)
+    for i in range(iso.reference + 1, n):
+        shifts[i] = shifts[i - 1] + steps[i - 1]
+    for i in range(iso.reference - 1, -1, -1):
+        shifts[i] = shifts[i + 1] - steps[i]
+    return shifts
+
+
+def _reduced(iso: _Isotherms, log_shifts) -> FrequencyResponse:
+    """The isotherms on one reduced frequency axis (a_T ω), sorted; points that land on the
+    same frequency averaged."""
+    j = iso.joint
+    omega = j.omega * 10.0 ** np.asarray(log_shifts)[iso.point_isotherm]
+    order = np.argsort(omega)
+    omega, response = omega[order], j.response[order]
+    keep = np.r_[True, np.diff(omega) > 1e-12 * omega[1:]]
+    groups = np.cumsum(keep) - 1
+    n = groups[-1] + 1
+    r = np.zeros(n, complex)
+    np.add.at(r, groups, response)
+    r /= np.bincount(groups)
+    sigma = None
+    if j.sigma is not None:
+        s2 = np.zeros(n)
+        np.add.at(s2, groups, j.sigma[order] ** 2)
+        sigma = np.sqrt(s2) / np.bincount(groups)
+    return FrequencyResponse(omega[keep], r, sigma, kind=j.kind, units=j.units,
+                             name=f"master curve of {j.label}", source=j.source)
+
+
+# ---------------------------------------------------------------------------- result
+@dataclass(frozen=True)
+class MasterCurve:
+    """A joint time–temperature superposition.
+
+    Attributes
+    ----------
+    structure : str
+        The master structure.
+    temperatures : tuple of float
+        The isotherms' temperatures [°C], ascending.
+    reference_temperature : float
+    shift_draws : ndarray, shape (n_draws, n_isotherms)
+        Posterior draws of log10 a_T (0 at the reference).
+    master_draws : ndarray, shape (n_draws, n_params)
+        Posterior draws of the master structure's parameters (physical units, reduced time).
+    posterior : PosteriorResult
+        The joint posterior (structure, shifts, noise).
+    log_evidence, log_evidence_err : float
+        ln Z of the joint model (NaN where no route gave one).
+    laws : dict
+        ``{"wlf": {...}, "arrhenius": {...}}``: each law's parameters over the draws and its
+        relative support (see the module).
+    notes : tuple of str
+    """
+
+    structure: str
+    temperatures: tuple[float, ...]
+    reference_temperature: float
+    shift_draws: np.ndarray = field(repr=False)
+    master_draws: np.ndarray = field(repr=False)
+    posterior: object = field(repr=False)
+    log_evidence: float
+    log_evidence_err: float
+    laws: dict
+    data: FrequencyResponse = field(repr=False)
+    isotherms: tuple = field(repr=False)
+    notes: tuple[str, ...] = ()
+
+    @property
+    def log_shift_mean(self) -> np.ndarray:
+        return self.shift_draws.mean(axis=0)
+
+    def master_data(self) -> FrequencyResponse:
+        """The isotherms on the reduced frequency axis at the posterior mean shifts: a data
+        set ``compare`` takes (σ adds the shifts' posterior spread to each point's own, where
+        the data give σ)."""
+        return _reduced(_Isotherms(self.isotherms, self.temperatures,
+                                   self.temperatures.index(self.reference_temperature)),
+                        self.log_shift_mean)
+
+    def shift_factors(self) -> list[dict]:
+        """``[{"temperature", "log10_aT": {mean, sd, hdi_low, hdi_high}, "log10_bT": ...}]``
+        as ``summary.json`` holds them (b_T = 1: no vertical shift)."""
+        from ..inference._arviz import hdi
+
+        out = []
+        for i, t in enumerate(self.temperatures):
+            x = self.shift_draws[:, i]
+            lo, hi = (0.0, 0.0) if not x.any() else hdi(x, 0.94)
+            out.append({"temperature": t,
+                        "log10_aT": {"mean": float(x.mean()), "sd": float(x.std(ddof=1)),
+                                     "hdi_low": lo, "hdi_high": hi},
+                        "log10_bT": {"mean": 0.0, "sd": 0.0, "hdi_low": 0.0, "hdi_high": 0.0}})
+        return out
+
+    def shift_law(self) -> dict:
+        """``{"name", "reference_temperature", "parameters", "probabilities", "method"}``:
+        the law with the larger support and its parameters."""
+        probs = {k: v["probability"] for k, v in self.laws.items()}
+        best = max(probs, key=probs.get)
+        return {"name": best, "reference_temperature": self.reference_temperature,
+                "parameters": self.laws[best]["parameters"], "probabilities": probs,
+                "method": "BIC of each law fitted to the posterior mean and covariance of the "
+                          "shifts; parameters over the posterior draws"}
+
+    def to_dict(self) -> dict:
+        return {"structure": self.structure, "reference_temperature": self.reference_temperature,
+                "temperatures": list(self.temperatures),
+                "log_evidence": _num(self.log_evidence),
+                "log_evidence_err": _num(self.log_evidence_err),
+                "certified": bool(self.posterior.converged),
+                "sampler": self.posterior.sampler,
+                "parameters": {n: {k: _num(getattr(v, k)) for k in
+                                   ("mean", "sd", "hdi_low", "hdi_high")}
+                               for n, v in self.posterior.summary.items()
+                               if not n.startswith("log10_aT_")},
+                "shift_factors": self.shift_factors(), "shift_law": self.shift_law(),
+                "laws": self.laws, "notes": list(self.notes)}
+
+
+def _num(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+# ---------------------------------------------------------------------------- the fit
+def mastercurve(isotherms, structure="zener", *, reference_temperature: float | None = None,
+                noise: str = "proportional", seed: int = 0) -> MasterCurve:
+    """One joint posterior of a master structure and the isotherms' shifts.
+
+    Parameters
+    ----------
+    isotherms : sequence
+        ``(FrequencyResponse, temperature [°C])`` pairs, or :class:`bayesfo.data.Isotherm`
+        objects (``bayesfo.read_isotherms`` of a TRIOS, pyvisco or temperature-column file).
+    structure : str or Structure
+        The master function (a structure of the library).
+    reference_temperature : float, optional
+        [°C]; an isotherm's temperature (default: the middle isotherm).
+    noise : {"proportional", "constant", "known"}
+        ``proportional`` suits data spanning decades (as isotherms do).
+    seed : int
+
+    Returns
+    -------
+    MasterCurve
+
+    Raises
+    ------
+    InputError
+        Fewer than two isotherms, a missing or repeated temperature, isotherms of different
+        kinds or units, a reference temperature without an isotherm.
+    """
+    from scipy.optimize import least_squares
+
+    from ..identify.optimize import fit_structure
+    from ..inference import Likelihood, certified_posterior
+    from ..inference.transform import _Transform
+    from ..response import dissipation_grid
+    from ..structures import Scaling, get_structure
+
+    master = get_structure(structure) if isinstance(structure, str) else structure
+    iso = _isotherms(isotherms, reference_temperature)
+    joint = iso.joint
+    scaling = Scaling.from_data(joint)
+    shifts0 = _seed_shifts(iso)
+    # The master's dissipation is checked over the reduced window the seeds span, widened.
+    reduced0 = _reduced(iso, shifts0)
+    w = reduced0.omega / scaling.omega_ref
+    shifted = ShiftedStructure(master, iso.temperatures, iso.reference, iso.point_isotherm,
+                               dissipation_grid(w.min(), w.max()))
+    lik = Likelihood(shifted, joint, noise=noise, scaling=scaling)
+    # Master seeds on the reduced data, then everything jointly (least squares on relative
+    # residuals, in the sampling coordinates: logs of the log-uniform parameters).
+    fit = fit_structure(master, reduced0, rng=seed, seed_methods=True, scaling=scaling)
+    modes = master.to_scaled(master.to_physical(np.atleast_2d(fit.optima if fit.optima.size
+                                                              else fit.theta_scaled),
+                                                fit.scaling), scaling)
+    shift_cols = np.delete(shifts0, iso.reference)
+    tr = _Transform(lik)
+    k_all = shifted.n_params
+    log, lo, hi = tr.log[:k_all], tr.lo_u[:k_all], tr.hi_u[:k_all]
+    g = lik.g_scaled
+
+    def to_theta(u):
+        return np.where(log, np.exp(u), u)
+
+    def residuals(u):
+        model = lik.model(to_theta(u)[None, :])[0]
+        r = (model - g) / np.abs(g)
+        return np.r_[r.real, r.imag] if np.all(np.isfinite(r)) else np.full(2 * g.size, 1e3)
+
+    best = None
+    for mode in modes[:4]:
+        theta0 = np.r_[mode, shift_cols]
+        with np.errstate(divide="ignore"):
+            u0 = np.where(log, np.log(np.abs(theta0)), theta0)
+        u0 = np.clip(u0, lo + 1e-9, hi - 1e-9)
+        sol = least_squares(residuals, u0, bounds=(lo, hi), x_scale="jac", max_nfev=400)
+        theta = to_theta(sol.x)
+        if shifted.admissible(theta, joint.kind) and (best is None or sol.cost < best[1]):
+            best = (theta, sol.cost)
+    notes = []
+    if best is None:
+        raise InputError(f"no admissible joint fit of {master.name} to the isotherms; try "
+                         "another structure")
+    found = certified_posterior(lik, best[0][None, :], sampler="auto", seed=seed)
+    notes.extend(found.notes)
+    post = found.posterior
+    if not post.converged:
+        notes.append(f"{master.name}: the joint posterior is not certified "
+                     f"({'; '.join(post.messages)})")
+    physical = np.asarray(post.samples)
+    k = master.n_params
+    shift_draws = shifted.log_shifts(physical[:, :k_all])
+    ev = found.evidence
+    laws = _fit_laws(shift_draws, iso.temperatures, iso.reference, seed)
+    best = max(laws, key=lambda name: laws[name]["probability"])
+    if laws[best]["chi2_per_dof"] > LAW_MISS:
+        law = laws[best]
+        notes.append(f"the {'WLF' if best == 'wlf' else 'Arrhenius'} law, the better of the two, "
+                     f"misses the shifts beyond their uncertainty (chi2/dof "
+                     f"{law['chi2_per_dof']:.3g}; most at {law['worst_temperature']:g} °C, by "
+                     f"{law['worst_deviation']:+.2f} decades): neither law holds over the whole "
+                     "range (e.g. WLF above the glass transition only)")
+    return MasterCurve(
+        structure=master.name, temperatures=iso.temperatures,
+        reference_temperature=iso.temperatures[iso.reference], shift_draws=shift_draws,
+        master_draws=physical[:, :k], posterior=post,
+        log_evidence=math.nan if ev is None else ev.log_z,
+        log_evidence_err=math.nan if ev is None else ev.log_z_err, laws=laws, data=joint,
+        isotherms=iso.data, notes=tuple(notes))
+
+
+# ---------------------------------------------------------------------------- shift laws
+def wlf(temperature, t_ref, c1, c2):
+    """log10 a_T by the WLF equation (temperatures in °C or K alike: differences only)."""
+    dt = np.asarray(temperature, float) - t_ref
+    return -c1 * dt / (c2 + dt)
+
+
+def arrhenius(temperature, t_ref, ea):
+    """log10 a_T by the Arrhenius law, temperatures in °C, E_a in J/mol."""
+    inv = 1.0 / (np.asarray(temperature, float) + KELVIN) - 1.0 / (t_ref + KELVIN)
+    return ea / (GAS_CONSTANT * math.log(10.0)) * inv
+
+
+def _fit_laws(shift_draws, temperatures, reference: int, seed: int) -> dict:
+    """WLF and Arrhenius fitted to each of :data:`LAW_DRAWS` posterior draws of the shifts
+    (least squares, each shift weighted by its posterior sd), and the laws' BIC-based
+    probabilities from the shifts' posterior mean and covariance."""
+    from scipy.optimize import least_squares
+
+    from ..inference._arviz import hdi
+
+    temps = np.asarray(temperatures, float)
+    t_ref = temps[reference]
+    others = np.array([i for i in range(temps.size) if i != reference])
+    x = shift_draws[:, others]
+    sd = np.maximum(x.std(axis=0, ddof=1), 1e-6)
+    rng = np.random.default_rng(seed)
+    rows = rng.choice(x.shape[0], size=min(LAW_DRAWS, x.shape[0]), replace=False)
+    t = temps[others]
+    out = {}
+    # Arrhenius: linear in E_a; weighted least squares, closed form for every draw at once.
+    basis = arrhenius(t, t_ref, 1.0)
+    ea = (x[rows] / sd**2) @ basis / np.sum(basis**2 / sd**2)
+    # WLF: C1, C2 per draw by nonlinear least squares from a common start.
+    c2_min = -(t.min() - t_ref) + 1.0  # C2 + T − T_ref > 0 over the isotherms
+    mean = x.mean(axis=0)
+
+    def fit_wlf(y, start):
+        sol = least_squares(lambda p: (wlf(t, t_ref, p[0], p[1]) - y) / sd, start,
+                            bounds=([-1e3, max(c2_min, 1e-3)], [1e3, 1e5]))
+        return sol.x
+
+    start = fit_wlf(mean, [10.0, max(50.0, c2_min + 10.0)])
+    wlf_draws = np.array([fit_wlf(x[r], start) for r in rows])
+
+    def summary(v, unit):
+        lo, hi = hdi(v, 0.94)
+        return {"mean": float(v.mean()), "sd": float(v.std(ddof=1)), "hdi_low": lo,
+                "hdi_high": hi, "unit": unit}
+
+    cov = np.cov(x, rowvar=False) if x.shape[1] > 1 else np.array([[sd[0] ** 2]])
+    cov = np.atleast_2d(cov) + 1e-12 * np.eye(x.shape[1])
+    prec = np.linalg.inv(cov)
+    n = x.shape[1]
+
+    def bic(pred, k):
+        r = mean - pred
+        return float(r @ prec @ r) + k * math.log(n)
+
+    predicted = {"wlf": wlf(t, t_ref, *start), "arrhenius": arrhenius(t, t_ref, float(np.median(ea)))}
+    bics = {"wlf": bic(predicted["wlf"], 2), "arrhenius": bic(predicted["arrhenius"], 1)}
+    low = min(bics.values())
+    weights = {k: math.exp(-0.5 * (v - low)) for k, v in bics.items()}
+    total = sum(weights.values())
+    out["wlf"] = {"parameters": {"C1": summary(wlf_draws[:, 0], ""),
+                                 "C2": summary(wlf_draws[:, 1], "°C")}}
+    out["arrhenius"] = {"parameters": {"Ea": summary(ea, "J/mol")}}
+    for name, k in (("wlf", 2), ("arrhenius", 1)):
+        # How far the law misses the shifts, in their posterior sds: near 1 where it holds.
+        z = (mean - predicted[name]) / sd
+        worst = int(np.argmax(np.abs(z)))
+        out[name].update(
+            bic=bics[name], probability=weights[name] / total,
+            chi2_per_dof=float(np.sum(z**2) / max(n - k, 1)),
+            worst_temperature=float(t[worst]), worst_deviation=float(mean[worst] - predicted[name][worst]))
+    return out

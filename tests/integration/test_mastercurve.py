@@ -1,0 +1,142 @@
+"""Master curves: shifts and shift laws recovered from synthetic isotherms of a known master
+function, the command on the bundled adhesive isotherms, bad input."""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import bayesfo as bf
+from bayesfo.data import FrequencyResponse
+from bayesfo.errors import InputError
+from bayesfo.structures import get_structure
+from bayesfo.tts import arrhenius, wlf
+from bayesfo.tts.joint import _fit_laws, shift_name
+
+ZENER = [10.0, 1.0, 0.1, 0.6]  # a1, b0, b1, q (compliance form)
+W = np.logspace(-1, 2, 12)
+TEMPS = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0]
+ADHESIVE = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+
+
+def isotherms(log_aT, seed=0, rel=0.01):
+    """Isotherms of the Zener at the reduced frequencies a_T·ω, with 1 % complex noise."""
+    z = get_structure("zener")
+    rng = np.random.default_rng(seed)
+    out = []
+    for t, la in zip(TEMPS, log_aT, strict=True):
+        g = z.response([ZENER], W * 10.0**la, "modulus")[0]
+        sd = rel * np.abs(g)
+        y = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
+        out.append((FrequencyResponse(W, y, kind="modulus", units="Pa", name=f"syn {t:g} °C"), t))
+    return out
+
+
+def _fit(data, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return bf.mastercurve(data, "zener", reference_temperature=20.0, **kw)
+
+
+@pytest.fixture(scope="module")
+def wlf_case():
+    truth = wlf(np.array(TEMPS), 20.0, 8.0, 80.0)
+    return truth, _fit(isotherms(truth))
+
+
+def test_shifts_and_the_wlf_law_are_recovered(wlf_case):
+    truth, mc = wlf_case
+    assert mc.posterior.converged
+    factors = mc.shift_factors()
+    assert [f["temperature"] for f in factors] == TEMPS
+    assert factors[2]["log10_aT"] == {"mean": 0.0, "sd": 0.0, "hdi_low": 0.0, "hdi_high": 0.0}
+    inside = [f["log10_aT"]["hdi_low"] <= a <= f["log10_aT"]["hdi_high"]
+              for f, a in zip(factors, truth, strict=True) if f["temperature"] != 20.0]
+    assert sum(inside) >= 4  # 94 % intervals: all five, or one out by chance
+    for f, a in zip(factors, truth, strict=True):
+        assert abs(f["log10_aT"]["mean"] - a) < 0.03  # 12 points of 1 % noise per isotherm
+    law = mc.shift_law()
+    assert law["name"] == "wlf" and law["probabilities"]["wlf"] > 0.99
+    for name, value in (("C1", 8.0), ("C2", 80.0)):
+        p = law["parameters"][name]
+        assert p["hdi_low"] <= value <= p["hdi_high"], (name, p)
+    assert mc.laws["wlf"]["chi2_per_dof"] < 4 and not mc.notes
+    # The master structure's parameters, in the reference isotherm's time scale.
+    summary = mc.posterior.summary
+    for name, value in zip(("a1", "b0", "b1", "q"), ZENER, strict=True):
+        assert summary[name].hdi_low <= value <= summary[name].hdi_high, name
+
+
+def test_an_arrhenius_law_is_told_from_wlf():
+    truth = arrhenius(np.array(TEMPS), 20.0, 150e3)
+    mc = _fit(isotherms(truth, seed=1))
+    law = mc.shift_law()
+    # Over 50 °C a WLF with a large C2 follows an Arrhenius law closely; the simpler law wins
+    # on its one parameter fewer, not decisively.
+    assert law["name"] == "arrhenius" and law["probabilities"]["arrhenius"] > 0.5
+    ea = law["parameters"]["Ea"]
+    assert ea["hdi_low"] <= 150e3 <= ea["hdi_high"] and ea["unit"] == "J/mol"
+
+
+def test_law_fits_per_draw_carry_the_shift_uncertainty():
+    # Shifts on WLF (C1 8, C2 80) with a posterior of 0.05 decades sd each, centred where one
+    # measurement put it (one sd off the law at random): C1 comes out near 8 with a spread
+    # from the draws, and the law misses the posterior means by about one sd (chi2/dof ~ 1).
+    rng = np.random.default_rng(0)
+    t = np.array(TEMPS)
+    exact = wlf(t, 20.0, 8.0, 80.0)
+    draws = exact + 0.05 * rng.normal(size=t.size) + 0.05 * rng.normal(size=(2000, t.size))
+    draws[:, 2] = 0.0
+    laws = _fit_laws(draws, TEMPS, 2, seed=0)
+    c1 = laws["wlf"]["parameters"]["C1"]
+    assert abs(c1["mean"] - 8.0) < 3 * c1["sd"] and c1["sd"] > 0.05
+    # chi2 with 3 degrees of freedom: below 4 (per dof) 99 % of the time where the law holds;
+    # Arrhenius, which does not, misses these shifts by far more.
+    assert laws["wlf"]["chi2_per_dof"] < 4 < 10 < laws["arrhenius"]["chi2_per_dof"]
+
+
+def test_master_data_lie_on_one_curve(wlf_case):
+    _, mc = wlf_case
+    m = mc.master_data()
+    assert m.n_frequencies == len(TEMPS) * W.size and np.all(np.diff(m.omega) > 0)
+    z = get_structure("zener").response([ZENER], m.omega, "modulus")[0]
+    assert np.max(np.abs(m.response / z - 1)) < 0.05  # 1 % noise, shifts within 0.03 decades
+
+
+@pytest.mark.parametrize("data, message", [
+    (lambda iso: iso[:1], "two or more isotherms, got 1"),
+    (lambda iso: [iso[0], (iso[1][0], iso[0][1])], "two isotherms at 0 and 0 °C"),
+    (lambda iso: [iso[0], (iso[1][0], None)], "no temperature"),
+    (lambda iso: [iso[0], "x"], "isotherm 2: give"),
+])
+def test_bad_isotherms_are_refused(data, message):
+    with pytest.raises(InputError, match=message):
+        bf.mastercurve(data(isotherms(np.zeros(6))), "zener")
+    with pytest.raises(InputError, match="reference temperature 25 °C: no isotherm there"):
+        bf.mastercurve(isotherms(np.zeros(6)), "zener", reference_temperature=25.0)
+
+
+def test_shift_names_are_identifiers():
+    assert shift_name(-40.0) == "log10_aT_m40C" and shift_name(12.5) == "log10_aT_12p5C"
+
+
+def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
+    files = [ADHESIVE / f"T{t}C.csv" for t in ("p000", "p010", "p020", "p030", "p040")]
+    status, out, err = run_cli("mastercurve", *files, "--reference-temperature", "20",
+                               "--out", tmp_path / "mc", "--no-figures")
+    assert status == 0, err
+    summary = json.loads((tmp_path / "mc" / "summary.json").read_text())
+    shifts = {f["temperature"]: f["log10_aT"]["mean"] for f in summary["shift_factors"]}
+    # Cooler isotherms move to higher reduced frequencies, monotonically.
+    assert shifts[20.0] == 0.0 and shifts[0.0] > shifts[10.0] > 0 > shifts[30.0] > shifts[40.0]
+    assert summary["shift_law"]["reference_temperature"] == 20.0
+    assert set(summary["shift_law"]["probabilities"]) == {"wlf", "arrhenius"}
+    master = bf.read(tmp_path / "mc" / "master.csv")  # a data set compare reads
+    assert master.n_frequencies == sum(bf.read(f).n_frequencies for f in files)
+    assert "log10 a_T" in out and "wlf:" in out
+    status, _, err = run_cli("mastercurve", files[0], "--out", tmp_path / "one")
+    assert status == 2 and "two or more isotherms, got 1" in err

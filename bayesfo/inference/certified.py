@@ -105,7 +105,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
     remedy : str
         What to try when no route certifies the posterior (appended to that note).
     sampler_options : dict, optional
-        emcee settings (``max_steps``, ``n_walkers``, ...; see
+        Settings of emcee (``max_steps``, ``n_walkers``, ...; see
         :func:`~bayesfo.inference.posterior.sample_posterior`).
 
     Returns

@@ -57,14 +57,26 @@ class ShiftedStructure:
     """A master structure seen through the isotherms: the structure's parameters followed by
     one log10 a_T per isotherm other than the reference, evaluated on the joint data's points
     (each at its own isotherm's reduced frequency). It offers what the inference routes use of
-    a :class:`~bayesfo.structures.Structure`."""
+    a :class:`~bayesfo.structures.Structure`.
+
+    Attributes
+    ----------
+    master : Structure
+        The master structure.
+    temperatures : tuple of float
+        The isotherms' temperatures [°C], ascending.
+    reference : int
+        The isotherm at the reference temperature (a_T = 1, no shift parameter).
+    point_isotherm : ndarray of int
+        The isotherm of each point of the joint data, in its order.
+    master_grid : ndarray or None
+        The dissipation grid of the master (scaled), spanning the reduced window.
+    """
 
     master: object
     temperatures: tuple[float, ...]
     reference: int
-    #: Isotherm of each point of the joint data, in its order.
     point_isotherm: np.ndarray
-    #: The dissipation grid of the master (scaled), spanning the reduced window.
     master_grid: np.ndarray | None = None
 
     @property

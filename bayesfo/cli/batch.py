@@ -87,6 +87,13 @@ def run(args) -> int:
     print(f"batch: {len(result.outcomes)} data sets, {n_ok} compared ({reused} complete from an "
           f"earlier run), {len(result.failed)} failed; {result.executor}, "
           f"{result.wall_seconds:.1f} s; wrote {result.out_dir}/{{<id>/, {names}}}")
+    temperatures = {o.dataset.temperature for o in result.outcomes} - {None}
+    if len(temperatures) > 1 and not args.quiet:
+        # Isotherms compared one by one may each pick another structure: the figure of the
+        # orders against temperature then jumps between models, not between material states.
+        print(f"note: {len(temperatures)} temperatures: each isotherm was compared on its own; "
+              "for one master structure and the shift factors of all of them, run 'bayesfo "
+              "mastercurve' on the same files")
     return result.exit_status
 
 

@@ -140,3 +140,13 @@ def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
     assert "log10 a_T" in out and "wlf:" in out
     status, _, err = run_cli("mastercurve", files[0], "--out", tmp_path / "one")
     assert status == 2 and "two or more isotherms, got 1" in err
+
+
+def test_batch_over_isotherms_points_to_mastercurve(tmp_path, run_cli):
+    files = [ADHESIVE / "Tp020C.csv", ADHESIVE / "Tp030C.csv"]
+    status, out, err = run_cli("batch", *files, "--structures", "voigt", "--workers", "1",
+                               "--no-figures", "--out", tmp_path / "b")
+    assert status == 0, err
+    assert out.strip().splitlines()[-1] == (
+        "note: 2 temperatures: each isotherm was compared on its own; for one master structure "
+        "and the shift factors of all of them, run 'bayesfo mastercurve' on the same files")

@@ -153,15 +153,31 @@ def check_options(options: dict, where: str) -> dict:
 MAX_SEED = 2**32 - 1
 
 
+#: Limits of the emcee settings, checked before any work: emcee keeps the whole chain in memory
+#: (walkers × steps × parameters × 8 bytes, allocated for max_steps at the start), so their
+#: product is capped too (2·10^7 positions: 1.6 GB at ten parameters, 60 times the defaults).
+MAX_WALKERS = 10_000
+MAX_STEPS = 10_000_000
+MAX_CHAIN = 20_000_000
+
+
 def check_sampler_settings(options: dict, where: str) -> None:
-    """``max_steps`` (at least 100) and ``walkers`` (at least 8) are integers or None."""
-    for key, least in (("max_steps", 100), ("walkers", 8)):
+    """``max_steps`` (100 to :data:`MAX_STEPS`) and ``walkers`` (8 to :data:`MAX_WALKERS`) are
+    integers or None, and together within :data:`MAX_CHAIN` positions."""
+    for key, least, most in (("max_steps", 100, MAX_STEPS), ("walkers", 8, MAX_WALKERS)):
         value = options.get(key)
+        flag = "--" + key.replace("_", "-")
         if value is not None and (isinstance(value, bool) or not isinstance(value, int)
                                   or value < least):
-            flag = "--" + key.replace("_", "-")
             raise InputError(f"{where}: {key} ({flag}) must be an integer of at least {least}, "
                              f"got {value!r}")
+        if value is not None and value > most:
+            raise InputError(f"{where}: {key} ({flag}) must be at most {most:,}, got {value:,}")
+    steps, walkers = options.get("max_steps"), options.get("walkers")
+    if steps is not None and walkers is not None and steps * walkers > MAX_CHAIN:
+        raise InputError(f"{where}: --walkers {walkers:,} × --max-steps {steps:,} = "
+                         f"{steps * walkers:,} chain positions, more than the {MAX_CHAIN:,} that "
+                         "fit in memory; lower one of them")
 
 
 def sampler_options(options: dict) -> dict:

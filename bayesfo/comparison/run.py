@@ -40,7 +40,7 @@ from ..inference.adequacy import check_adequacy
 from ..inference.certified import certified_posterior, evidence_check
 from ..inference.importance import K_HAT_MAX, screen_noise
 from ..inference.likelihood import NOISE_PRIORS
-from ..options import EVIDENCE_ROUTES, SAMPLERS
+from ..options import EVIDENCE_ROUTES, SAMPLERS, check_sampler_settings
 from ..parallel import (
     LazyPool,
     available_cpus,
@@ -221,6 +221,8 @@ def _check_sampler_options(options: dict) -> None:
         if name not in known:
             raise InputError(f"compare: unknown sampler option {name!r}; the options are "
                              + ", ".join(known))
+    check_sampler_settings({"max_steps": options.get("max_steps"),
+                            "walkers": options.get("n_walkers")}, "compare")
 
 
 def remedy(lik) -> str:

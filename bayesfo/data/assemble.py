@@ -4,6 +4,7 @@ formed, and every data set passed through the checks and limits of the contract 
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import replace
 
 import numpy as np
@@ -58,7 +59,7 @@ def assemble_table(table: Table, choice: Choice, cols: list[Column], ctx: dict, 
             kept[c] = np.array([to_number(x, decimal) for x in cells_c])
         except ValueError:
             ignored.append(c.label)
-    dup_labels = {x for x in labels if labels.count(x) > 1}
+    dup_labels = {x for x, n in Counter(labels).items() if n > 1}
     temps = None
     if choice.temperature is not None:
         t = choice.temperature

@@ -101,11 +101,11 @@ class Reading:
         if self.not_used:
             out.append("also in the file, not used: " + "; ".join(self.not_used))
         if self.columns_kept:
-            out.append("other columns kept as metadata: "
-                       + ", ".join(f"'{c}'" for c in self.columns_kept))
+            out.append(f"other columns kept as metadata ({len(self.columns_kept)}): "
+                       + _first(self.columns_kept))
         if self.columns_ignored:
             out.append(f"columns ignored ({len(self.columns_ignored)}): "
-                       + ", ".join(f"'{c}'" for c in self.columns_ignored))
+                       + _first(self.columns_ignored))
         out.extend(f"skipped: {s}" for s in self.rows_skipped)
         return tuple(out)
 
@@ -169,3 +169,14 @@ def contract_text(data: FrequencyResponse, temperature: float | None = None) -> 
         comments.append(f"source: {data.source}")
     comments.extend(f"note: {note}" for note in data.notes)
     return data.to_csv_text(comments)
+
+
+#: Column names a note lists before "and N more" (a file may have thousands).
+SHOWN_COLUMNS = 20
+
+
+def _first(names) -> str:
+    """``'a', 'b', 'c'``, or the first :data:`SHOWN_COLUMNS` and how many more."""
+    shown = ", ".join(f"'{c}'" for c in names[:SHOWN_COLUMNS])
+    rest = len(names) - SHOWN_COLUMNS
+    return shown + (f" and {rest} more" if rest > 0 else "")

@@ -5,6 +5,7 @@ failure; the messages are asserted from their start."""
 from __future__ import annotations
 
 import os
+import re
 import threading
 
 import numpy as np
@@ -439,3 +440,32 @@ def test_matignon_stability_of_non_finite_coefficients_is_false():
     a = np.array([[1.0, 2.0, np.nan], [1.0, np.inf, 1.0], [1.0, 3.0, 2.0]])
     np.testing.assert_array_equal(matignon_stable(a, np.array([0.5, 0.5, 0.5])),
                                   [False, False, True])
+
+
+@pytest.mark.parametrize("settings, message", [
+    ({"walkers": 10_000_000}, "walkers (--walkers) must be at most 10,000, got 10,000,000"),
+    ({"max_steps": 1_000_000_000}, "must be at most 10,000,000, got 1,000,000,000"),
+    ({"walkers": 1000, "max_steps": 1_000_000}, "1,000,000,000 chain positions, more than"),
+])
+def test_sampler_settings_that_exhaust_memory_are_refused_before_work(settings, message):
+    from bayesfo.options import check_sampler_settings
+
+    with pytest.raises(InputError, match=re.escape(message)):
+        check_sampler_settings(settings, "compare")
+    check_sampler_settings({"walkers": 64, "max_steps": 20_000}, "compare")  # ordinary: fine
+
+
+def test_a_file_of_many_columns_is_read_in_linear_time_and_noted_briefly(tmp_path):
+    # 20 000 extra columns: the reader once counted duplicate labels quadratically (minutes at
+    # 100 000 columns); the note names the first columns and how many more.
+    from bayesfo.data import read
+
+    n = 20_000
+    path = tmp_path / "wide.csv"
+    path.write_text("omega,storage,loss," + ",".join(f"x{i}" for i in range(n)) + "\n"
+                    + "".join(f"{k},{k + 1},{k}," + ",".join("1" * n) + "\n"
+                              for k in (1, 2, 3)))
+    data = read(path)
+    note = next(x for x in data.notes if x.startswith("other columns kept as metadata"))
+    assert note.startswith(f"other columns kept as metadata ({n}): 'x0', 'x1'")
+    assert note.endswith(f"'x19' and {n - 20} more")

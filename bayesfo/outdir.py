@@ -77,7 +77,7 @@ def is_output_path(name) -> bool:
 def _read_json(path: Path):
     try:
         return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):  # unreadable, not JSON, nested too deeply
         return None
 
 
@@ -229,6 +229,10 @@ def check_output_directory(out_dir, option: str = "--out", directories=()) -> Pa
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"{option} '{out_dir}' is a file, not a directory; give a directory")
+    try:  # first complete a swap that a killed run left half-done: its entries are recorded
+        recover(out_dir)
+    except OSError:
+        pass  # not writable: said below
     foreign = [n for n in directories
                if _real_directory(out_dir / n) and n not in owned_entries(out_dir)]
     if foreign:

@@ -206,8 +206,8 @@ def _stored_rows(ds: DataSet, out_dir: Path, fingerprint: dict) -> tuple | None:
             return None
         summary = json.loads((sub / "summary.json").read_text(encoding="utf-8"))
         return _dataset_rows(ds, OK, None, summary_rows(summary))
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):
+        return None  # not complete (or not readable as bayesfo wrote it): run it again
 
 
 def _store(ds: DataSet, result: dict, out_dir: Path, fingerprint: dict) -> Outcome:

@@ -121,6 +121,12 @@ def load(directory, *, models=()) -> Comparison:
     if not d.is_dir():
         raise InputError(f"'{d}': " + ("not a directory" if d.exists() else "no such directory")
                          + "; give the output directory of bayesfo compare")
+    try:  # a swap that a killed run left half-done is completed first, as the next run would
+        from ..outdir import recover
+
+        recover(d)
+    except OSError:
+        pass  # a directory that cannot be written: read what it holds
     path = d / "summary.json"
     if not path.is_file():
         raise InputError(f"'{path}': missing, so '{d}' holds no complete output of bayesfo "
@@ -131,6 +137,9 @@ def load(directory, *, models=()) -> Comparison:
         raise InputError(f"'{path}': not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     except ValueError as exc:
         raise InputError(f"'{path}': not valid JSON ({exc})") from None
+    except RecursionError:
+        raise InputError(f"'{path}': nested too deeply to be a summary.json of bayesfo") \
+            from None
     except OSError as exc:
         raise InputError(f"'{path}': cannot be read ({exc.strerror or exc})") from None
     library = load_library(extra=list(models)) if models else default_library()

@@ -625,3 +625,52 @@ def test_the_api_refuses_what_the_samplers_cannot_handle():
     with pytest.raises(InputError, match=f"{MAX_FREQUENCIES + 1} frequencies, more than"):
         compare(FrequencyResponse(many, g, kind="compliance"), "voigt", workers=1,
                 progress=False)
+
+
+_KILLED_MID_SWAP = """
+import os, sys
+from pathlib import Path
+import bayesfo.outdir as outdir
+
+out = Path(sys.argv[1])
+real = os.replace
+
+def die(src, dst):  # the old run's entries are moved aside; the new one's never arrive
+    if (out / outdir.JOURNAL).exists() and Path(src).parent.name == "new":
+        os._exit(9)
+    return real(src, dst)
+
+outdir.os.replace = die
+with outdir.staged_run(out) as stage:
+    (stage / "summary.json").write_text("second")
+    (stage / "figures").mkdir()
+    (stage / "figures" / "b.png").write_text("b")
+"""
+
+
+def test_a_run_killed_mid_swap_is_completed_by_the_next_check_and_by_load(tmp_path):
+    out = tmp_path / "out"
+    with outdir.staged_run(out) as stage:
+        (stage / "summary.json").write_text("first")
+        (stage / "figures").mkdir()
+        (stage / "figures" / "a.png").write_text("a")
+    done = subprocess.run([sys.executable, "-c", _KILLED_MID_SWAP, str(out)],
+                          capture_output=True, text=True, timeout=HANG)
+    assert done.returncode == 9, done.stderr
+    assert not (out / "summary.json").exists()  # the swap stopped half-way
+    # The next run's check completes the swap instead of refusing a 'figures' it cannot place.
+    assert outdir.check_output_directory(out, directories=("figures",)) == out
+    assert (out / "summary.json").read_text() == "second"
+    assert sorted(p.name for p in (out / "figures").iterdir()) == ["b.png"]
+    assert not list(out.glob(".bayesfo-staging-*"))
+
+
+def test_load_refuses_a_record_nested_too_deeply(tmp_path):
+    from bayesfo.comparison import load
+    from bayesfo.errors import InputError
+
+    out = tmp_path / "out"
+    with outdir.staged_run(out) as stage:
+        (stage / "summary.json").write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(InputError, match="nested too deeply"):
+        load(out)

@@ -7,6 +7,9 @@ from pathlib import Path
 
 from ..errors import InputError
 
+#: Master structures ranked by default: a few seconds each on 20 isotherms.
+DEFAULT_STRUCTURES = "zener,fractional_zener_sl,max-n2m1"
+
 
 def add_parser(subparsers):
     """Register ``bayesfo mastercurve``."""
@@ -22,8 +25,9 @@ def add_parser(subparsers):
                         "temperature column, pyvisco), or one file per temperature (the "
                         "temperature from a '# temperature:' line or the name, e.g. Tp020C.csv), "
                         "or directories of such files")
-    p.add_argument("--structure", default="zener", metavar="S",
-                   help="the master structure (default zener; 'bayesfo structures' lists them)")
+    p.add_argument("--structures", default=DEFAULT_STRUCTURES, metavar="S,...",
+                   help="master structures to rank by ln Z on the joint data (default "
+                        f"{DEFAULT_STRUCTURES}; 'bayesfo structures' lists them)")
     p.add_argument("--reference-temperature", type=float, default=None, metavar="T",
                    help="reference temperature [°C], an isotherm's (default: the middle one)")
     p.add_argument("--noise", default="proportional", choices=("proportional", "constant",
@@ -74,15 +78,15 @@ def read_isotherm_files(paths) -> list[tuple]:
 def run(args) -> int:
     from .._signals import load_libraries
     from ..outdir import check_output_directory, staged_run
-    from ..structures import get_structure
+    from ..structures import resolve_structures
     from ..tts import mastercurve
 
-    get_structure(args.structure)  # an unknown name fails before any reading
+    structures = resolve_structures(args.structures)  # an unknown name fails before reading
     isotherms = read_isotherm_files(args.data)
     target = Path(args.out or "bayesfo-mastercurve")
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))
-    mc = mastercurve(isotherms, args.structure, reference_temperature=args.reference_temperature,
+    mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
                      noise=args.noise, seed=args.seed)
     summary = {"data": mc.data.to_dict(), **mc.to_dict()}
     master = mc.master_data()
@@ -114,9 +118,14 @@ def run(args) -> int:
 
 
 def _print(mc, out) -> None:
-    status = "certified" if mc.posterior.converged else "NOT certified"
-    print(f"{mc.data.label}: master structure {mc.structure}, ln Z {mc.log_evidence:.2f} ± "
-          f"{mc.log_evidence_err:.2f}, joint posterior {status} ({mc.posterior.sampler})")
+    print(f"{mc.data.label}: master structures ranked by ln Z of the joint posterior")
+    for r in mc.ranking:
+        z = "-" if r["log_evidence"] is None else (f"{r['log_evidence']:.2f} ± "
+                                                    f"{r['log_evidence_err']:.2f}")
+        p = "-" if r["probability"] is None else f"{r['probability']:.3f}"
+        print(f"   {r['structure']:<22} ln Z {z:>20}  P {p:>6}  "
+              f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")
+    print(f"shift factors of {mc.structure}, T_ref = {mc.reference_temperature:g} °C:")
     print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}")
     for f in mc.shift_factors():
         a = f["log10_aT"]

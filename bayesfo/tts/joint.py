@@ -340,6 +340,9 @@ class MasterCurve:
         ``{"wlf": {...}, "arrhenius": {...}}``: each law's parameters over the draws and its
         relative support (see the module).
     notes : tuple of str
+    ranking : tuple of dict
+        Every master structure fitted, best first: ``structure``, ``log_evidence``,
+        ``log_evidence_err``, ``probability`` (equal prior odds), ``certified``, ``sampler``.
     """
 
     structure: str
@@ -354,6 +357,7 @@ class MasterCurve:
     data: FrequencyResponse = field(repr=False)
     isotherms: tuple = field(repr=False)
     notes: tuple[str, ...] = ()
+    ranking: tuple = ()
 
     @property
     def log_shift_mean(self) -> np.ndarray:
@@ -403,6 +407,7 @@ class MasterCurve:
                                    ("mean", "sd", "hdi_low", "hdi_high")}
                                for n, v in self.posterior.summary.items()
                                if not n.startswith("log10_aT_")},
+                "structures": list(self.ranking),
                 "shift_factors": self.shift_factors(), "shift_law": self.shift_law(),
                 "laws": self.laws, "notes": list(self.notes)}
 
@@ -413,17 +418,19 @@ def _num(x):
 
 
 # ---------------------------------------------------------------------------- the fit
-def mastercurve(isotherms, structure="zener", *, reference_temperature: float | None = None,
+def mastercurve(isotherms, structures="zener", *, reference_temperature: float | None = None,
                 noise: str = "proportional", seed: int = 0) -> MasterCurve:
-    """One joint posterior of a master structure and the isotherms' shifts.
+    """One joint posterior of a master structure and the isotherms' shifts; with several
+    structures, each is fitted and the one of highest ln Z is returned, with the ranking.
 
     Parameters
     ----------
     isotherms : sequence
         ``(FrequencyResponse, temperature [°C])`` pairs, or :class:`bayesfo.data.Isotherm`
         objects (``bayesfo.read_isotherms`` of a TRIOS, pyvisco or temperature-column file).
-    structure : str or Structure
-        The master function (a structure of the library).
+    structures : str, Structure or sequence
+        The master function: a structure of the library, or several (a comma list or a
+        sequence), ranked by ln Z on the joint data as ``compare`` ranks them.
     reference_temperature : float, optional
         [°C]; an isotherm's temperature (default: the middle isotherm).
     noise : {"proportional", "constant", "known"}
@@ -440,6 +447,29 @@ def mastercurve(isotherms, structure="zener", *, reference_temperature: float | 
         Fewer than two isotherms, a missing or repeated temperature, isotherms of different
         kinds or units, a reference temperature without an isotherm.
     """
+    from ..structures import resolve_structures
+
+    names = resolve_structures(structures) if isinstance(structures, str) else (
+        [structures] if not isinstance(structures, (list, tuple)) else list(structures))
+    iso = _isotherms(isotherms, reference_temperature)
+    fits = [_fit_one(iso, s, noise, seed) for s in names]
+    z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
+    best = int(np.argmax(z))
+    p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
+    p = p / np.nansum(p)
+    ranking = tuple(
+        {"structure": f.structure, "log_evidence": _num(f.log_evidence),
+         "log_evidence_err": _num(f.log_evidence_err), "probability": _num(pi),
+         "certified": bool(f.posterior.converged), "sampler": f.posterior.sampler}
+        for f, pi in sorted(zip(fits, p, strict=True), key=lambda fp: -fp[0].log_evidence
+                            if math.isfinite(fp[0].log_evidence) else np.inf))
+    from dataclasses import replace
+
+    return replace(fits[best], ranking=ranking)
+
+
+def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
+    """The joint posterior with one master structure."""
     from scipy.optimize import least_squares
 
     from ..identify.optimize import fit_structure
@@ -449,7 +479,6 @@ def mastercurve(isotherms, structure="zener", *, reference_temperature: float | 
     from ..structures import Scaling, get_structure
 
     master = get_structure(structure) if isinstance(structure, str) else structure
-    iso = _isotherms(isotherms, reference_temperature)
     joint = iso.joint
     scaling = Scaling.from_data(joint)
     shifts0 = _seed_shifts(iso)

@@ -134,6 +134,12 @@ def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
     # Cooler isotherms move to higher reduced frequencies, monotonically.
     assert shifts[20.0] == 0.0 and shifts[0.0] > shifts[10.0] > 0 > shifts[30.0] > shifts[40.0]
     assert summary["shift_law"]["reference_temperature"] == 20.0
+    # The default master structures, ranked by ln Z; the shifts are the best one's.
+    ranked = summary["structures"]
+    assert {r["structure"] for r in ranked} == {"zener", "fractional_zener_sl", "max-n2m1"}
+    z = [r["log_evidence"] for r in ranked]
+    assert z == sorted(z, reverse=True) and summary["structure"] == ranked[0]["structure"]
+    assert sum(r["probability"] for r in ranked) == pytest.approx(1.0)
     assert set(summary["shift_law"]["probabilities"]) == {"wlf", "arrhenius"}
     master = bf.read(tmp_path / "mc" / "master.csv")  # a data set compare reads
     assert master.n_frequencies == sum(bf.read(f).n_frequencies for f in files)

@@ -1,0 +1,58 @@
+"""``bayesfo export``: a Prony series of a compared model, for finite-element codes."""
+
+from __future__ import annotations
+
+
+def add_parser(subparsers):
+    """Register ``bayesfo export``."""
+    from ..predictions.functions import AVERAGES
+    from ..predictions.prony import FORMATS
+
+    p = subparsers.add_parser(
+        "export", help="a Prony series of the model (csv, Abaqus, ANSYS) from the output "
+                       "directory of a comparison",
+        description="Fit G(t) = G_inf + sum g_i exp(-t/tau_i) (tau_i fixed per decade, g_i >= "
+                    "0) to the posterior median G', G'' of a structure or an average, and "
+                    "write it with its largest relative error over the data window beside the "
+                    "width of the model's credible band.")
+    p.add_argument("directory", metavar="DIR", help="output directory of bayesfo compare")
+    p.add_argument("--format", required=True, choices=FORMATS,
+                   help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY) or ansys "
+                        "(TB,PRONY with TBDATA)")
+    p.add_argument("--out", required=True, metavar="FILE", help="the file to write")
+    p.add_argument("--per-decade", type=int, default=2, metavar="K",
+                   help="relaxation times per decade (default 2)")
+    p.add_argument("--liquid", action="store_true", help="G_inf = 0: the material relaxes fully")
+    who = p.add_mutually_exclusive_group()
+    who.add_argument("--structure", metavar="S", help="the structure (default: the best ranked)")
+    who.add_argument("--average", choices=AVERAGES, help="an average over the structures")
+    p.add_argument("--seed", type=int, default=0, help="seed of the draws used (default 0)")
+    return p
+
+
+def run(args) -> int:
+    from .._io import atomic_write_text
+    from ..comparison import load
+    from ..errors import InputError
+    from ..predictions.prony import prony_series
+
+    result = load(args.directory, models=getattr(args, "models", ()) or ())
+    try:
+        prony = prony_series(result, per_decade=args.per_decade, liquid=args.liquid,
+                             structure=args.structure, average=args.average, seed=args.seed)
+    except InputError as exc:  # the API's words, in the command line's
+        raise InputError(str(exc).replace("predict: ", "", 1).replace("export: ", "", 1)
+                         .replace("terms per decade", "--per-decade")) from None
+    try:
+        atomic_write_text(args.out, prony.text(args.format))
+    except OSError as exc:
+        raise InputError(f"--out '{args.out}': cannot be written ({exc.strerror or exc})") \
+            from None
+    error = max(prony.max_rel_error_modulus, prony.max_rel_error_relaxation)
+    print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
+          f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
+          f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
+    if error > prony.band_rel_halfwidth:
+        print(f"note: the series departs from the model by more than the model's uncertainty; "
+              f"more terms (--per-decade {min(10, 2 * args.per_decade)}) may help")
+    return 0

@@ -1,0 +1,183 @@
+"""Prony series of a compared model for finite-element codes.
+
+G(t) = G∞ + Σ g_i exp(−t/τ_i) with the τ_i fixed, ``per_decade`` of them per decade from two
+decades below 1/ω_max to two decades above 1/ω_min, and G∞, g_i ≥ 0 fitted by non-negative least
+squares to the posterior median of G′(ω) and G″(ω) (relative residuals, 20 frequencies per
+decade over the data window widened by a decade each side). ``liquid`` fixes G∞ = 0.
+
+How well the series stands for the model is stated: the largest relative error of its G′, G″
+and G(t) against the posterior medians over the data window, beside the half-width of the
+model's own 94 % band of G(t) there (a series whose error is well inside the band adds nothing
+the data could tell).
+
+Formats: ``csv`` (``tau_s,g_i`` with ``#`` lines for G∞, G0, the unit and the errors), ``abaqus``
+(``*VISCOELASTIC, TIME=PRONY``: g_i/G0, k_i = 0, τ_i; G0 in a comment, for ``*ELASTIC,
+MODULI=INSTANTANEOUS``) and ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` pairs of α_i = g_i/G0
+and τ_i).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+FORMATS = ("csv", "abaqus", "ansys")
+#: Decades of relaxation times beyond the data window on each side.
+TAU_MARGIN = 2
+
+
+@dataclass(frozen=True)
+class Prony:
+    """A Prony series and how well it stands for the model.
+
+    Attributes
+    ----------
+    tau, g : ndarray
+        Relaxation times [s] and moduli [``unit``] of the terms (terms fitted to 0 are dropped).
+    g_inf : float
+        The long-time modulus (0 for a liquid).
+    unit : str
+    source : str
+        The structure, or the average, it was fitted to.
+    window : (float, float)
+        The times [s] the data cover, 1/ω_max to 1/ω_min.
+    max_rel_error_modulus, max_rel_error_relaxation : float
+        Largest relative error of the series' G* (|ΔG*|/|G*|), and of its G(t) (relative to
+        G(t), or to 0.1 % of G0 where G(t) has relaxed below that), against the posterior
+        medians over the window.
+    band_rel_halfwidth : float
+        The smallest relative half-width of the model's 94 % band of G(t) over the window.
+    """
+
+    tau: np.ndarray
+    g: np.ndarray
+    g_inf: float
+    unit: str
+    source: str
+    window: tuple[float, float]
+    max_rel_error_modulus: float
+    max_rel_error_relaxation: float
+    band_rel_halfwidth: float
+
+    @property
+    def g_0(self) -> float:
+        """The instantaneous modulus G∞ + Σ g_i."""
+        return float(self.g_inf + np.sum(self.g))
+
+    def relaxation(self, t) -> np.ndarray:
+        t = np.asarray(t, float)
+        return self.g_inf + np.sum(self.g * np.exp(-t[..., None] / self.tau), axis=-1)
+
+    def modulus(self, omega) -> np.ndarray:
+        s = 1j * np.asarray(omega, float)[..., None] * self.tau
+        return self.g_inf + np.sum(self.g * s / (1 + s), axis=-1)
+
+    def text(self, fmt: str) -> str:
+        """The series in ``fmt`` (one of :data:`FORMATS`)."""
+        if fmt not in FORMATS:
+            raise InputError(f"export: format must be one of {', '.join(FORMATS)}, got {fmt!r}")
+        head = [f"Prony series of {self.source} (bayesfo), modulus in {self.unit or 'the data unit'} "
+                "(shear G or tensile E, as measured)",
+                f"fitted over t = {self.window[0]:.4g} to {self.window[1]:.4g} s (the data window)",
+                f"g_inf = {self.g_inf:.10g}", f"g_0 = {self.g_0:.10g}",
+                f"max_rel_error = {max(self.max_rel_error_modulus, self.max_rel_error_relaxation):.3g}"
+                f" (G', G'': {self.max_rel_error_modulus:.3g}; G(t): "
+                f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of G(t) is at least "
+                f"+-{self.band_rel_halfwidth:.3g} (relative) there"]
+        if fmt == "csv":
+            lines = [f"# {h}" for h in head] + ["tau_s,g_i"]
+            lines += [f"{t:.10g},{g:.10g}" for t, g in zip(self.tau, self.g, strict=True)]
+        elif fmt == "abaqus":
+            lines = [f"** {h}" for h in head]
+            lines.append(f"** instantaneous shear modulus G0 = {self.g_0:.10g}: give it in "
+                         "*ELASTIC, MODULI=INSTANTANEOUS")
+            lines.append("*VISCOELASTIC, TIME=PRONY")
+            lines += [f"{g / self.g_0:.10g}, 0., {t:.10g}"
+                      for t, g in zip(self.tau, self.g, strict=True)]
+        else:  # ansys
+            lines = [f"! {h}" for h in head]
+            lines.append(f"! instantaneous shear modulus G0 = {self.g_0:.10g}")
+            lines.append(f"TB,PRONY,1,,{self.tau.size},SHEAR")
+            pairs = [v for t, g in zip(self.tau, self.g, strict=True)
+                     for v in (g / self.g_0, t)]
+            for start in range(0, len(pairs), 6):  # TBDATA takes six values per command
+                chunk = ",".join(f"{v:.10g}" for v in pairs[start:start + 6])
+                lines.append(f"TBDATA,{start + 1},{chunk}")
+        return "\n".join(lines) + "\n"
+
+
+def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
+                 structure: str | None = None, average: str | None = None,
+                 seed: int = 0) -> Prony:
+    """A Prony series fitted to a comparison's structure (default the best ranked) or average.
+
+    Parameters
+    ----------
+    result : Comparison
+    per_decade : int
+        Relaxation times per decade (1 to 10).
+    liquid : bool
+        G∞ = 0 (a liquid relaxes completely).
+    structure : str, optional
+        The structure (default: the best ranked), as in :func:`bayesfo.predict`.
+    average : {"bma", "stacking"}, optional
+        An average over the structures instead, as in :func:`bayesfo.predict`.
+    seed : int
+        Seeds the draws used.
+
+    Returns
+    -------
+    Prony
+    """
+    from scipy.optimize import nnls
+
+    from .functions import predict
+
+    if isinstance(per_decade, bool) or not isinstance(per_decade, int) or not 1 <= per_decade <= 10:
+        raise InputError(f"export: terms per decade must be an integer from 1 to 10, got "
+                         f"{per_decade!r}")
+    w_lo, w_hi = float(np.min(result.data.omega)), float(np.max(result.data.omega))
+    omega = np.logspace(math.log10(w_lo) - 1, math.log10(w_hi) + 1,
+                        int(20 * (math.log10(w_hi / w_lo) + 2)) + 1)
+    kw = dict(structure=structure, average=average, seed=seed)
+    storage = predict(result, "storage", omega, **kw)
+    loss = predict(result, "loss", omega, **kw)
+    g = storage.median + 1j * loss.median
+    if not np.all(np.isfinite(g)):
+        raise InputError("export: the model's modulus is not finite over the window")
+    # The terms reach TAU_MARGIN decades past the window: a power-law spectrum (a springpot)
+    # relaxes over every decade, and terms only over the window leave its edges short.
+    lo_tau, hi_tau = 1 / (w_hi * 10**TAU_MARGIN), 10**TAU_MARGIN / w_lo
+    n = int(round(math.log10(hi_tau / lo_tau) * per_decade)) + 1
+    tau = np.logspace(math.log10(lo_tau), math.log10(hi_tau), n)
+    s = 1j * omega[:, None] * tau
+    basis = s / (1 + s)
+    if not liquid:
+        basis = np.column_stack([np.ones(omega.size), basis])
+    weight = 1.0 / np.abs(g)
+    a = np.vstack([(basis.real * weight[:, None]), (basis.imag * weight[:, None])])
+    b = np.r_[g.real * weight, g.imag * weight]
+    x, _ = nnls(a, b, maxiter=50 * a.shape[1])
+    g_inf, terms = (0.0, x) if liquid else (float(x[0]), x[1:])
+    keep = terms > 0
+    window = (1.0 / w_hi, 1.0 / w_lo)
+    fitted = Prony(tau=tau[keep], g=terms[keep], g_inf=g_inf, unit=storage.unit,
+                   source=storage.structure or f"{storage.average} average", window=window,
+                   max_rel_error_modulus=math.nan, max_rel_error_relaxation=math.nan,
+                   band_rel_halfwidth=math.nan)
+    inside = (omega >= w_lo) & (omega <= w_hi)
+    err_g = float(np.max(np.abs(fitted.modulus(omega[inside]) - g[inside]) / np.abs(g[inside])))
+    t = np.logspace(math.log10(window[0]), math.log10(window[1]), 50)
+    g_t = predict(result, "relaxation_modulus", t, **kw)
+    # Relative to G(t), or to 0.1 % of G0 where G(t) has relaxed below it (a liquid's tail).
+    scale = np.maximum(np.abs(g_t.median), 1e-3 * fitted.g_0)
+    err_t = float(np.max(np.abs(fitted.relaxation(t) - g_t.median) / scale))
+    half = float(np.min((g_t.hdi_high - g_t.hdi_low) / 2 / np.abs(g_t.median)))
+    from dataclasses import replace
+
+    return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
+                   band_rel_halfwidth=half)

@@ -1,0 +1,103 @@
+"""Prony series for finite-element codes: each format parsed back, the fit's error against the
+model, a liquid, bad input."""
+
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import bayesfo as bf
+from bayesfo.errors import InputError
+from bayesfo.predictions import prony_series
+
+DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp020C.csv"
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = bf.compare(bf.read(DATA), "voigt,zener,maxwell-int", workers=1,
+                            progress=False, seed=0)
+    bf.write_outputs(result, out, figures=False)
+    return result, out
+
+
+def _numbers(line: str) -> list[float]:
+    return [float(x) for x in re.split(r"[,\s]+", line.strip()) if x]
+
+
+def parse(text: str, fmt: str) -> tuple[np.ndarray, np.ndarray, float]:
+    """(tau, g, g_0) read back from a file in ``fmt``."""
+    lines = text.splitlines()
+    g0 = float(next(re.search(r"g_0 = (\S+)", x).group(1) for x in lines if "g_0 = " in x))
+    if fmt == "csv":
+        rows = [_numbers(x) for x in lines[lines.index("tau_s,g_i") + 1:]]
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows]), g0
+    if fmt == "abaqus":
+        rows = [_numbers(x) for x in lines[lines.index("*VISCOELASTIC, TIME=PRONY") + 1:]]
+        assert all(r[1] == 0.0 for r in rows)  # no bulk relaxation
+        return np.array([r[2] for r in rows]), np.array([r[0] for r in rows]) * g0, g0
+    tb = next(x for x in lines if x.startswith("TB,PRONY"))
+    n = int(tb.split(",")[4])
+    values, expected = [], 1
+    for x in lines:
+        if x.startswith("TBDATA,"):
+            parts = x.split(",")
+            assert int(parts[1]) == expected  # each command continues where the last ended
+            chunk = [float(v) for v in parts[2:]]
+            assert len(chunk) <= 6
+            values += chunk
+            expected += len(chunk)
+    assert len(values) == 2 * n
+    return np.array(values[1::2]), np.array(values[0::2]) * g0, g0
+
+
+@pytest.mark.parametrize("fmt", ["csv", "abaqus", "ansys"])
+def test_each_format_reads_back_as_the_series(written, fmt, tmp_path, run_cli):
+    result, out = written
+    prony = prony_series(result)
+    status, text, err = run_cli("export", out, "--format", fmt, "--out", tmp_path / f"p.{fmt}")
+    assert status == 0, err
+    tau, g, g0 = parse((tmp_path / f"p.{fmt}").read_text(), fmt)
+    np.testing.assert_allclose(tau, prony.tau, rtol=1e-9)
+    np.testing.assert_allclose(g, prony.g, rtol=1e-8)
+    assert g0 == pytest.approx(prony.g_0, rel=1e-9)
+    assert f"{prony.tau.size} terms of voigt" in text
+
+
+def test_the_series_stands_for_the_model_within_its_band(written):
+    result, _ = written
+    prony = prony_series(result, per_decade=2)
+    # Against the model's own medians over the data window, independently evaluated.
+    t = np.logspace(np.log10(prony.window[0]), np.log10(prony.window[1]), 30)
+    g_t = result.predict("relaxation_modulus", t)
+    assert np.max(np.abs(prony.relaxation(t) / g_t.median - 1)) < 2e-3
+    w = result.data.omega
+    g = result.predict("storage", w).median + 1j * result.predict("loss", w).median
+    assert np.max(np.abs(prony.modulus(w) - g) / np.abs(g)) < 2e-3
+    assert prony.max_rel_error_relaxation < prony.band_rel_halfwidth
+    assert np.all(prony.g > 0) and prony.g_inf > 0
+    assert prony.g_0 == pytest.approx(prony.g_inf + prony.g.sum())
+
+
+def test_a_liquid_relaxes_fully(written):
+    result, _ = written
+    prony = prony_series(result, structure="maxwell-int", liquid=True)
+    assert prony.g_inf == 0.0 and prony.relaxation(1e6) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_bad_requests(written, tmp_path, run_cli):
+    result, out = written
+    with pytest.raises(InputError, match="terms per decade must be an integer from 1 to 10"):
+        prony_series(result, per_decade=0)
+    status, _, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "x.csv",
+                             "--structure", "nope")
+    assert status == 2 and err.startswith("bayesfo: error: no structure 'nope'")
+    status, _, err = run_cli("export", out, "--format", "nastran", "--out", tmp_path / "x")
+    assert status == 2 and "invalid choice" in err

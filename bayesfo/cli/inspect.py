@@ -91,6 +91,16 @@ def _print(info: dict, seen: set | None = None) -> None:
     if bad:
         print(f"warning: {len(bad)} point(s) with negative loss, impossible for a passive "
               f"{info['kind']}: omega = " + ", ".join(f"{w:.4g}" for w in bad) + " rad/s")
+    kk = info.get("kramers_kronig")
+    if kk is not None:
+        worst = ", ".join(f"{w:.4g}" for w in kk["worst_frequencies"])
+        if kk["consistent"]:
+            print(f"Kramers–Kronig: the two parts are consistent (F = {kk['chi2_per_dof']:.2f})")
+        else:
+            print(f"warning: the two parts are not consistent by the Kramers–Kronig relations "
+                  f"(F = {kk['chi2_per_dof']:.3g}, most at omega = {worst} rad/s): an instrument "
+                  "artefact (inertia, compliance), parts from different measurements, or a master "
+                  "curve whose isotherms do not superpose")
     if reading["format"] == "bayesfo CSV":
         print(f"read as bayesfo CSV: columns {', '.join(reading['columns'])}; "
               + (f"temperature {info['temperature_C']:g} °C ('# temperature:' line); "

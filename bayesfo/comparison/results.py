@@ -421,7 +421,9 @@ class Comparison:
                      "omega_max": float(self.data.omega.max()),
                      "warnings": self.data_warnings, "notes": list(self.data.notes),
                      "dissipation_violations_omega":
-                         self.data.omega[self.data.dissipation_violations()].tolist()},
+                         self.data.omega[self.data.dissipation_violations()].tolist(),
+                     "kramers_kronig": None if (kk := self.data.kramers_kronig()) is None
+                     else kk.to_dict()},
             "seed": self.seed,
             "ranked_by": self.ranked_by,
             "structures": [r.to_dict() for r in self.results],

@@ -346,6 +346,16 @@ class FrequencyResponse:
             lines.append(",".join(repr(float(v)) for v in row))
         return "\n".join(lines) + "\n"
 
+    def kramers_kronig(self):
+        """The linear Kramers–Kronig test of the two parts
+        (:func:`bayesfo.data.kramers_kronig.kramers_kronig`), or None with too few points."""
+        from .kramers_kronig import kramers_kronig
+
+        try:
+            return kramers_kronig(self)
+        except InputError:
+            return None
+
     def to_dict(self) -> dict:
         """Plain-Python summary for JSON output (no arrays of data)."""
         return {
@@ -359,6 +369,7 @@ class FrequencyResponse:
             "has_sigma": self.sigma is not None,
             "dissipation_violations": self.omega[self.dissipation_violations()].tolist(),
             "notes": list(self.notes),
+            "kramers_kronig": None if (kk := self.kramers_kronig()) is None else kk.to_dict(),
         }
 
 

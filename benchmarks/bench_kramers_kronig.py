@@ -1,0 +1,100 @@
+"""The linear Kramers–Kronig test (bayesfo.data.kramers_kronig) measured by simulation:
+its false-alarm rate on consistent data (fractional Zener, Maxwell and Voigt responses with
+complex noise, σ given and estimated) and its power on inconsistent data (storage modulus of
+one Zener, loss modulus of another whose relaxation time differs by a factor), over seeds; the
+cost of one test; the bundled isotherms.
+
+Usage: python benchmarks/bench_kramers_kronig.py [--seeds 200]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+import bayesfo as bf
+from bayesfo.data import FrequencyResponse
+from bayesfo.data.kramers_kronig import FALSE_ALARM, kramers_kronig
+from bayesfo.structures import get_structure
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def sample(structure, rng):
+    s = get_structure(structure)
+    if structure == "zener":
+        a1 = 10 ** rng.uniform(-1, 1)
+        return s, [a1, 1.0, 10 ** rng.uniform(-3, -1) * a1, rng.uniform(0.3, 1.0)]
+    if structure == "voigt":
+        return s, [10 ** rng.uniform(-1, 1), 1.0, rng.uniform(0.2, 0.9)]
+    # maxwell: a1 s^beta/(1 + b1 s^alpha) as a modulus, beta < alpha
+    alpha = rng.uniform(0.4, 1.0)
+    return s, [1.0, 10 ** rng.uniform(-1, 1), alpha, rng.uniform(0.05, 0.9) * alpha]
+
+
+def noisy(g, rel, rng, known):
+    sd = rel * np.abs(g)
+    y = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
+    return y, (sd if known else None)
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seeds", type=int, default=200)
+    args = parser.parse_args()
+    print(f"machine: {platform.machine()}, {os.cpu_count()} CPUs, python "
+          f"{platform.python_version()}; nominal false-alarm rate {FALSE_ALARM}")
+    w = np.logspace(-1, 2, 25)
+    print(f"{'case':<44} {'noise':>9} {'flagged':>8} {'median chi2/dof':>16}")
+    for structure in ("zener", "maxwell", "voigt"):
+        for known in (True, False):
+            for rel in (0.01, 0.05):
+                chi, flagged = [], 0
+                for seed in range(args.seeds):
+                    rng = np.random.default_rng(seed)
+                    s, theta = sample(structure, rng)
+                    y, sd = noisy(s.response(theta, w, "modulus"), rel, rng, known)
+                    kk = kramers_kronig(FrequencyResponse(w, y, sd, kind="modulus"))
+                    chi.append(kk.chi2_per_dof)
+                    flagged += not kk.consistent
+                print(f"consistent {structure:<10} {rel:>4.0%} noise {'':<18} "
+                      f"{'given' if known else 'estimated':>9} {flagged / args.seeds:8.3f} "
+                      f"{np.median(chi):16.2f}")
+    for factor in (1.5, 3.0, 10.0):
+        for known in (True, False):
+            chi, flagged = [], 0
+            for seed in range(args.seeds):
+                rng = np.random.default_rng(seed)
+                s, theta = sample("zener", rng)
+                other = list(theta)
+                other[0] *= factor  # a1: the relaxation time
+                other[2] *= factor  # b1, so that the plateaus stay
+                g = s.response(theta, w, "modulus").real + 1j * s.response(other, w,
+                                                                           "modulus").imag
+                y, sd = noisy(g, 0.01, rng, known)
+                kk = kramers_kronig(FrequencyResponse(w, y, sd, kind="modulus"))
+                chi.append(kk.chi2_per_dof)
+                flagged += not kk.consistent
+            print(f"G' and G'' of Zeners with tau apart x{factor:<5} 1% noise {'':<5} "
+                  f"{'given' if known else 'estimated':>9} {flagged / args.seeds:8.3f} "
+                  f"{np.median(chi):16.2f}")
+    data = FrequencyResponse(w, get_structure("zener").response([2.0, 1.0, 0.1, 0.6], w,
+                                                                "modulus"), kind="modulus")
+    t0 = time.perf_counter()
+    for _ in range(100):
+        kramers_kronig(data)
+    print(f"one test, 25 frequencies: {(time.perf_counter() - t0) * 10:.2f} ms")
+    for f in sorted((ROOT / "examples" / "data" / "adhesive_468mp").glob("T*.csv")):
+        kk = kramers_kronig(bf.read(f))
+        print(f"  {f.stem}: chi2/dof {kk.chi2_per_dof:8.2f} "
+              f"{'consistent' if kk.consistent else 'NOT consistent'}; worst at "
+              + ", ".join(f"{x:.3g}" for x in kk.worst_frequencies) + " rad/s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,80 @@
+"""The linear Kramers–Kronig test: consistent responses pass at about the stated false-alarm
+rate, parts of different responses fail, and the result reaches inspect and summary.json."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from bayesfo.data import FrequencyResponse
+from bayesfo.data.kramers_kronig import FALSE_ALARM, kramers_kronig
+from bayesfo.structures import get_structure
+
+W = np.logspace(-1, 2, 25)
+ZENER = get_structure("zener")
+
+
+def _zener(rng):
+    a1 = 10 ** rng.uniform(-1, 1)
+    return [a1, 1.0, 10 ** rng.uniform(-3, -1) * a1, rng.uniform(0.3, 1.0)]
+
+
+def _noisy(g, rng, rel=0.01):
+    sd = rel * np.abs(g)
+    return g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size)), sd
+
+
+@pytest.mark.parametrize("known", [True, False])
+def test_consistent_data_pass_at_the_stated_rate(known):
+    # 200 fractional Zeners with 1 % noise: flagged ones are false alarms, binomial with
+    # p = 0.01 (mean 2; 8 or more has probability 1e-3).
+    flagged = 0
+    for seed in range(200):
+        rng = np.random.default_rng(seed)
+        y, sd = _noisy(ZENER.response(_zener(rng), W, "modulus"), rng)
+        kk = kramers_kronig(FrequencyResponse(W, y, sd if known else None, kind="modulus"))
+        flagged += not kk.consistent
+    assert flagged < 8 and FALSE_ALARM == 0.01
+
+
+def test_parts_of_different_responses_fail():
+    # Storage modulus of one Zener, loss modulus of one relaxing 1.5 times slower.
+    failed = 0
+    for seed in range(50):
+        rng = np.random.default_rng(seed)
+        theta = _zener(rng)
+        slower = [theta[0] * 1.5, theta[1], theta[2] * 1.5, theta[3]]
+        g = (ZENER.response(theta, W, "modulus").real
+             + 1j * ZENER.response(slower, W, "modulus").imag)
+        y, _ = _noisy(g, rng)
+        kk = kramers_kronig(FrequencyResponse(W, y, kind="modulus"))
+        failed += not kk.consistent
+        if not kk.consistent:
+            assert kk.chi2_per_dof > 3 and len(kk.worst_frequencies) == 3
+    assert failed >= 45
+
+
+def test_a_compliance_is_tested_on_its_own_basis():
+    rng = np.random.default_rng(0)
+    y, sd = _noisy(ZENER.response([2.0, 1.0, 0.1, 0.6], W, "compliance"), rng)
+    kk = kramers_kronig(FrequencyResponse(W, y, sd, kind="compliance"))
+    assert kk.consistent and kk.noise == "given" and 0.1 < kk.chi2_per_dof < 3
+
+
+def test_too_few_points_have_no_test_and_the_blocks_are_written(run_cli, tmp_path):
+    few = FrequencyResponse(W[:4], ZENER.response([2.0, 1.0, 0.1, 0.6], W[:4], "modulus"),
+                            kind="modulus")
+    assert few.kramers_kronig() is None and few.to_dict()["kramers_kronig"] is None
+    rng = np.random.default_rng(1)
+    y, _ = _noisy(ZENER.response([2.0, 1.0, 0.1, 0.6], W, "modulus"), rng)
+    path = tmp_path / "z.csv"
+    FrequencyResponse(W, y, kind="modulus", units="Pa").to_csv(path)
+    status, out, _ = run_cli("inspect", path, "--json")
+    block = json.loads(out)["kramers_kronig"]
+    assert status == 0 and block["consistent"] is True
+    assert set(block) == {"consistent", "chi2_per_dof", "worst_frequencies", "noise",
+                          "n_elements"}
+    status, out, _ = run_cli("inspect", path)
+    assert "Kramers–Kronig: the two parts are consistent (F = " in out

@@ -50,7 +50,7 @@ def main():
     print(f"machine: {platform.machine()}, {os.cpu_count()} CPUs, python "
           f"{platform.python_version()}; nominal false-alarm rate {FALSE_ALARM}")
     w = np.logspace(-1, 2, 25)
-    print(f"{'case':<44} {'noise':>9} {'flagged':>8} {'median chi2/dof':>16}")
+    print(f"{'case':<44} {'noise':>9} {'flagged':>8} {'median F':>16}")
     for structure in ("zener", "maxwell", "voigt"):
         for known in (True, False):
             for rel in (0.01, 0.05):

@@ -184,7 +184,7 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
         parts.append(_evaluate(r.structure, theta, quantity, x))
     values = np.concatenate(parts, axis=0)
     if quantity in ("relaxation_spectrum", "retardation_spectrum"):
-        discrete = [n for n in weights if result[n].structure.integer and weights[n] > 0]
+        discrete = [n for n in weights if result[n].structure.integer and weights[n] >= 1e-3]
         if discrete:
             notes.append(f"{', '.join(discrete)}: integer orders give a discrete spectrum "
                          "(lines at the relaxation times), which a continuous density shows "

@@ -93,14 +93,14 @@ class Prony:
             lines += [f"{t:.10g},{g:.10g}" for t, g in zip(self.tau, self.g, strict=True)]
         elif fmt == "abaqus":
             lines = [f"** {h}" for h in head]
-            lines.append(f"** instantaneous shear modulus G0 = {self.g_0:.10g}: give it in "
+            lines.append(f"** instantaneous modulus G0 = {self.g_0:.10g}: give it in "
                          "*ELASTIC, MODULI=INSTANTANEOUS")
             lines.append("*VISCOELASTIC, TIME=PRONY")
             lines += [f"{g / self.g_0:.10g}, 0., {t:.10g}"
                       for t, g in zip(self.tau, self.g, strict=True)]
         else:  # ansys
             lines = [f"! {h}" for h in head]
-            lines.append(f"! instantaneous shear modulus G0 = {self.g_0:.10g}")
+            lines.append(f"! instantaneous modulus G0 = {self.g_0:.10g}")
             lines.append(f"TB,PRONY,1,,{self.tau.size},SHEAR")
             pairs = [v for t, g in zip(self.tau, self.g, strict=True)
                      for v in (g / self.g_0, t)]

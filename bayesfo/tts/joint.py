@@ -533,10 +533,10 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
     shift_draws = shifted.log_shifts(physical[:, :k_all])
     ev = found.evidence
     laws = _fit_laws(shift_draws, iso.temperatures, iso.reference, seed)
-    best = max(laws, key=lambda name: laws[name]["probability"])
-    if laws[best]["chi2_per_dof"] > LAW_MISS:
-        law = laws[best]
-        notes.append(f"the {'WLF' if best == 'wlf' else 'Arrhenius'} law, the better of the two, "
+    preferred = max(laws, key=lambda name: laws[name]["probability"])
+    if laws[preferred]["chi2_per_dof"] > LAW_MISS:
+        law = laws[preferred]
+        notes.append(f"the {'WLF' if preferred == 'wlf' else 'Arrhenius'} law, the better of the two, "
                      f"misses the shifts beyond their uncertainty (chi2/dof "
                      f"{law['chi2_per_dof']:.3g}; most at {law['worst_temperature']:g} °C, by "
                      f"{law['worst_deviation']:+.2f} decades): neither law holds over the whole "

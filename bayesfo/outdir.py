@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import hashlib
 import json
 import os
 import re
@@ -79,6 +80,46 @@ def _read_json(path: Path):
         return json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):  # unreadable, not JSON, nested too deeply
         return None
+
+
+def _digest(path: Path) -> str:
+    """SHA-256 of a file, in hex."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+@contextlib.contextmanager
+def one_run(out_dir, checked=lambda name: True):
+    """Read the files of ``out_dir`` as the output of one run: a swap that a killed run left
+    half-done is completed first, a run swapping its outputs in is waited for (its lock is held
+    while the block reads), and every file for which ``checked(name)`` holds and whose digest
+    the run recorded must still have it.
+
+    Raises
+    ------
+    InputError
+        A file that another run wrote, or that was changed since (copied in, truncated).
+    """
+    out_dir = Path(out_dir)
+    with contextlib.ExitStack() as stack:
+        try:
+            recover(out_dir)
+            stack.enter_context(_locked(out_dir))
+        except OSError:  # a directory that cannot be written: read what it holds, unlocked
+            pass
+        record = _read_json(out_dir / MANIFEST)
+        digests = record.get("sha256") if isinstance(record, dict) else None
+        for name, digest in (digests.items() if isinstance(digests, dict) else ()):
+            path = out_dir / name
+            if (isinstance(name, str) and is_output_name(name) and checked(name)
+                    and path.is_file() and _digest(path) != digest):
+                raise InputError(f"'{path}' is not the file that the run which wrote "
+                                 f"'{out_dir}' left there (changed, truncated or copied in "
+                                 "from another run); run compare again into the directory")
+        yield
 
 
 def owned_entries(out_dir) -> list[str]:
@@ -346,8 +387,11 @@ def staged_run(out_dir):
         bad = [n for n in new if not is_output_name(n)]
         if bad:
             raise ValueError(f"output entry {bad[0]!r} is not a name a run may write")
+        digests = {n: _digest(staging / "new" / n) for n in new
+                   if (staging / "new" / n).is_file()}
         atomic_write_text(staging / "new" / MANIFEST,
-                          json.dumps({"format": _FORMAT, "entries": new}, indent=2) + "\n")
+                          json.dumps({"format": _FORMAT, "entries": new, "sha256": digests},
+                                     indent=2) + "\n")
         with _locked(out_dir):
             _recover_unlocked(out_dir, keep=staging.name)
             old = owned_entries(out_dir)

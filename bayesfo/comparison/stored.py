@@ -115,18 +115,21 @@ def load(directory, *, models=()) -> Comparison:
         A missing directory, ``summary.json`` or NetCDF file, or one that cannot be read or is
         not what ``compare`` writes: the message names the file and what is wrong.
     """
-    from ..structures import default_library, load_library
-
     d = Path(directory)
     if not d.is_dir():
         raise InputError(f"'{d}': " + ("not a directory" if d.exists() else "no such directory")
                          + "; give the output directory of bayesfo compare")
-    try:  # a swap that a killed run left half-done is completed first, as the next run would
-        from ..outdir import recover
+    from ..outdir import one_run
 
-        recover(d)
-    except OSError:
-        pass  # a directory that cannot be written: read what it holds
+    # The summary and the NetCDF files of one run (a swap under way is waited for, one that a
+    # killed run left half-done is completed, and files another run wrote are refused).
+    with one_run(d, lambda name: name == "summary.json" or name.endswith(".nc")):
+        return _load(d, models)
+
+
+def _load(d: Path, models) -> Comparison:
+    from ..structures import default_library, load_library
+
     path = d / "summary.json"
     if not path.is_file():
         raise InputError(f"'{path}': missing, so '{d}' holds no complete output of bayesfo "

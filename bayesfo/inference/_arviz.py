@@ -12,7 +12,9 @@ are arviz-stats' array functions, given plain arrays:
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -70,19 +72,33 @@ def hdi_columns(values, prob: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def psis(log_w) -> tuple[np.ndarray, float]:
-    """Pareto-smoothed log importance weights (normalised) and the Pareto k̂ of their tail."""
+    """Pareto-smoothed log importance weights (normalised) and the Pareto k̂ of their tail
+    (inf where the tail is flat and cannot be fitted: the weights are then not certified)."""
     # arviz-stats smooths the ratios 1/p of a log-likelihood p (leave-one-out): ratios w are
     # passed as the log-likelihood -log w.
-    smoothed, k_hat = _stats().psislw(-np.asarray(log_w, dtype=float))
+    log_w = np.asarray(log_w, dtype=float)
+    try:
+        smoothed, k_hat = _stats().psislw(-log_w)
+    except ValueError:  # a tail of equal weights: nothing to smooth, and no certificate
+        from scipy.special import logsumexp
+
+        return log_w - logsumexp(log_w), math.inf
     return np.asarray(smoothed), float(k_hat)
 
 
 def loo(tree):
     """PSIS-LOO from the ``log_likelihood`` group of ``tree`` (variable ``G``, per frequency):
-    arviz-stats' ``ELPDData`` (``elpd``, ``se``, ``pareto_k``, ``elpd_i``)."""
+    arviz-stats' ``ELPDData`` (``elpd``, ``se``, ``pareto_k``, ``elpd_i``); where the tail of
+    the importance ratios is flat and no Pareto fit exists, the same fields undefined (NaN, and
+    k̂ = inf)."""
     from arviz_stats import loo as _loo
 
-    return _loo(tree, pointwise=True, var_name="G")
+    try:
+        return _loo(tree, pointwise=True, var_name="G")
+    except ValueError:  # the pointwise log-likelihood's tail is flat (a hopeless misfit)
+        n = tree.log_likelihood["G"].shape[-1]
+        return SimpleNamespace(elpd=math.nan, se=math.nan, pareto_k=np.full(n, math.inf),
+                               elpd_i=np.full(n, math.nan))
 
 
 def waic(log_lik) -> tuple[float, float]:

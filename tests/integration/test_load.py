@@ -139,6 +139,11 @@ def test_missing_or_damaged_outputs_are_input_errors(written, tmp_path):
     copy = tmp_path / "copy"
     shutil.copytree(out, copy)
     (copy / "voigt.nc").write_bytes(b"not a NetCDF file")
+    # The run recorded its files' digests: a file changed since is refused as such.
+    with pytest.raises(InputError, match=r"voigt\.nc' is not the file that the run which wrote"):
+        bf.load(copy)
+    # Without the record (a run of an earlier version), the reader says what is wrong.
+    (copy / ".bayesfo-run.json").unlink()
     with pytest.raises(InputError, match=r"voigt\.nc': cannot be read as NetCDF"):
         bf.load(copy)
     (copy / "voigt.nc").unlink()

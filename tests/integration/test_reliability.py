@@ -674,3 +674,30 @@ def test_load_refuses_a_record_nested_too_deeply(tmp_path):
         (stage / "summary.json").write_text("[" * 100_000 + "]" * 100_000)
     with pytest.raises(InputError, match="nested too deeply"):
         load(out)
+
+
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_load_refuses_a_netcdf_of_another_run(tmp_path):
+    from bayesfo.comparison import load
+    from bayesfo.errors import InputError
+
+    data = FrequencyResponse(*_zener_points(), kind="modulus", units="Pa")
+    runs = {}
+    for seed in (1, 2):
+        out = tmp_path / f"run{seed}"
+        write_outputs(compare(data, "voigt", seed=seed, workers=1, progress=False), out,
+                      figures=False)
+        runs[seed] = out
+    assert load(runs[1]).ranking == ["voigt"]  # as written: fine
+    shutil.copy(runs[2] / "voigt.nc", runs[1] / "voigt.nc")  # the other run's posterior
+    with pytest.raises(InputError, match="voigt.nc' is not the file that the run which wrote"):
+        load(runs[1])
+
+
+def _zener_points():
+    from bayesfo.structures import get_structure
+
+    w = np.logspace(-1, 2, 20)
+    g = get_structure("zener").response([10.0, 1.0, 0.1, 0.6], w, "modulus")
+    rng = np.random.default_rng(0)
+    return w, g * (1 + 0.01 * (rng.normal(size=w.size) + 1j * rng.normal(size=w.size)))

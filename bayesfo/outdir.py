@@ -110,16 +110,26 @@ def one_run(out_dir, checked=lambda name: True):
             stack.enter_context(_locked(out_dir))
         except OSError:  # a directory that cannot be written: read what it holds, unlocked
             pass
-        record = _read_json(out_dir / MANIFEST)
-        digests = record.get("sha256") if isinstance(record, dict) else None
-        for name, digest in (digests.items() if isinstance(digests, dict) else ()):
-            path = out_dir / name
-            if (isinstance(name, str) and is_output_name(name) and checked(name)
-                    and path.is_file() and _digest(path) != digest):
-                raise InputError(f"'{path}' is not the file that the run which wrote "
-                                 f"'{out_dir}' left there (changed, truncated or copied in "
-                                 "from another run); run compare again into the directory")
+        path = changed_file(out_dir, checked)
+        if path is not None:
+            raise InputError(f"'{path}' is not the file that the run which wrote "
+                             f"'{out_dir}' left there (changed, truncated or copied in "
+                             "from another run); run compare again into the directory")
         yield
+
+
+def changed_file(out_dir, checked=lambda name: True) -> Path | None:
+    """The first file of ``out_dir`` (among those for which ``checked(name)`` holds) whose
+    SHA-256 is not the one its run recorded, or None (also where no digests were recorded)."""
+    out_dir = Path(out_dir)
+    record = _read_json(out_dir / MANIFEST)
+    digests = record.get("sha256") if isinstance(record, dict) else None
+    for name, digest in (digests.items() if isinstance(digests, dict) else ()):
+        path = out_dir / name
+        if (isinstance(name, str) and is_output_name(name) and checked(name)
+                and path.is_file() and _digest(path) != digest):
+            return path
+    return None
 
 
 def owned_entries(out_dir) -> list[str]:

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .._io import atomic_write_text
-from ..outdir import is_output_path, recover, staged_run
+from ..outdir import changed_file, is_output_path, recover, staged_run
 from .datasets import DataSet
 from .task import INPUT_ERROR, INTERNAL_ERROR, OK
 
@@ -203,6 +203,8 @@ def _stored_rows(ds: DataSet, out_dir: Path, fingerprint: dict) -> tuple | None:
         files = record.get("files")
         if not isinstance(files, list) or not all(
                 is_output_path(name) and (sub / name).is_file() for name in files):
+            return None
+        if changed_file(sub) is not None:  # truncated, changed or copied in since
             return None
         summary = json.loads((sub / "summary.json").read_text(encoding="utf-8"))
         return _dataset_rows(ds, OK, None, summary_rows(summary))

@@ -313,6 +313,21 @@ def test_temperature_table_and_figure(reference):
     np.testing.assert_allclose([x for x, _ in got], [x for x, _ in expected], atol=0.02 * 160)
 
 
+def test_resume_redoes_a_data_set_whose_files_changed(reference, tmp_path, monkeypatch):
+    # A truncated NetCDF (a full disk, a copy cut short) is not a complete result, though
+    # batch.json lists it: its digest is not the one its run recorded.
+    datasets, _, out = reference
+    out2 = tmp_path / "out"
+    shutil.copytree(out, out2)
+    nc = sorted((out2 / "Tm010C").glob("*.nc"))[0]
+    nc.write_bytes(nc.read_bytes()[: nc.stat().st_size // 2])
+    calls = []
+    monkeypatch.setattr(executors, "run_task", lambda task: calls.append(task["id"]) or {
+        "id": task["id"], "status": "input_error", "error": "not run", "files": {}})
+    run_batch(datasets, out2, workers=1, progress=False, write_combined=False)
+    assert sorted(calls) == ["Tm010C", "broken"]  # Tp150C stays complete
+
+
 def test_resume_skips_complete_and_redoes_incomplete(reference, tmp_path, monkeypatch):
     datasets, result, out = reference
     out2 = tmp_path / "out"

@@ -45,8 +45,9 @@ QUANTITIES = {
     "relaxation_spectrum": ("tau", "H(τ)", "modulus"),
     "retardation_spectrum": ("tau", "L(τ)", "compliance"),
 }
-#: The unit of each kind of argument.
+#: The unit of each kind of argument, and its name.
 X_UNITS = {"omega": "rad/s", "time": "s", "tau": "s"}
+X_NAMES = {"omega": "omega", "time": "t", "tau": "tau"}
 #: Ways of averaging over structures.
 AVERAGES = ("bma", "stacking")
 #: Probability of the credible band (the highest-density interval, as everywhere in bayesfo).
@@ -190,6 +191,12 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
                          "(lines at the relaxation times), which a continuous density shows "
                          "as 0 between them")
     median, lo, hi = _band(values)
+    undefined = np.flatnonzero(np.isnan(median))
+    if undefined.size:
+        shown = ", ".join(f"{v:.4g}" for v in x[undefined[:6]])
+        notes.append(f"{QUANTITIES[quantity][1]} is not finite for some draws at {X_NAMES[domain]} "
+                     f"{shown}{' and more' if undefined.size > 6 else ''} {X_UNITS[domain]}: "
+                     "no value or band there")
     return Prediction(
         quantity=quantity, unit=_unit(quantity, data), x=x, x_unit=X_UNITS[domain],
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, data.omega),

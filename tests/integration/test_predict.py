@@ -165,3 +165,20 @@ def test_bands_cover_the_truth_over_seeds():
         p = _compare(seed, "zener").predict("relaxation_modulus", T)
         covered.append(np.mean((p.hdi_low <= truth) & (truth <= p.hdi_high)))
     assert np.mean(covered) >= 0.83
+
+
+def test_values_that_are_not_finite_are_said_not_shown_as_numbers(result, monkeypatch):
+    import bayesfo.predictions.functions as functions
+
+    real = functions._evaluate
+
+    def overflowing(structure, theta, quantity, x):
+        out = real(structure, theta, quantity, x)
+        out[0, -1] = np.inf  # one draw overflows at the last time
+        return out
+
+    monkeypatch.setattr(functions, "_evaluate", overflowing)
+    p = result.predict("relaxation_modulus", [0.1, 1.0], structure="zener")
+    assert np.isfinite(p.median[0]) and np.isnan(p.median[1]) and np.isnan(p.hdi_high[1])
+    assert p.to_dict()["median"][1] is None
+    assert p.notes == ("G(t) is not finite for some draws at t 1 s: no value or band there",)

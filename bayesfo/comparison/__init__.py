@@ -6,7 +6,8 @@ rank them, and write the output directory; read it back.
 (:func:`load`).
 """
 
-from .criteria import LADDER_SHORTFALL, PARETO_K_WARN
+from ..inference.certified import LADDER_SHORTFALL
+from .criteria import PARETO_K_WARN
 from .criteria_types import Criteria
 from .output import ranking_csv, write_outputs
 from .results import Comparison, StructureResult

@@ -16,7 +16,6 @@ from ..identify.optimize import FitResult
 from ..inference import Likelihood, PosteriorResult
 from ..inference._arviz import loo as psis_loo
 from ..inference._arviz import waic as waic_of
-from ..inference.certified import LADDER_SHORTFALL  # noqa: F401  (bayesfo.comparison's name)
 
 PARETO_K_WARN = 0.7
 

@@ -15,7 +15,8 @@ from bayesfo.data import FrequencyResponse
 from bayesfo.errors import InputError
 from bayesfo.structures import get_structure
 from bayesfo.tts import arrhenius, wlf
-from bayesfo.tts.joint import _fit_laws, shift_name
+from bayesfo.tts.joint import shift_name
+from bayesfo.tts.laws import _fit_laws
 
 ZENER = [10.0, 1.0, 0.1, 0.6]  # a1, b0, b1, q (compliance form)
 W = np.logspace(-1, 2, 12)

@@ -54,6 +54,8 @@ CAPTIONS = {
                "labels: posterior not converged.",
     "bode": "Magnitude and phase of the data (± 1 sd where σ is known) with each structure's "
             "posterior median response (line) and its 50 % and 90 % credible bands.",
+    "moduli": "Storage and loss parts and the loss tangent of the data with each structure's "
+              "posterior median and its 50 % and 90 % credible bands.",
     "nyquist": "The same in the complex plane: posterior median curve and single posterior "
                "draws (thin lines).",
     "residuals": "Residuals of the data from the posterior median prediction, real and "

@@ -15,6 +15,9 @@ Modules
     :func:`plot_bode`, :func:`plot_nyquist` (log-magnitude form for data over many decades),
     :func:`plot_residuals`: posterior response bands against the data; structures whose
     curves coincide are named in the legend.
+``moduli``
+    :func:`plot_moduli`: storage and loss parts (G′, G″ or J′, J″) and tan δ with the
+    posterior bands.
 ``posterior``
     :func:`plot_corner`, :func:`plot_trace` (one structure), :func:`plot_q_posteriors`.
 ``ranking``
@@ -40,6 +43,7 @@ Example
 from __future__ import annotations
 
 from ._base import Drawn
+from .moduli import plot_moduli
 from .output import save_figure, write_figures
 from .posterior import plot_corner, plot_q_posteriors, plot_trace
 from .ranking import plot_ranking
@@ -51,6 +55,7 @@ __all__ = [
     "Drawn",
     "plot_bode",
     "plot_corner",
+    "plot_moduli",
     "plot_nyquist",
     "plot_q_posteriors",
     "plot_ranking",

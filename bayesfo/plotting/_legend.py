@@ -3,6 +3,8 @@ labels fit, and the note of coinciding curves as its title."""
 
 from __future__ import annotations
 
+import numpy as np
+
 
 def _legend(fig, handles, labels, note: str = ""):
     """The legend above the axes; ``note`` (what coincides) as its title."""
@@ -34,8 +36,12 @@ def _legend_columns(fig, labels, max_columns: int = 3) -> int:
                  + mpl.rcParams["legend.columnspacing"]) * size
     available = fig.get_figwidth() * 72.0 - 2 * (mpl.rcParams["legend.borderpad"] + 1.0) * size
     for n in range(min(len(labels), max_columns), 1, -1):
-        rows = -(-len(labels) // n)  # matplotlib fills the columns one after the other
-        columns = [widths[i:i + rows] for i in range(0, len(widths), rows)]
+        # matplotlib fills the columns one after the other, the first len % n columns with one
+        # entry more than the rest (four entries in three columns: 2, 1, 1).
+        rows, extra = divmod(len(labels), n)
+        sizes = [rows + 1] * extra + [rows] * (n - extra)
+        starts = np.cumsum([0, *sizes])
+        columns = [widths[a:b] for a, b in zip(starts[:-1], starts[1:], strict=True) if b > a]
         if sum(max(c) + per_entry for c in columns) <= available:
             return n
     return 1

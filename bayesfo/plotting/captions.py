@@ -105,6 +105,12 @@ def figure_caption(name: str, comparison) -> str | None:
                 "structure's posterior median response (one line style per structure) and its "
                 "50 % and 90 % credible bands; the legend names structures whose curves "
                 "coincide and marks those the posterior predictive checks reject (misfits).")
+    if name == "moduli":
+        storage, loss = ("J′", "J″") if comparison.data.kind == "compliance" else ("G′", "G″")
+        return (f"Storage part {storage}, loss part {loss} and loss tangent tan δ = "
+                f"{loss}/{storage} of the data (± 1 sd) with each structure's posterior median "
+                "and its 50 % and 90 % credible bands, on logarithmic axes (values that are not "
+                "positive are left out, and the legend says how many).")
     if name == "nyquist":
         if nyquist_form(comparison) == "log":
             return ("The same in the complex plane, log-magnitude form (|G| spans more than "

@@ -529,7 +529,7 @@ def test_demo_figures_show_voigt_and_zener_apart(tmp_path):
     q = plot_q_posteriors(comp)
     assert "voigt/inset" in q.artists and "zener/inset" in q.artists
     written = write_figures(comp, tmp_path, formats=("png",))
-    assert set(written) >= {"ranking", "bode", "nyquist", "residuals", "q_posteriors"}
+    assert set(written) >= {"ranking", "bode", "moduli", "nyquist", "residuals", "q_posteriors"}
     for name in written:
         caption = figure_caption(name, comp)
         assert caption, name

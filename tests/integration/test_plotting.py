@@ -24,6 +24,7 @@ from bayesfo.errors import DataWarning, InputError, PredictiveWarning  # noqa: E
 from bayesfo.plotting import (  # noqa: E402
     plot_bode,
     plot_corner,
+    plot_moduli,
     plot_nyquist,
     plot_q_posteriors,
     plot_ranking,
@@ -134,6 +135,59 @@ def test_bode_draws_the_data_and_the_held_out_points(comparison):
     assert mag_ax.get_xscale() == "log" and mag_ax.get_yscale() == "log"
     assert mag_ax.get_ylabel().endswith("[1/Pa]") and "rad/s" in phase_ax.get_xlabel()
     assert "deg" in phase_ax.get_ylabel()
+
+
+def test_moduli_equal_the_storage_and_loss_parts_of_the_draws(comparison):
+    """A compliance J* = J′ − iJ″: the panels are Re J, −Im J and their ratio, for the data and
+    for the quantiles of the posterior responses."""
+    drawn = plot_moduli(comparison, n_draws=ALL)
+    omega = drawn.values["omega"]
+    for name in comparison.ranking:
+        r = comparison[name]
+        g = r.structure.response(_draws(r), omega, "compliance")
+        for quantity, x in (("storage", g.real), ("loss", -g.imag),
+                            ("tan_delta", -g.imag / g.real)):
+            np.testing.assert_allclose(drawn.values[f"{name}/{quantity}_median"],
+                                       np.median(x, axis=0), rtol=1e-12)
+            np.testing.assert_allclose(drawn.values[f"{name}/{quantity}_q95"],
+                                       np.quantile(x, 0.95, axis=0), rtol=1e-12)
+        assert np.all(drawn.values[f"{name}/loss_median"] > 0)
+    data = comparison.data
+    order = np.argsort(data.omega)
+    j = data.response[order]
+    np.testing.assert_allclose(drawn.values["data/storage"], j.real)
+    np.testing.assert_allclose(drawn.values["data/loss"], -j.imag)
+    # The fixture's noise makes J″ of a point negative: it is not drawn on the log axis, in the
+    # loss and the tan δ panel, and the legend says so.
+    negative = int(np.count_nonzero(-j.imag <= 0))
+    assert negative >= 1
+    assert drawn.values["left_out"] == 2 * negative
+    line = drawn.artists["data/loss"].lines[0]
+    np.testing.assert_allclose(line.get_ydata(), (-j.imag)[-j.imag > 0])
+    assert f"{2 * negative} data values not positive" in drawn.artists["note"].get_text()
+    # Error bars of one sd of each part, σ/√2 (the upper half: the lower one is cut above 0).
+    segs = drawn.artists["data/storage"].lines[2][0].get_segments()
+    upper = np.array([s[1, 1] for s in segs]) - j.real
+    np.testing.assert_allclose(upper, data.sigma[order] / np.sqrt(2), rtol=1e-12)
+    storage_ax, loss_ax, tan_ax = drawn.axes
+    assert storage_ax.get_ylabel() == "J′ [1/Pa]" and loss_ax.get_ylabel() == "J″ [1/Pa]"
+    assert "delta" in tan_ax.get_ylabel()
+    assert all(ax.get_yscale() == "log" for ax in drawn.axes)
+    drawn.figure.canvas.draw()
+    box = drawn.figure.legends[0].get_window_extent()
+    assert 0 <= box.x0 and box.x1 <= drawn.figure.bbox.width
+
+
+def test_moduli_refuse_a_transfer_function(comparison):
+    from bayesfo.plotting.moduli import storage_loss
+
+    generic = replace(comparison, data=FrequencyResponse(W, np.ones(W.size) + 1j, kind="generic"))
+    with pytest.raises(InputError, match="modulus or compliance data.*Bode"):
+        plot_moduli(generic)
+    assert plt.get_fignums() == []
+    g = np.array([2.0 + 1.0j])
+    assert storage_loss(g, "modulus") == (2.0, 1.0)
+    assert storage_loss(g, "compliance") == (2.0, -1.0)
 
 
 def test_structures_argument_is_checked(comparison):
@@ -389,7 +443,7 @@ def test_write_figures_skips_failed_structures_and_closes_figures(comparison, tm
     before = plt.get_fignums()
     written = write_figures(with_failure, tmp_path, formats=("png",))
     assert plt.get_fignums() == before
-    expected = ["ranking", "bode", "nyquist", "residuals", "q_posteriors"]
+    expected = ["ranking", "bode", "moduli", "nyquist", "residuals", "q_posteriors"]
     for name in comparison.ranking:
         expected += [f"corner_{name}", f"trace_{name}"]
     assert list(written) == expected
@@ -403,7 +457,7 @@ def test_write_figures_single_structure_and_formats(comparison, tmp_path):
     single = replace(comparison, results=(comparison["zener-int"],))
     written = write_figures(single, tmp_path, formats=("png", "svg"))
     # No free order: no q figure.
-    assert list(written) == ["ranking", "bode", "nyquist", "residuals", "corner_zener-int",
+    assert list(written) == ["ranking", "bode", "moduli", "nyquist", "residuals", "corner_zener-int",
                              "trace_zener-int"]
     assert all([p.suffix for p in paths] == [".png", ".svg"] for paths in written.values())
     with pytest.raises(InputError, match="'formats'.*'xyz'"):
@@ -504,6 +558,8 @@ def test_density_1d_equals_the_reflected_kernel_sum_everywhere(draws):
     (["voigt", "zener", "maxwell"], 3),
     (["maxwell (misfits)", "fractional_zener_sl (misfits)", "fractional_maxwell_gel (misfits)",
       "fractional_maxwell_liquid (misfits)", "fractional_kelvin_voigt (misfits)"], None),
+    # The demo's: three columns would hold 2, 1, 1 entries, the first two of them long.
+    (["fractional_kelvin_voigt (small misfit)", "zener (misfits)", "voigt (misfits)"], None),
 ])
 def test_the_response_legend_stays_inside_the_figure(names, columns):
     """Long structure names take fewer legend columns instead of running past the figure's

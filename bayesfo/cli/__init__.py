@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 import warnings
 
@@ -93,6 +94,21 @@ def _stdout_gone() -> bool:
         return False
 
 
+def _negative_blocks(argv) -> list[str]:
+    """``--block -40C`` as ``--block=-40C``: argparse takes a value that starts with '-' and is
+    not a number for an option, and a temperature below zero is a natural block."""
+    argv = [str(a) for a in argv]
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] == "--block" and i + 1 < len(argv) and re.match(r"-[0-9.]", argv[i + 1]):
+            out.append(f"--block={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(argv[i])
+        i += 1
+    return out
+
+
 def main(argv=None) -> int:
     """Run the command line; returns the exit status."""
     import signal
@@ -107,7 +123,7 @@ def main(argv=None) -> int:
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
-        args = parser.parse_args(argv)
+        args = parser.parse_args(_negative_blocks(sys.argv[1:] if argv is None else argv))
         if args.command is None:
             parser.print_help()
             return 2

@@ -33,7 +33,8 @@ def add_data_options(p):
                         "(temperature=)")
     p.add_argument("--block", default=None, metavar="N|LABEL",
                    help="for a file of several data sets (steps, intervals, isotherms): which "
-                        "one, by number from 1, label or temperature (\"20 °C\"; bayesfo "
+                        "one, by number from 1 (\"#20\" where a bare 20 could also be a "
+                        "temperature), label or temperature (\"20 °C\", -40C; bayesfo "
                         "inspect lists them)")
     p.add_argument("--delimiter", default=None, choices=(",", ";", "tab", "space"),
                    help="cell delimiter (default: sniffed)")

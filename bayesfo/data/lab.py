@@ -160,7 +160,29 @@ def _quoted(text: str) -> str | None:
 
 
 def select(sets: list[Isotherm], block: int | str, where: str) -> Isotherm:
-    """The data set ``block`` (number from 1, or label) of :func:`read_isotherms`' result."""
+    """The data set ``block`` (number from 1, or label) of :func:`read_isotherms`' result.
+
+    A bare number given as text (``--block 20``) on a file whose data sets have temperatures
+    is refused where a data set is at that temperature too: the number and the temperature
+    would name different sets. ``"#20"`` is the 20th set, ``"20 °C"`` the one at 20 °C."""
+    if isinstance(block, str) and re.fullmatch(r"#\s*[0-9]+", block.strip()):
+        block = int(block.strip()[1:])
+    if isinstance(block, str) and block.strip().isdigit() and not any(
+            s.label == block for s in sets):
+        at = [s for s in sets if s.temperature is not None
+              and abs(s.temperature - float(block)) <= 0.5]
+        k = int(block)
+        if at and not (1 <= k <= len(sets) and sets[k - 1] is at[0]):
+            number = (f"data set {k} is at {sets[k - 1].temperature:g} °C"
+                      if 1 <= k <= len(sets) and sets[k - 1].temperature is not None
+                      else f"there is no data set {k}" if not 1 <= k <= len(sets)
+                      else f"data set {k} is {sets[k - 1].label}")
+            text = (f"{where}: block {block.strip()} is ambiguous: {number}, and a data set "
+                    f"is at {at[0].temperature:g} °C; give ")
+            raise InputError(f"{text}block='{block.strip()} °C' for the temperature or "
+                             f"block={k} (an int) for the number",
+                             command_line=f'{text}--block "{block.strip()} °C" for the '
+                                          f'temperature or --block "#{k}" for the number')
     if isinstance(block, (int, np.integer)) or (isinstance(block, str) and block.isdigit()
                                                and not any(s.label == block for s in sets)):
         k = int(block)

@@ -404,22 +404,43 @@ def get_structure(name: str, library: dict[str, Structure] | None = None) -> Str
     """The structure called ``name`` (e.g. ``"zener"``, ``"max-n2m1"``, ``"zener-inv-int"``)
     or one of its aliases (``"fractional_kelvin_voigt"``, ``"fzss"``)."""
     library = default_library() if library is None else library
-    if name in library:
-        return library[name]
-    found = library.lookup(name) if isinstance(library, Library) and isinstance(name, str) else None
+    found = _find(name, library)
     if found is not None:
         return found[0]
     raise StructureError(
-        f"unknown structure {show(str(name))}; known structures: "
+        f"unknown structure {show(str(name))}{_did_you_mean(name, library)}; known structures: "
         f"{', '.join(_short_list(library))}"
     )
+
+
+def _find(name, library) -> tuple[Structure, str | None] | None:
+    """``(structure, picture)`` for ``name`` as given, else in lower case with ``_`` for
+    spaces (``Voigt``, ``Fractional Kelvin Voigt``); None where neither names one."""
+    if not isinstance(name, str):
+        return None
+    for candidate in dict.fromkeys((name, name.strip().lower().replace(" ", "_"))):
+        if candidate in library:
+            return library[candidate], None
+        found = library.lookup(candidate) if isinstance(library, Library) else None
+        if found is not None:
+            return found
+    return None
+
+
+def _did_you_mean(name, library) -> str:
+    """``" (did you mean 'zener'?)"`` for the closest known names, or an empty string."""
+    import difflib
+
+    known = list(library) + list(getattr(library, "aliases", {}))
+    close = difflib.get_close_matches(str(name).strip().lower(), known, n=3, cutoff=0.6)
+    return f" (did you mean {' or '.join(show(c) for c in close)}?)" if close else ""
 
 
 def picture_for(name: str, library: dict[str, Structure] | None = None) -> str | None:
     """The picture an alias names (``"fractional_poynting_thomson"`` → the Poynting–Thomson
     picture of ``zener``), None for a structure's own name or an alias without a picture."""
     library = default_library() if library is None else library
-    found = library.lookup(name) if isinstance(library, Library) else None
+    found = _find(name, library)
     return None if found is None else found[1]
 
 
@@ -446,8 +467,8 @@ def resolve_structures(spec: str | list[str], library: dict[str, Structure] | No
         name = raw.strip()
         if not name:
             raise StructureError(f"empty structure name in {spec!r}")
-        m = re.fullmatch(r"max([0-9]+)(-inv)?(-int)?", name)
-        if name == "all":
+        m = re.fullmatch(r"max([0-9]+)(-inv)?(-int)?", name.lower())
+        if name.lower() == "all":
             chosen = list(library.values())
         elif m:
             limit, inv, integer = int(m.group(1)), bool(m.group(2)), bool(m.group(3))

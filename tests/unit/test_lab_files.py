@@ -577,6 +577,29 @@ def test_block_by_temperature_and_unicode_in_the_message(run_cli):
     assert 'the temperature (e.g. --block "20 °C")' in err and "block=" not in err
 
 
+def test_a_bare_number_that_is_also_a_temperature_is_refused(run_cli, tmp_path):
+    """On a file of isotherms, --block 30 could be the 30th set or the one at 30 °C: refused
+    where they differ, with both spellings; "#3" is the number, "30 °C" the temperature, and a
+    temperature below zero may follow --block without '='."""
+    rows = ["omega,G',G'',T"]
+    for t, g in ((-5, 10.0), (2, 5.0), (30, 1.0)):
+        rows += [f"{w},{g * w},{g * w / 2},{t}" for w in (0.1, 1.0, 10.0)]
+    path = tmp_path / "isotherms.csv"
+    path.write_text("\n".join(rows) + "\n")
+    # The second set is the one at 2 °C: both readings agree, nothing to refuse.
+    status, out, _ = run_cli("inspect", path, "--block", "2", "--json")
+    assert status == 0 and json.loads(out)["temperature_C"] == 2.0
+    with pytest.raises(InputError, match=r"block 30 is ambiguous: there is no data set 30, and "
+                                         r"a data set is at 30 °C; give block='30 °C'"):
+        read(path, block="30")
+    status, _, err = run_cli("inspect", path, "--block", "30")
+    assert status == 2 and '--block "30 °C" for the temperature or --block "#30"' in err
+    for block, temperature in (("#3", 30.0), ("30 °C", 30.0), ("-5C", -5.0), ("1", -5.0)):
+        status, out, err = run_cli("inspect", path, "--block", block, "--json")
+        assert status == 0 and json.loads(out)["temperature_C"] == temperature, (block, err)
+    assert read(path, block=3).n_frequencies == 3  # an int is the number
+
+
 def test_several_data_sets_are_refused_in_the_words_of_the_caller(run_cli):
     """The command line names --block and --columns only; the API names block= and columns=."""
     path = LAB / "trios_steps.csv"

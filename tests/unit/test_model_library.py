@@ -517,3 +517,18 @@ def test_every_fractional_structure_reports_an_order():
     assert order_parameter(get_structure("fractional_maxwell_gel").param_names) == "alpha"
     assert order_parameter(get_structure("maxwell").param_names) == "beta"
     assert order_parameter(get_structure("max-n2m1").param_names) == "q"
+
+
+def test_structure_names_ignore_case_and_unknown_ones_get_the_closest():
+    from bayesfo.structures import resolve_structures
+
+    names = [s.name for s in resolve_structures("Voigt, ZENER,Fractional Kelvin Voigt,MAX1")]
+    assert names == ["voigt", "zener", "fractional_kelvin_voigt", "max-n1m0", "max-n1m1"]
+    assert [s.name for s in resolve_structures("ALL")] == [s.name for s in resolve_structures("all")]
+    with pytest.raises(StructureError, match=r"unknown structure 'vogit' \(did you mean 'voigt'\?\)"):
+        get_structure("vogit")
+    with pytest.raises(StructureError, match=r"'zenr' \(did you mean 'zener'"):
+        resolve_structures("voigt,zenr")
+    with pytest.raises(StructureError) as info:
+        get_structure("xyz")
+    assert "did you mean" not in str(info.value)

@@ -52,11 +52,12 @@ def _strength(d: float) -> str:
     return next(label for bound, label in EVIDENCE_SCALE if d < bound)
 
 
-def _order(result):
-    from .comparison.table import order_parameter
+def _orders(result) -> list:
+    """``(name, summary)`` of every fractional order of a result's posterior."""
+    from .comparison.table import order_parameters
 
-    p = order_parameter(result.posterior.param_names)
-    return p, (result.posterior.summary.get(p) if p else None)
+    summary = result.posterior.summary
+    return [(p, summary[p]) for p in order_parameters(summary)]
 
 
 def _digits(sd: float) -> int:
@@ -115,7 +116,8 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     Returns
     -------
     list of (str, bool)
-        Sentences in reading order; ``flagged`` marks cautions (no convergence, poorly
+        Sentences in reading order, whether the structures describe the data first, then the
+        evidence; ``flagged`` marks cautions (no convergence, poorly
         determined order, parameters the data do not determine, an evidence difference within
         its error).
     """
@@ -128,6 +130,9 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     best = rows[0]
     name = best["structure"]
     result = comparison[name]
+    # Whether the structures describe the data comes first: a decisive ranking of structures
+    # that all misfit says only which misfits least.
+    out.extend(_adequacy_sentences(comparison, rows))
     if best["log_evidence"] is None:
         out.append((f"No structure has a log-evidence; ranked by PSIS-LOO, {name} comes first.",
                     True))
@@ -153,7 +158,6 @@ def verdict(comparison) -> list[tuple[str, bool]]:
             if d < 2 * err:
                 out.append((f"The difference from {second['structure']} is within twice its "
                             "estimation error: the evidence does not separate the two.", True))
-    out.extend(_adequacy_sentences(comparison, rows))
     if len(rows) > 1:
         agree = [c for c in CRITERIA_NAMES if best.get(f"rank_{c}") == 1]
         disagree = {}
@@ -170,26 +174,33 @@ def verdict(comparison) -> list[tuple[str, bool]]:
             lead = (f"{_join([CRITERIA_NAMES[c] for c in agree])} also rank {name} first, but "
                     if agree else "The information criteria disagree with the evidence: ")
             out.append((lead + "; ".join(parts) + ".", False))
-    p, s = _order(result)
-    if s is not None:
-        sym = ORDER_SYMBOLS.get(p, p)
-        digits = _digits(s.sd)
-        text = (f"The fractional order of {name} is {sym} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
-                f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f}).")
-        if s.poorly_determined:
-            out.append((text + f" {sym} is poorly determined: its {HDI_PERCENT} % HDI covers "
-                        "more than half of the prior range.", True))
+    orders = _orders(result)
+    if orders:
+        values = []
+        for p, s in orders:
+            digits = _digits(s.sd)
+            values.append(f"{ORDER_SYMBOLS[p]} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
+                          f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f})")
+        text = (f"The fractional order{'s' if len(orders) > 1 else ''} of {name} "
+                f"{'are' if len(orders) > 1 else 'is'} {_join(values)}.")
+        poor = [ORDER_SYMBOLS[p] for p, s in orders if s.poorly_determined]
+        if poor:
+            out.append((text + f" {_join(poor)} {'is' if len(poor) == 1 else 'are'} poorly "
+                        f"determined: {'its' if len(poor) == 1 else 'their'} {HDI_PERCENT} % "
+                        "HDI covers more than half of the prior range.", True))
         else:
             out.append((text, False))
-        if s.multimodal:
-            out.append((f"The posterior of {sym} has several separated modes.", True))
+        for p, s in orders:
+            if s.multimodal:
+                out.append((f"The posterior of {ORDER_SYMBOLS[p]} has several separated modes.",
+                            True))
     elif result.structure.integer:
         out.append((f"{name} is an integer-order structure (its exponents are fixed at 1).",
                     False))
-    out.extend(_physical_sentence(name, result, skip=p))
+    out.extend(_physical_sentence(name, result, skip={p for p, _ in orders}))
     out.extend(_noise_sentences(name, result))
     poor = [r["structure"] for r in rows[1:]
-            if (o := _order(comparison[r["structure"]]))[1] is not None and o[1].poorly_determined]
+            if any(s.poorly_determined for _, s in _orders(comparison[r["structure"]]))]
     if poor:
         out.append(("The fractional order is poorly determined (HDI wider than half the prior "
                     f"range) for: {', '.join(poor)}.", True))
@@ -247,7 +258,7 @@ def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
         return []
     parts, vague = [], []
     for p, s in phys["physical"].items():
-        if p == skip:
+        if skip is not None and p in skip:
             continue
         if s.get("not_determined"):  # before the value: an undefined median is named too
             vague.append(f"{p} ({s['not_determined_reason']})")

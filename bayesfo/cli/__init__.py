@@ -54,8 +54,35 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Warnings of one kind that several structures raise, held and said once at the end of the
+#: command (one line naming the structures) instead of once per structure.
+_PARETO = re.compile(r"(?P<name>.+?): Pareto k up to (?P<k>[0-9.]+) at (?P<where>.+); "
+                     r"PSIS-LOO is unreliable there")
+_held: list = []
+
+
 def _one_line_warning(message, category, filename, lineno, file=None, line=None):
-    print(f"bayesfo: warning: {message}", file=sys.stderr)
+    text = str(message)
+    match = _PARETO.fullmatch(text)
+    if match:
+        _held.append(match)
+        return
+    print(f"bayesfo: warning: {text}", file=sys.stderr)
+
+
+def _held_warnings() -> None:
+    """Print the held warnings, one line per kind: a single structure's as it was raised."""
+    if not _held:
+        return
+    if len(_held) == 1:
+        print(f"bayesfo: warning: {_held[0].string}", file=sys.stderr)
+    else:
+        parts = [f"{m['name']} ({m['k']} at {m['where'].removeprefix('omega = ')})"
+                 for m in _held]
+        print("bayesfo: warning: PSIS-LOO is unreliable (Pareto k above 0.7) at some "
+              f"frequencies for {', '.join(parts)}; elpd_loo of these structures is rough",
+              file=sys.stderr)
+    _held.clear()
 
 
 class Terminated(BaseException):
@@ -129,7 +156,11 @@ def main(argv=None) -> int:
             return 2
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.showwarning = _one_line_warning
-            status = importlib.import_module(f"{__name__}.{args.command}").run(args)
+            _held.clear()
+            try:
+                status = importlib.import_module(f"{__name__}.{args.command}").run(args)
+            finally:
+                _held_warnings()
         sys.stdout.flush()  # a closed pipe shows here, not at the interpreter's exit
         return status
     except BrokenPipeError as exc:

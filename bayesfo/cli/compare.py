@@ -220,13 +220,16 @@ def run(args) -> int:
               "predictive checks pass (small: a systematic misfit within 2° and 3.5 %; partly: "
               "pass, but the fitted noise swamps points the fit misses)")
         width = max([16] + [len(row['structure']) for row in result.table()])
+        means = {row["structure"]: _order_means(row) for row in result.table()}
+        o_width = max([13] + [len(v) for v in means.values()])
         print(f"{'#':>2} {'structure':<{width}} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
-              f"{'elpd_loo':>10} {'BIC':>10} {'q (sd)':>16} {'R-hat':>6} {'ok':>3} {'fits':>6}")
+              f"{'elpd_loo':>10} {'BIC':>10} {'orders (mean)':>{o_width}} {'R-hat':>6} "
+              f"{'ok':>3} {'fits':>6}")
         for row in result.table():
             if row.get("error"):
                 print(f"{'-':>2} {row['structure']:<{width}} {row['n_params']:>2}  skipped: {row['error']}")
                 continue
-            q = "" if row["q_mean"] is None else f"{row['q_mean']:.3f} ({row['q_sd']:.3f})"
+            q = means[row["structure"]]
             if row["log_evidence"] is None:
                 z = dz = p = "-"
             else:
@@ -235,23 +238,27 @@ def run(args) -> int:
                 dz = f"{row['delta_log_evidence']:.2f}"
                 p = f"{row['posterior_probability']:.3f}"
             print(f"{row['rank']:>2} {row['structure']:<{width}} {row['n_params']:>2} {z:>18} {dz:>8} "
-                  f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>16} "
+                  f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>{o_width}} "
                   f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3} "
                   f"{(row['fits'] or '-').replace('no', 'NO'):>6}")
         _print_undetermined(result)
         pairs = result.baselines()
         if pairs:
-            print("integer baselines (q = 1) against their fractional parents:")
+            print("integer baselines (every fractional order = 1) against their fractional "
+                  "parents:")
             for b in pairs:
                 if b["delta_log_evidence"] is None:
                     continue
                 d = b["delta_log_evidence"]
                 verdict = "fractional order favoured" if d > 0 else "integer order favoured"
                 hdi = ""
-                if b["order"] is not None:
-                    lo, hi = b["order_hdi"]
-                    hdi = (f"; {b['order']} of {b['parent']} in [{lo:.3f}, {hi:.3f}] (94 % HDI"
-                           f"{', includes 1' if b['order_hdi_includes_1'] else ''})")
+                if b["orders"]:
+                    parts = [f"{o['symbol']} in [{o['hdi'][0]:.3f}, {o['hdi'][1]:.3f}]"
+                             for o in b["orders"]]
+                    parts[0] = parts[0].replace(" in ", f" of {b['parent']} in ", 1)
+                    ones = [o["symbol"] for o in b["orders"] if o["hdi_includes_1"]]
+                    hdi = (f"; {', '.join(parts)} (94 % HDI"
+                           f"{'; includes 1: ' + ', '.join(ones) if ones else ''})")
                 print(f"   {b['parent']:<14} vs {b['baseline']:<16} ln Z difference "
                       f"{d:+9.2f} ± {b['delta_log_evidence_err']:.2f}: {verdict}{hdi}")
         if result.holdout is not None:
@@ -266,3 +273,9 @@ def run(args) -> int:
             print(f"report: {out / 'report.html'} (figures in {out / 'figures'}; summary.json, "
                   "ranking.csv and one NetCDF per structure beside it)")
     return 0
+
+
+def _order_means(row: dict) -> str:
+    """The posterior means of every fractional order of a ranking row, by symbol
+    (``"α 0.589 β 0.128"``), from its ``orders`` cell."""
+    return " ".join(part.split(" [")[0] for part in (row.get("orders") or "").split("; ") if part)

@@ -25,7 +25,13 @@ from .parameters import (  # noqa: F401  (re-exported: the names results offered
     summarise_draws,
     with_determination,
 )
-from .table import RANKING_FIELDS, order_parameter, ranking_rows  # noqa: F401  (re-exported)
+from .table import (  # noqa: F401  (re-exported)
+    ORDER_SYMBOLS,
+    RANKING_FIELDS,
+    order_parameter,
+    order_parameters,
+    ranking_rows,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -442,7 +448,9 @@ class Comparison:
         parent minus the baseline's; > 0 favours the fractional order), ``bayes_factor`` (parent
         over baseline), the parent's posterior order ``order`` (``q``, or ``beta`` for the
         Maxwell) with ``order_mean``, ``order_hdi`` (94 %) and ``order_hdi_includes_1``: whether
-        q = 1, the baseline, is inside the parent's HDI.
+        q = 1, the baseline, is inside the parent's HDI; and ``orders``, the same for every
+        order the baseline fixes at 1 (``name``, ``symbol``, ``mean``, ``hdi``,
+        ``hdi_includes_1``).
         """
         done = {r.name: r for r in self.results if r.error is None}
         out = []
@@ -453,12 +461,19 @@ class Comparison:
             p = done[parent]
             ev_p, ev_b = p.criteria.get("evidence"), r.criteria.get("evidence")
             d = None if ev_p is None or ev_b is None else ev_p.log_z - ev_b.log_z
-            order = next((k for k in ("q", "beta") if k in p.posterior.summary), None)
+            # Every order the baseline fixes at 1 (the Maxwell's α and β), the first as before.
+            fixed = [k for k in order_parameters(p.posterior.summary) if k in r.structure.fixed]
+            order = next((k for k in ("q", "beta") if k in fixed), fixed[0] if fixed else None)
             row = {"parent": parent, "baseline": r.name, "delta_log_evidence": d,
                    "delta_log_evidence_err": None if d is None
                    else math.hypot(ev_p.log_z_err, ev_b.log_z_err),
                    "bayes_factor": None if d is None else math.exp(min(d, 700.0)),
-                   "order": order}
+                   "order": order, "orders": []}
+            for k in fixed:
+                o = p.posterior.summary[k]
+                row["orders"].append({"name": k, "symbol": ORDER_SYMBOLS[k], "mean": o.mean,
+                                      "hdi": [o.hdi_low, o.hdi_high],
+                                      "hdi_includes_1": bool(o.hdi_low <= 1.0 <= o.hdi_high)})
             if order is not None:
                 o = p.posterior.summary[order]
                 row.update(order_mean=o.mean, order_hdi=[o.hdi_low, o.hdi_high],

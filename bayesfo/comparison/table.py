@@ -14,14 +14,37 @@ from .parameters import flagged_names, natural_block, physical_text
 #: of two springpots in parallel); ``alpha`` (the one springpot of the fractional Maxwell gel
 #: and liquid, the Zener solid–liquid and the springpot itself).
 ORDER_PARAMS = ("q", "beta", "alpha")
-#: Their symbols in text.
-ORDER_SYMBOLS = {"q": "q", "beta": "β", "alpha": "α"}
+#: The symbols in text of every parameter that is a fractional order (the cards' exponents).
+ORDER_SYMBOLS = {"q": "q", "alpha": "α", "beta": "β", "delta": "δ", "kappa": "κ", "gamma": "γ"}
 
 
 def order_parameter(parameters) -> str | None:
     """The name of the fractional order among ``parameters`` (names or a dict by name), the
     first of :data:`ORDER_PARAMS` present, else None."""
     return next((k for k in ORDER_PARAMS if k in parameters), None)
+
+
+def order_parameters(parameters) -> list[str]:
+    """Every fractional order among ``parameters`` (names or a dict by name), in their order:
+    a two-springpot model has two (α and β), the Zener liquid–liquid three."""
+    return [k for k in parameters if k in ORDER_SYMBOLS]
+
+
+def orders_text(parameters: dict, digits: int = 3) -> str:
+    """Every fractional order of a structure record's ``parameters`` (``summary.json`` form)
+    by its symbol, as the posterior mean and 94 % HDI: ``"α 0.589 [0.586, 0.592]; β 0.128
+    [0.121, 0.135]"``; empty where the structure has none."""
+    parts = []
+    for k in order_parameters(parameters):
+        p = parameters[k] or {}
+        mean, lo, hi = p.get("mean"), p.get("hdi_low"), p.get("hdi_high")
+        if mean is None:
+            continue
+        text = f"{ORDER_SYMBOLS[k]} {mean:.{digits}f}"
+        if lo is not None and hi is not None:
+            text += f" [{lo:.{digits}f}, {hi:.{digits}f}]"
+        parts.append(text)
+    return "; ".join(parts)
 
 
 def _finite_or_none(value) -> bool:
@@ -111,6 +134,8 @@ def ranking_rows(structures, ranking) -> list[dict]:
             "error": "",
             # Posterior medians of the physical parameters, with units, as one text cell.
             "physical_parameters": physical_text(s.get("parameters_physical")),
+            # Every fractional order by its symbol (q_mean and q_sd hold only the first).
+            "orders": "" if s.get("integer") else orders_text(natural_block(s)),
             # The parameters (in the form natural to the data) that the data do not determine,
             # and those whose HDI covers more than half of their prior range.
             "not_determined": "; ".join(flagged_names(natural_block(s))),
@@ -128,5 +153,5 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
                   "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
                   "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se",
-                  "not_determined", "poorly_determined")
+                  "not_determined", "poorly_determined", "orders")
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import warnings
 import json
 from pathlib import Path
 
@@ -72,6 +73,8 @@ def test_summary_contract_and_files(voigt_comparison):
     assert pair["delta_log_evidence"] == pytest.approx(z["voigt"] - z["voigt-int"])
     assert pair["delta_log_evidence"] > 10 and not pair["order_hdi_includes_1"]
     assert pair["order_hdi"] == [q["hdi_low"], q["hdi_high"]]
+    assert pair["orders"] == [{"name": "q", "symbol": "q", "mean": q["mean"],
+                               "hdi": [q["hdi_low"], q["hdi_high"]], "hdi_includes_1": False}]
     with (out / "ranking.csv").open() as fh:
         rows = list(csv.DictReader(fh))
     assert [r["structure"] for r in rows] == summary["ranking"]
@@ -341,3 +344,39 @@ def test_ranking_figure_names_the_structures_that_misfit(voigt_comparison):
     assert labels["voigt-int"].endswith("misfits the data")
     assert labels["voigt"] == "voigt" and labels["zener"] == "zener"
     assert list(drawn.values["fits"]) == [result[n].fits for n in result.ranking]
+
+
+def test_every_order_of_a_two_springpot_model_is_named(tmp_path):
+    """The Maxwell card has two orders (α, β; in its physical form the springpots' β and
+    δ = β − α): the baseline line names both, and ranking.csv's orders cell gives every order
+    of the physical form with its mean and 94 % HDI."""
+    from bayesfo.comparison.table import orders_text, ranking_rows
+
+    rng = np.random.default_rng(3)
+    w = np.logspace(-2, 2, 25)
+    g = get_structure("maxwell").response([1.0, 0.5, 0.3, 0.8], w, "compliance")
+    sd = 0.02 * np.abs(g)
+    data = FrequencyResponse(w, g + sd / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25)),
+                             sd, kind="compliance")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = compare(data, resolve_structures("maxwell,maxwell-int"), seed=0, progress=False,
+                         noise="known")
+    (pair,) = result.baselines()
+    summary = result["maxwell"].posterior.summary
+    assert [(o["name"], o["symbol"]) for o in pair["orders"]] == [("alpha", "α"), ("beta", "β")]
+    for o in pair["orders"]:
+        s = summary[o["name"]]
+        assert o["hdi"] == [s.hdi_low, s.hdi_high] and o["mean"] == s.mean
+    record = next(s for s in result.to_summary()["structures"] if s["name"] == "maxwell")
+    row = next(r for r in ranking_rows(result.to_summary()["structures"], result.ranking)
+               if r["structure"] == "maxwell")
+    block = record["parameters_physical"] if record["natural_form"] == "physical" \
+        else record["parameters"]
+    assert row["orders"] == orders_text(block)
+    symbols = [part.split()[0] for part in row["orders"].split("; ")]
+    assert symbols == [{"alpha": "α", "beta": "β", "delta": "δ"}[k] for k in block
+                       if k in ("alpha", "beta", "delta")]
+    assert "δ" in symbols or record["natural_form"] != "physical"
+    d = block.get("delta") or block["beta"]
+    assert f"{d['mean']:.3f} [{d['hdi_low']:.3f}, {d['hdi_high']:.3f}]" in row["orders"]

@@ -63,3 +63,48 @@ def test_batch_example_runs(tmp_path):
                           capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "adhesive-batch" / "temperature_summary.csv").exists()
+
+
+def _demo_rows(text: str) -> dict:
+    """The ranking rows of the demo's terminal table, by structure: k, ln Z and its error, the
+    orders' means by symbol, ok and fits."""
+    rows = {}
+    for line in text.splitlines():
+        m = re.match(r"\s*(\d+) (\S+)\s+(\d+)\s+(-?[0-9.]+) ± ([0-9.]+)( L)?\s+(-?[0-9.]+)\s+"
+                     r"([0-9.]+)\s+(-?[0-9.]+)\s+(-?[0-9.]+)\s+(.*?)\s+(-|[0-9.]+) (yes|NO)\s+(\S+)$",
+                     line)
+        if m:
+            orders = dict(zip(m[11].split()[::2], map(float, m[11].split()[1::2]), strict=True))
+            rows[m[2]] = {"rank": int(m[1]), "k": int(m[3]), "log_z": float(m[4]),
+                          "err": float(m[5]), "orders": orders, "ok": m[13], "fits": m[14]}
+    return rows
+
+
+@pytest.mark.filterwarnings("always::bayesfo.errors.PredictiveWarning")
+def test_the_readme_demo_table_is_what_the_demo_prints(run_cli, tmp_path):
+    """The README shows the output of `make demo`: the same structures in the same order, with
+    the same ln Z (within three times its error), orders (within 0.005), certificates and fit
+    checks. Regenerate the README block from a run when this fails."""
+    makefile = (ROOT / "Makefile").read_text()
+    data = re.search(r"^DEMO_DATA \?= (\S+)", makefile, flags=re.M)[1]
+    structures = re.search(r"^DEMO_STRUCTURES \?= (\S+)", makefile, flags=re.M)[1]
+    status, out, err = run_cli("compare", ROOT / data, "--structures", structures,
+                               "--out", tmp_path / "demo", "--no-figures")
+    assert status == 0, err
+    shown = _demo_rows(re.search(r"```\n( # structure.*?)```", README, flags=re.S)[1])
+    ran = _demo_rows(out)
+    assert list(shown) == list(ran) and len(ran) == len(structures.split(","))
+    for name, row in ran.items():
+        want = shown[name]
+        assert (want["rank"], want["k"], want["ok"], want["fits"]) == \
+            (row["rank"], row["k"], row["ok"], row["fits"]), name
+        assert abs(want["log_z"] - row["log_z"]) <= 3 * max(want["err"], row["err"]) + 0.02, name
+        assert want["orders"].keys() == row["orders"].keys(), name
+        for symbol, mean in row["orders"].items():
+            assert abs(want["orders"][symbol] - mean) <= 0.005, (name, symbol)
+    # The baseline lines and the held warning are shown as printed.
+    for line in out.splitlines():
+        if " vs " in line and "ln Z difference" in line:
+            assert line.split(":")[0] in README, line
+    held = "bayesfo: warning: PSIS-LOO is unreliable (Pareto k above 0.7) at some frequencies"
+    assert held in README and err.count(held) == 1 and "Pareto k up to" not in err

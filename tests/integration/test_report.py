@@ -97,7 +97,11 @@ def test_verdict_names_the_structure_with_the_highest_evidence(comparison):
     best = max(z, key=z.get)
     second = sorted(z, key=z.get)[-2]
     sentences = verdict(comparison)
-    first = sentences[0][0]
+    # Whether the structures fit comes first (the adequacy sentences, flagged where one
+    # misfits), then the evidence.
+    first = next(t for t, _ in sentences if "best-supported structure:" in t)
+    before = sentences[:[t for t, _ in sentences].index(first)]
+    assert all("describe" in t or "fit" in t for t, _ in before), before
     assert first.startswith(f"{best} is the best-supported structure")
     assert f"runner-up, {second}," in first
     assert f"Δln Z = {z[best] - z[second]:.2f}" in first

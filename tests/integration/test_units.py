@@ -155,7 +155,7 @@ def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_ru
     result, out = zener_run
     assert RANKING_FIELDS[: len(OLD_RANKING_FIELDS)] == OLD_RANKING_FIELDS
     assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == (
-        "physical_parameters", "delta_loo_se", "not_determined", "poorly_determined")
+        "physical_parameters", "delta_loo_se", "not_determined", "poorly_determined", "orders")
     with (out / "ranking.csv").open(newline="") as fh:
         (row,) = list(csv.DictReader(fh))
     text = row["physical_parameters"]
@@ -167,6 +167,9 @@ def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_ru
     for name, value in parts.items():
         assert float(value.split()[0]) == pytest.approx(phys[name]["median"], rel=1e-3)
     assert "," not in text  # one cell, readable without quoting
+    # Every fractional order by its symbol, mean and 94 % HDI (the Zener has one, q).
+    q = phys["q"]
+    assert row["orders"] == f"q {q['mean']:.3f} [{q['hdi_low']:.3f}, {q['hdi_high']:.3f}]"
 
 
 def test_units_follow_the_data_units():

@@ -18,8 +18,10 @@ def add_parser(subparsers):
                             "the master structure, in one posterior",
         description="Fit one master structure and every isotherm's shift log10 a_T jointly "
                     "(a certified posterior, as compare computes it), fit the WLF and "
-                    "Arrhenius laws to the shifts, and write summary.json, master.csv (the "
-                    "reduced data, which 'bayesfo compare' reads) and figures/mastercurve.png.")
+                    "Arrhenius laws to the shifts, test whether superposition holds (van "
+                    "Gurp–Palmen), and write summary.json, master.csv (the reduced data, which "
+                    "'bayesfo compare' reads), figures/mastercurve.png and "
+                    "figures/van_gurp_palmen.png.")
     p.add_argument("data", nargs="+", metavar="DATA",
                    help="files of isotherms: a lab export with several (TRIOS steps, a "
                         "temperature column, pyvisco), or one file per temperature (the "
@@ -36,7 +38,7 @@ def add_parser(subparsers):
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default bayesfo-mastercurve)")
-    p.add_argument("--no-figures", action="store_true", help="skip figures/mastercurve.png")
+    p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--json", action="store_true", help="print summary.json's shift block")
     return p
 
@@ -107,8 +109,15 @@ def run(args) -> int:
             from ..plotting.output import save_figure
 
             (stage / "figures").mkdir()
-            drawn = plot_mastercurve(mc)
-            save_figure(drawn.figure, stage / "figures" / "mastercurve.png")
+            import matplotlib.pyplot as plt
+
+            from ..plotting.mastercurve import plot_van_gurp_palmen
+
+            for name, plot in (("mastercurve", plot_mastercurve),
+                               ("van_gurp_palmen", plot_van_gurp_palmen)):
+                drawn = plot(mc)
+                save_figure(drawn.figure, stage / "figures" / f"{name}.png")
+                plt.close(drawn.figure)
     if args.json:
         print(json.dumps({k: summary[k] for k in ("shift_factors", "shift_law")}, indent=1,
                          ensure_ascii=False))
@@ -135,7 +144,13 @@ def _print(mc, out) -> None:
         text = ", ".join(f"{k} = {v['mean']:.4g} ± {v['sd']:.2g} {v['unit']}".rstrip()
                          for k, v in law["parameters"].items())
         print(f"{name:>10}: {text}; probability {law['probability']:.3f}")
+    from ..tts.validity import describe
+
+    vgp = mc.tts_checks.get("van_gurp_palmen")
+    if vgp is not None and vgp["valid"]:
+        print(describe(vgp))  # a failing or untested test is among the notes
     for n in mc.notes:
         print(f"note: {n}")
-    print(f"wrote {out}/summary.json, master.csv" + ("" if not (out / "figures").exists()
-                                                     else " and figures/mastercurve.png"))
+    print(f"wrote {out}/summary.json, master.csv" + (
+        "" if not (out / "figures").exists()
+        else " and figures/mastercurve.png, figures/van_gurp_palmen.png"))

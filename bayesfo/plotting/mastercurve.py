@@ -86,3 +86,51 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     ax.legend(loc="best", fontsize=7)
     values.update(temperature=temps, log10_aT_mean=mean, log10_aT_low=low, log10_aT_high=high)
     return Drawn.build(fig, axes, values, artists)
+
+
+def plot_van_gurp_palmen(mc, *, ax=None) -> Drawn:
+    """The van Gurp–Palmen plot: the loss angle δ against |G*| (or |J*|) of every isotherm,
+    coloured by temperature, without any shift (:mod:`bayesfo.tts.validity`). The isotherms of
+    a thermorheologically simple material fall on one curve; the pairs that the test finds
+    parting are named in the title.
+
+    Returns
+    -------
+    Drawn
+        Axes: (ax,). Values: per isotherm ``"<T>/magnitude"`` and ``"<T>/delta_deg"`` (sorted
+        by frequency). Artists: ``"<T>"`` (``Line2D``), ``"title"``.
+    """
+    import matplotlib as mpl
+
+    from ..tts.validity import loss_angle_deg
+    from ._base import axes_or_new
+    from .style import COLUMN_WIDTH, style
+
+    with style():
+        fig, ax = axes_or_new(ax, (COLUMN_WIDTH + 0.6, 3.2))
+        temps = np.asarray(mc.temperatures)
+        cmap = mpl.colormaps["coolwarm"]
+        norm = mpl.colors.Normalize(temps.min(), temps.max())
+        values, artists = {}, {}
+        for d, t in zip(mc.isotherms, temps, strict=True):
+            order = np.argsort(d.omega)
+            g = d.response[order]
+            mag, delta = np.abs(g), loss_angle_deg(g, d.kind)
+            values[f"{t:g}/magnitude"], values[f"{t:g}/delta_deg"] = mag, delta
+            (artists[f"{t:g}"],) = ax.plot(mag, delta, "o-", ms=2.5, lw=0.7,
+                                           color=cmap(norm(t)))
+        ax.set_xscale("log")
+        sym = "G" if mc.data.kind == "modulus" else "J"
+        unit = f" [{mc.data.units}]" if mc.data.units else ""
+        ax.set_xlabel(f"|{sym}*|{unit}")
+        ax.set_ylabel("loss angle δ [deg]")
+        fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, label="T [°C]")
+        check = mc.tts_checks.get("van_gurp_palmen") or {}
+        if check.get("valid") is False:
+            title = ("parting: " + ", ".join(f"{a:g}/{b:g} °C" for a, b in check["failing"]))
+        elif check.get("valid"):
+            title = "one curve: superposition holds"
+        else:
+            title = "no overlap in |G*|: not tested"
+        artists["title"] = ax.set_title(title, fontsize=8)
+    return Drawn.build(fig, (ax,), values, artists)

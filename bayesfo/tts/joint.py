@@ -13,7 +13,9 @@ Seeds: the shift between neighbouring isotherms that best overlays their log|G*|
 reduced, then a joint least-squares fit of everything.
 
 The shift laws, WLF and Arrhenius, are fitted to the posterior draws of the shifts
-(:mod:`bayesfo.tts.laws`).
+(:mod:`bayesfo.tts.laws`). Whether superposition holds at all is tested on the isotherms
+themselves, without a model (:mod:`bayesfo.tts.validity`), and each isotherm's residuals under
+the joint fit name those the master structure misses.
 """
 
 from __future__ import annotations
@@ -35,6 +37,9 @@ SHIFT_RANGE = 15.0
 #: A law whose χ²/dof against the shifts' posterior exceeds this misses them: a note says so
 #: (the 99.9 % point of χ²/dof for 5 degrees of freedom is 4.1).
 LAW_MISS = 4.0
+#: An isotherm whose relative residuals under the joint fit (rms) exceed this many times the
+#: median isotherm's is named as one the master structure misses.
+ISOTHERM_MISFIT = 3.0
 
 
 def shift_name(temperature: float) -> str:
@@ -350,6 +355,15 @@ class MasterCurve:
     isotherms: tuple = field(repr=False)
     notes: tuple[str, ...] = ()
     ranking: tuple = ()
+    tts_checks: dict = field(default_factory=dict)
+
+    @property
+    def tts_valid(self) -> bool | None:
+        """Whether superposition holds by the van Gurp–Palmen test of the isotherms
+        (:mod:`bayesfo.tts.validity`); None where no two neighbouring isotherms overlap in
+        |G*|."""
+        check = self.tts_checks.get("van_gurp_palmen")
+        return None if check is None else check["valid"]
 
     @property
     def log_shift_mean(self) -> np.ndarray:
@@ -401,7 +415,8 @@ class MasterCurve:
                                if not n.startswith("log10_aT_")},
                 "structures": list(self.ranking),
                 "shift_factors": self.shift_factors(), "shift_law": self.shift_law(),
-                "laws": self.laws, "notes": list(self.notes)}
+                "laws": self.laws, "tts_valid": self.tts_valid, "tts_checks": self.tts_checks,
+                "notes": list(self.notes)}
 
 
 def _num(x):
@@ -457,7 +472,20 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
                             if math.isfinite(fp[0].log_evidence) else np.inf))
     from dataclasses import replace
 
-    return replace(fits[best], ranking=ranking)
+    from .validity import describe, van_gurp_palmen
+
+    chosen = fits[best]
+    vgp = van_gurp_palmen(iso.data, iso.temperatures)
+    checks = {"van_gurp_palmen": vgp, "isotherm_fit": chosen.tts_checks["isotherm_fit"]}
+    notes = list(chosen.notes)
+    if vgp["valid"] is not True:
+        notes.append(describe(vgp))
+    misfit = checks["isotherm_fit"]["misfit"]
+    if misfit:
+        notes.append(f"the joint fit of {chosen.structure} misses the isotherm(s) at "
+                     f"{', '.join(f'{t:g}' for t in misfit)} °C: their relative residuals are "
+                     f"over {ISOTHERM_MISFIT:g} times the median isotherm's")
+    return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes))
 
 
 def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
@@ -522,6 +550,14 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
                      f"({'; '.join(post.messages)})")
     physical = np.asarray(post.samples)
     k = master.n_params
+    # Each isotherm's relative residual (rms over its points) at the posterior median.
+    fitted = lik.model(np.median(post.samples_scaled[:, :k_all], axis=0)[None, :])[0]
+    rel = np.abs(fitted - g) / np.abs(g)
+    rms = np.array([math.sqrt(float(np.mean(rel[iso.point_isotherm == i] ** 2)))
+                    for i in range(len(iso.data))])
+    isotherm_fit = {"temperatures": list(iso.temperatures), "rms_relative": rms.tolist(),
+                    "misfit": [t for t, r in zip(iso.temperatures, rms, strict=True)
+                               if r > ISOTHERM_MISFIT * np.median(rms)]}
     shift_draws = shifted.log_shifts(physical[:, :k_all])
     ev = found.evidence
     laws = _fit_laws(shift_draws, iso.temperatures, iso.reference, seed)
@@ -539,4 +575,4 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
         master_draws=physical[:, :k], posterior=post,
         log_evidence=math.nan if ev is None else ev.log_z,
         log_evidence_err=math.nan if ev is None else ev.log_z_err, laws=laws, data=joint,
-        isotherms=iso.data, notes=tuple(notes))
+        isotherms=iso.data, notes=tuple(notes), tts_checks={"isotherm_fit": isotherm_fit})

@@ -66,6 +66,11 @@ def test_shifts_and_the_wlf_law_are_recovered(wlf_case):
         p = law["parameters"][name]
         assert p["hdi_low"] <= value <= p["hdi_high"], (name, p)
     assert mc.laws["wlf"]["chi2_per_dof"] < 4 and not mc.notes
+    # One master curve: superposition holds by the van Gurp–Palmen test, and the joint fit
+    # misses no isotherm.
+    assert mc.tts_valid is True and mc.to_dict()["tts_valid"] is True
+    assert mc.tts_checks["isotherm_fit"]["misfit"] == []
+    assert max(mc.tts_checks["isotherm_fit"]["rms_relative"]) < 0.03  # 1 % noise
     # The master structure's parameters, in the reference isotherm's time scale.
     summary = mc.posterior.summary
     for name, value in zip(("a1", "b0", "b1", "q"), ZENER, strict=True):
@@ -145,6 +150,11 @@ def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
     master = bf.read(tmp_path / "mc" / "master.csv")  # a data set compare reads
     assert master.n_frequencies == sum(bf.read(f).n_frequencies for f in files)
     assert "log10 a_T" in out and "wlf:" in out
+    assert summary["tts_valid"] is True and "superposition holds by the van Gurp" in out
+    pairs = summary["tts_checks"]["van_gurp_palmen"]["pairs"]
+    assert [p["temperatures"] for p in pairs] == [[0.0, 10.0], [10.0, 20.0], [20.0, 30.0],
+                                                  [30.0, 40.0]]
+    assert all(p["tested"] and p["passes"] for p in pairs)
     status, _, err = run_cli("mastercurve", files[0], "--out", tmp_path / "one")
     assert status == 2 and "two or more isotherms, got 1" in err
 

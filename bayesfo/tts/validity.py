@@ -1,0 +1,131 @@
+"""Does time–temperature superposition hold? The van Gurp–Palmen test of the isotherms.
+
+A thermorheologically simple material has one master curve: every isotherm is the same function
+of reduced frequency, so the loss angle δ is one function of |G*| whatever the shift factors
+(van Gurp and Palmen 1998). Plotted as δ against |G*|, the isotherms of a simple material fall on
+one curve; where two relaxation processes shift with temperature by different laws, the curves of
+neighbouring isotherms part. The test needs no model and no shift: for each pair of neighbouring
+isotherms, δ of each is interpolated (linearly in log |G*|) at the other's points where their
+|G*| ranges overlap, and the mean difference is compared with
+
+* its standard error, from the scatter of each isotherm's δ about a smooth curve (second
+  differences along frequency: noise of sd s gives second differences of sd s√6; curvature only
+  adds to it, so the error is if anything too large and the test lenient), and
+* :data:`TOLERANCE_DEG`: a vertical (density) shift moves an isotherm along |G*| by a few
+  hundredths of a decade, which changes δ at a given |G*| by a fraction of a degree; the phase
+  accuracy of rheometers and DMA instruments is of the same order.
+
+A pair fails when its mean difference exceeds both three standard errors and the tolerance;
+superposition is judged valid when no tested pair fails. Pairs whose |G*| ranges do not overlap
+(or overlap in fewer than :data:`MIN_OVERLAP` points of either) are not tested, and the result
+says so: with no pair tested the test has no verdict (``None``).
+
+References
+----------
+M. van Gurp and J. Palmen (1998), Rheol. Bull. 67, 5–8; J. Dealy and D. Plazek (2009),
+Rheol. Bull. 78, 16–31 (time–temperature superposition, a users' guide).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: Difference of the loss angle at equal |G*| [deg] that a pair of isotherms may show before
+#: superposition is judged to fail (with three standard errors; see the module).
+TOLERANCE_DEG = 1.5
+#: Points of each isotherm inside the common |G*| range for a pair to be tested.
+MIN_OVERLAP = 2
+#: Standard errors a pair's mean difference must exceed to fail.
+Z_FAIL = 3.0
+
+
+def loss_angle_deg(response: np.ndarray, kind: str) -> np.ndarray:
+    """The loss angle δ [deg] of complex responses: arg G* for a modulus, −arg J* for a
+    compliance (J* = J′ − iJ″)."""
+    angle = np.degrees(np.angle(response))
+    return angle if kind == "modulus" else -angle
+
+
+def _curve(data) -> tuple[np.ndarray, np.ndarray, float]:
+    """log10 |G*| and δ [deg] of an isotherm sorted by |G*|, and the sd of its δ from the
+    second differences along frequency."""
+    order = np.argsort(data.omega)
+    g = data.response[order]
+    x, d = np.log10(np.abs(g)), loss_angle_deg(g, data.kind)
+    sd = float(np.std(np.diff(d, 2)) / math.sqrt(6.0)) if d.size >= 4 else math.nan
+    by_x = np.argsort(x)
+    return x[by_x], d[by_x], sd
+
+
+def van_gurp_palmen(isotherms, temperatures, *, tolerance_deg: float = TOLERANCE_DEG) -> dict:
+    """The van Gurp–Palmen test of neighbouring isotherms (see the module).
+
+    Parameters
+    ----------
+    isotherms : sequence of FrequencyResponse
+        Modulus or compliance data, in the order of ``temperatures``.
+    temperatures : sequence of float
+        [°C], ascending.
+    tolerance_deg : float
+
+    Returns
+    -------
+    dict
+        ``valid`` (True, False, or None where no pair could be tested), ``tolerance_deg``,
+        ``pairs``: per neighbouring pair ``temperatures``, ``tested``, and where tested
+        ``n_overlap`` (points compared), ``delta_deg`` (mean δ of the warmer minus the colder
+        isotherm at equal |G*|), ``se_deg``, ``passes``; ``failing``: the temperature pairs
+        that fail; ``untested``: those without overlap.
+    """
+    curves = [_curve(d) for d in isotherms]
+    pairs = []
+    for i in range(len(curves) - 1):
+        (xa, da, sa), (xb, db, sb) = curves[i], curves[i + 1]
+        lo, hi = max(xa.min(), xb.min()), min(xa.max(), xb.max())
+        in_a = (xa >= lo) & (xa <= hi)
+        in_b = (xb >= lo) & (xb <= hi)
+        pair = {"temperatures": [float(temperatures[i]), float(temperatures[i + 1])],
+                "tested": bool(hi > lo and in_a.sum() >= MIN_OVERLAP
+                               and in_b.sum() >= MIN_OVERLAP)}
+        if pair["tested"]:
+            # The warmer minus the colder isotherm, both ways round, at each one's own points.
+            diff = np.r_[db[in_b] - np.interp(xb[in_b], xa, da),
+                         np.interp(xa[in_a], xb, db) - da[in_a]]
+            n_a, n_b = int(in_a.sum()), int(in_b.sum())
+            # Each difference carries one point's noise of each curve (interpolation between
+            # two neighbours only lowers the other's): the mean's error from both sds.
+            se = math.sqrt((sa**2 + sb**2) / min(n_a, n_b)) if math.isfinite(sa + sb) else 0.0
+            delta = float(diff.mean())
+            pair.update(n_overlap=n_a + n_b, delta_deg=delta, se_deg=se,
+                        passes=bool(abs(delta) <= max(tolerance_deg, Z_FAIL * se)))
+        pairs.append(pair)
+    tested = [p for p in pairs if p["tested"]]
+    failing = [p["temperatures"] for p in tested if not p["passes"]]
+    return {"valid": None if not tested else not failing, "tolerance_deg": tolerance_deg,
+            "pairs": pairs, "failing": failing,
+            "untested": [p["temperatures"] for p in pairs if not p["tested"]]}
+
+
+def describe(check: dict) -> str:
+    """The test's result in words, for the terminal and the notes."""
+    if check["valid"] is None:
+        return ("the van Gurp–Palmen test could not be made: no two neighbouring isotherms "
+                "overlap in |G*|")
+    n = sum(p["tested"] for p in check["pairs"])
+    if check["valid"]:
+        text = (f"superposition holds by the van Gurp–Palmen test: the loss angles of all {n} "
+                f"tested pairs of neighbouring isotherms agree at equal |G*| (within "
+                f"{check['tolerance_deg']:g}° or three standard errors)")
+    else:
+        worst = max((p for p in check["pairs"] if p["tested"] and not p["passes"]),
+                    key=lambda p: abs(p["delta_deg"]))
+        where = "; ".join(f"{a:g}/{b:g} °C" for a, b in check["failing"])
+        text = (f"superposition fails the van Gurp–Palmen test: the loss angles of neighbouring "
+                f"isotherms part at equal |G*| ({where}; up to {worst['delta_deg']:+.1f}° ± "
+                f"{worst['se_deg']:.1f}°), so the material is not thermorheologically simple "
+                "there and shifted data mix processes that shift differently")
+    if check["untested"]:
+        text += (f"; {len(check['untested'])} pair(s) without overlap in |G*| were not tested")
+    return text

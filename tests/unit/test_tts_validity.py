@@ -1,0 +1,106 @@
+"""The van Gurp–Palmen test of time–temperature superposition: synthetic isotherms of a
+thermorheologically simple material (one relaxation process, one shift law) pass it; those of a
+complex one (two processes whose shifts follow different laws) fail it where the processes
+overlap in the window; isotherms without common |G*| are not tested."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from bayesfo.data import FrequencyResponse  # noqa: E402
+from bayesfo.tts import arrhenius, wlf  # noqa: E402
+from bayesfo.tts.validity import TOLERANCE_DEG, describe, loss_angle_deg, van_gurp_palmen  # noqa: E402
+
+W = np.logspace(-1, 2, 16)
+TEMPS = np.arange(0.0, 101.0, 10.0)
+
+
+def _maxwell(w, g, tau, alpha):
+    """A fractional Maxwell liquid: a spring g in series with a springpot of order alpha."""
+    s = (1j * w * tau) ** alpha
+    return g * s / (1 + s)
+
+
+def _isotherms(complex_: bool, seed: int, kind: str = "modulus", noise: float = 0.01):
+    """Two fractional Maxwell processes; in the complex material the slow one shifts by
+    Arrhenius (60 kJ/mol) instead of WLF (C1 8, C2 120 °C at 50 °C)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for t in TEMPS:
+        fast = wlf(t, 50.0, 8.0, 120.0)
+        slow = arrhenius(t, 50.0, 60e3) if complex_ else fast
+        g = _maxwell(W * 10**fast, 1e6, 0.01, 0.6) + _maxwell(W * 10**slow, 1e5, 10.0, 0.9)
+        g = g * (1 + noise / np.sqrt(2) * (rng.normal(size=W.size) + 1j * rng.normal(size=W.size)))
+        out.append(FrequencyResponse(W, g if kind == "modulus" else 1 / g, kind=kind))
+    return out
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_simple_material_passes(seed):
+    check = van_gurp_palmen(_isotherms(False, seed), TEMPS)
+    assert check["valid"] is True and check["failing"] == [] and check["untested"] == []
+    assert len(check["pairs"]) == len(TEMPS) - 1
+    for p in check["pairs"]:
+        # 1 % noise: the loss angles agree to a few tenths of a degree.
+        assert abs(p["delta_deg"]) < 0.8 and 0 < p["se_deg"] < 0.5
+    assert describe(check).startswith("superposition holds")
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_complex_material_fails_where_its_processes_shift_apart(seed):
+    check = van_gurp_palmen(_isotherms(True, seed), TEMPS)
+    assert check["valid"] is False
+    failing = {tuple(p) for p in check["failing"]}
+    # Near the laws' common reference (50 °C) the shifts differ little; between 40 and 80 °C
+    # the slow process has moved by a decade against the fast one and the curves part by 2°.
+    assert {(40.0, 50.0), (50.0, 60.0), (60.0, 70.0)} <= failing
+    assert (0.0, 10.0) not in failing
+    worst = max(abs(p["delta_deg"]) for p in check["pairs"])
+    assert worst > 1.5 * TOLERANCE_DEG
+    assert "fails the van Gurp–Palmen test" in describe(check) and "50/60 °C" in describe(check)
+
+
+def test_compliance_data_give_the_same_test():
+    """δ is the loss angle of a compliance too (−arg J*): the reciprocal data give the same
+    differences."""
+    mod = van_gurp_palmen(_isotherms(True, 0), TEMPS)
+    comp = van_gurp_palmen(_isotherms(True, 0, kind="compliance"), TEMPS)
+    assert comp["valid"] is False and comp["failing"] == mod["failing"]
+    for a, b in zip(mod["pairs"], comp["pairs"], strict=True):
+        assert b["delta_deg"] == pytest.approx(a["delta_deg"], abs=1e-9)
+    g = np.array([1.0 + 1.0j])
+    assert loss_angle_deg(g, "modulus") == pytest.approx(45.0)
+    assert loss_angle_deg(1 / g, "compliance") == pytest.approx(45.0)
+
+
+def test_isotherms_without_common_magnitude_are_not_tested():
+    low = FrequencyResponse(W, 1e3 * (1 + 0.5j) * W**0.1, kind="modulus")
+    high = FrequencyResponse(W, 1e6 * (1 + 0.5j) * W**0.1, kind="modulus")
+    check = van_gurp_palmen([low, high], [0.0, 10.0])
+    assert check["valid"] is None and check["untested"] == [[0.0, 10.0]]
+    assert "could not be made" in describe(check)
+
+
+def test_the_van_gurp_palmen_figure_draws_every_isotherm_unshifted():
+    from types import SimpleNamespace
+
+    from bayesfo.plotting.mastercurve import plot_van_gurp_palmen
+
+    data = _isotherms(True, 0)
+    check = van_gurp_palmen(data, TEMPS)
+    mc = SimpleNamespace(temperatures=tuple(TEMPS), isotherms=tuple(data), data=data[0],
+                         tts_checks={"van_gurp_palmen": check})
+    drawn = plot_van_gurp_palmen(mc)
+    for d, t in zip(data, TEMPS, strict=True):
+        line = drawn.artists[f"{t:g}"]
+        np.testing.assert_allclose(line.get_xdata(), np.abs(d.response))
+        np.testing.assert_allclose(line.get_ydata(), np.degrees(np.angle(d.response)))
+    assert drawn.artists["title"].get_text().startswith("parting: ")
+    import matplotlib.pyplot as plt
+
+    plt.close(drawn.figure)

@@ -21,7 +21,15 @@ import numpy as np
 
 from ..errors import InputError
 from ._base import Drawn, new_figure
-from ._compute import N_DRAWS, N_GRID, legend_name, omega_grid, quantiles, response_draws, select_results
+from ._compute import (
+    N_DRAWS,
+    N_GRID,
+    legend_name,
+    omega_grid,
+    quantiles,
+    response_draws,
+    select_results,
+)
 from ._legend import _legend, _note_artists
 from .response import DATA_STYLE, HOLDOUT_STYLE, OMEGA_LABEL, _band, _band_handle
 from .style import COLUMN_WIDTH, comparison_styles, unit_suffix

@@ -420,12 +420,14 @@ OUTLINE_FLOOR = 2e-3
 
 
 def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Drawn:
-    """Posterior density of the fractional order of every structure, one ridge per structure.
+    """Posterior density of every fractional order of every structure, one ridge per order.
 
-    Structures are ordered as in the ranking (best on top); the order is ``q``, else ``beta``
-    (the generalised Maxwell model), else ``alpha`` (the springpot models with one order; see
-    :func:`bayesfo.comparison.table.order_parameter`), named beside the structure; structures
-    without a free order (``-int``) are left out. Each
+    Structures are ordered as in the ranking (best on top); a structure's first order is
+    ``q``, else ``beta`` (the generalised Maxwell model), else ``alpha`` (see
+    :func:`bayesfo.comparison.table.order_parameter`), and its other orders (the second
+    springpot's α of the two-springpot models, κ of the Zener liquid–liquid) follow in rows
+    of their own, each named by its symbol; structures without a free order (``-int``) are left
+    out. Each
     ridge is a kernel density of the draws, reflected at the prior bounds, scaled to its own
     peak; the dashed line is the prior density on the same scale, so a ridge that is no higher
     than its prior line is as uncertain as the prior. The bar under a ridge is the 94 % HDI
@@ -451,7 +453,9 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
         ``values``: per structure ``"<name>/grid"``, ``"<name>/density"`` (unscaled: it
         integrates to one over the prior range), ``"<name>/prior_density"``, ``"<name>/hdi"``,
         ``"<name>/baseline"`` and, for a zoomed ridge, ``"<name>/zoom"`` (the inset's x
-        range); ``"structures"`` (names, top to bottom). ``artists``: ``"<name>/ridge"``
+        range), where ``<name>`` is the structure for its first order and
+        ``<structure>:<order>`` for the others (``"fractional_kelvin_voigt:alpha"``);
+        ``"structures"`` (these keys, top to bottom). ``artists``: ``"<name>/ridge"``
         (``PolyCollection``), ``"<name>/outline"``, ``"<name>/prior"``, ``"<name>/hdi"``
         (``Line2D``), ``"<name>/label"`` (``Text``) and for a zoomed ridge ``"<name>/inset"``
         (``Axes``), ``"<name>/inset_ridge"``, ``"<name>/inset_prior"``, ``"<name>/inset_hdi"``
@@ -464,14 +468,25 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     """
     from matplotlib.transforms import blended_transform_factory
 
-    results = [(r, order_parameter(r)) for r in ok_results(comparison)]
-    results = [(r, p) for r, p in results if p is not None]
+    from ..comparison.table import order_parameters
+
+    # One ridge per fractional order: a structure's first order (q, else β, else α) under its
+    # name, its other orders (the second springpot's) under "<name>:<order>".
+    results, keys = [], []
+    for r in ok_results(comparison):
+        first = order_parameter(r)
+        if first is None:
+            continue
+        names = r.posterior.param_names if r.posterior is not None else r.structure.param_names
+        for p in [first] + [k for k in order_parameters(names) if k != first]:
+            results.append((r, p))
+            keys.append(r.name if p == first else f"{r.name}:{p}")
     if not results:
         raise InputError("no structure of the comparison has a free fractional order "
                          "(q, beta or alpha)")
     styles = comparison_styles(comparison)
     n = len(results)
-    values, artists = {"structures": np.array([r.name for r, _ in results])}, {}
+    values, artists = {"structures": np.array(keys)}, {}
     rows = []
     for i, (r, p) in enumerate(results):
         post = r.posterior
@@ -490,26 +505,27 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
         fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 0.75 + row_height * n))
         text_at = blended_transform_factory(ax.transAxes, ax.transData)
         for i, (r, p, x, prior, _, grid, dens) in enumerate(rows):
+            key = keys[i]
             post = r.posterior
             pd = prior_density(prior, grid)
             peak = float(dens.max())
             base = float(n - 1 - i)
             s = post.summary[p]
-            values.update({f"{r.name}/grid": grid, f"{r.name}/density": dens,
-                           f"{r.name}/prior_density": pd, f"{r.name}/baseline": base,
-                           f"{r.name}/hdi": (s.hdi_low, s.hdi_high)})
+            values.update({f"{key}/grid": grid, f"{key}/density": dens,
+                           f"{key}/prior_density": pd, f"{key}/baseline": base,
+                           f"{key}/hdi": (s.hdi_low, s.hdi_high)})
             c = styles[r.name].color
             top = base + ridge_height * dens / peak
-            artists[f"{r.name}/ridge"] = ax.fill_between(grid, base, top, color=c, alpha=0.45,
+            artists[f"{key}/ridge"] = ax.fill_between(grid, base, top, color=c, alpha=0.45,
                                                          lw=0, zorder=2 + i)
             # The outline stops where the ridge meets its baseline, so that the dashed prior
             # line is not hidden under it.
             outline = np.where(dens / peak > OUTLINE_FLOOR, top, np.nan)
-            (artists[f"{r.name}/outline"],) = ax.plot(grid, outline, color=c, lw=0.9,
+            (artists[f"{key}/outline"],) = ax.plot(grid, outline, color=c, lw=0.9,
                                                       zorder=2 + i)
-            (artists[f"{r.name}/prior"],) = ax.plot(grid, base + ridge_height * pd / peak,
+            (artists[f"{key}/prior"],) = ax.plot(grid, base + ridge_height * pd / peak,
                                                     color="0.35", lw=0.7, ls="--", zorder=3 + i)
-            (artists[f"{r.name}/hdi"],) = ax.plot([s.hdi_low, s.hdi_high], [base, base], color=c,
+            (artists[f"{key}/hdi"],) = ax.plot([s.hdi_low, s.hdi_high], [base, base], color=c,
                                                   lw=2.6, solid_capstyle="butt", zorder=3 + i)
             ax.plot([s.mean, s.mean], [base - 0.1, base + 0.1], color="black", lw=0.9,
                     zorder=3 + i)
@@ -521,16 +537,17 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
                 label += "\npoorly determined"
             if not post.converged:
                 label += "\nnot converged"
-            artists[f"{r.name}/label"] = ax.text(
+            artists[f"{key}/label"] = ax.text(
                 1.02, base + 0.05, label, transform=text_at, fontsize=6.5, va="bottom",
                 color=FLAG_COLOR if s.poorly_determined or not post.converged else "black",
                 clip_on=False)
             if tight[i]:
-                insets.append(_zoom_inset(ax, r.name, s, grid, dens, pd, base, c,
+                insets.append(_zoom_inset(ax, key, s, grid, dens, pd, base, c,
                                           (x_lo, x_hi), ridge_height, values, artists))
         ax.set_yticks([n - 1 - i for i in range(n)],
-                      [r.name if p == "q" else f"{r.name} (${_ORDER_SYMBOLS.get(p, p)}$)"
-                       for r, p in results])
+                      [(r.name if key == r.name else "") + ("" if p == "q" else
+                                                            f" (${_ORDER_SYMBOLS.get(p, p)}$)")
+                       for (r, p), key in zip(results, keys, strict=True)])
         ax.set_ylim(-0.35, n - 1 + ridge_height + 0.25)
         ax.set_xlim(x_lo, x_hi)
         ax.grid(axis="y", visible=False)
@@ -543,7 +560,8 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
 
 
 #: Symbols of the fractional orders (:data:`bayesfo.comparison.table.ORDER_PARAMS`).
-_ORDER_SYMBOLS = {"q": "q", "beta": r"\beta", "alpha": r"\alpha"}
+_ORDER_SYMBOLS = {"q": "q", "beta": r"\beta", "alpha": r"\alpha", "delta": r"\delta",
+                  "kappa": r"\kappa", "gamma": r"\gamma"}
 
 #: The posterior's highest-density interval in the labels (as the summaries).
 HDI_LABEL = "94 % HDI"
@@ -558,7 +576,6 @@ def _hdi_digits(width: float) -> int:
 
 def _zoom_inset(ax, name, s, grid, dens, pd, base, color, span, ridge_height, values, artists):
     """An inset beside a spike-like ridge: the ridge zoomed to its HDI and surroundings."""
-    from matplotlib.ticker import MaxNLocator
     from matplotlib.transforms import blended_transform_factory
 
     x_lo, x_hi = span
@@ -586,13 +603,19 @@ def _zoom_inset(ax, name, s, grid, dens, pd, base, color, span, ridge_height, va
     prior_at = float(np.max(pd[inside])) if np.any(inside) else 0.0
     ratio = peak / prior_at if prior_at > 0 else np.inf
     note = ("prior ≈ 0" if not np.isfinite(ratio) else
-            f"prior\n÷ {ratio:.3g}" if ratio < 1e4 else f"prior\n÷ {ratio:.0e}")
+            f"peak\n{ratio:.3g}×\nprior" if ratio < 1e4 else f"peak\n{ratio:.0e}×\nprior")
     artists[f"{name}/inset_note"] = inset.text(0.03, 0.95, note, transform=inset.transAxes,
                                                fontsize=5.0, ha="left", va="top", color="0.25")
     inset.set_xlim(z_lo, z_hi)
     inset.set_ylim(-0.12, 1.08)
     inset.set_yticks([])
-    inset.xaxis.set_major_locator(MaxNLocator(nbins=2))
+    # Ticks at the HDI's ends, their labels pointing away from each other: two labels of a
+    # narrow inset otherwise run together ("0.5640.570").
+    digits = _hdi_digits(width)
+    inset.set_xticks([s.hdi_low, s.hdi_high],
+                     [f"{s.hdi_low:.{digits}f}", f"{s.hdi_high:.{digits}f}"])
+    for label, side in zip(inset.get_xticklabels(), ("right", "left"), strict=True):
+        label.set_horizontalalignment(side)
     inset.tick_params(axis="x", labelsize=5.5, length=2, pad=1)
     inset.grid(False)
     inset.patch.set_alpha(0.9)

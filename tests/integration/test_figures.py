@@ -572,3 +572,23 @@ def test_structures_that_misfit_are_marked_in_the_response_legends():
         shown += [t.get_text() for ax in drawn.figure.axes if ax.get_legend()
                   for t in ax.get_legend().get_texts()]
         assert [s for s in shown if s.split(" (")[0] in ("voigt", "zener", "maxwell")] == expected
+
+
+def test_every_order_of_a_two_springpot_model_gets_its_ridge():
+    """The two-springpot Kelvin–Voigt model has two orders: both are drawn, β (its first order)
+    under the structure's name and α in a row of its own, each density from its own draws."""
+    comp = _demo_comparison(("voigt",))
+    fkv = _result("fractional_kelvin_voigt", get_structure("fractional_kelvin_voigt"),
+                  [9.4e4, 7.1e4, 0.59, 0.14], rel_sd=0.05, n=600, seed=3)
+    comp = _Comparison(comp.data, (fkv, comp.results[0]))
+    drawn = plot_q_posteriors(comp)
+    assert list(drawn.values["structures"]) == ["fractional_kelvin_voigt",
+                                                "fractional_kelvin_voigt:alpha", "voigt"]
+    ticks = [t.get_text() for t in drawn.axes[0].get_yticklabels()]
+    assert ticks == ["fractional_kelvin_voigt ($\\beta$)", " ($\\alpha$)", "voigt"]
+    for key, column in (("fractional_kelvin_voigt", 3), ("fractional_kelvin_voigt:alpha", 2)):
+        s = fkv.posterior.summary[fkv.posterior.param_names[column]]
+        np.testing.assert_allclose(drawn.values[f"{key}/hdi"], (s.hdi_low, s.hdi_high))
+        grid, dens = drawn.values[f"{key}/grid"], drawn.values[f"{key}/density"]
+        mean = np.sum(grid * dens) / np.sum(dens)
+        assert mean == pytest.approx(fkv.posterior.samples[:, column].mean(), abs=0.01)

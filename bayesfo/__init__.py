@@ -8,7 +8,7 @@ evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optim
 → ``inference`` (likelihood, certified posteriors, diagnostics, evidence) → ``comparison`` (run,
 criteria, results, output files) and ``tts`` (master curves: one posterior of a master
 structure and the isotherms' shift factors) → ``predictions`` (material functions with credible
-bands) → ``report`` and ``plotting``. ``options`` checks the options
+bands) and ``planning`` (the frequencies to measure next) → ``report`` and ``plotting``. ``options`` checks the options
 of a comparison before any work; ``outdir`` keeps each output directory the output of one run;
 ``parallel`` runs worker processes; ``batch`` runs comparisons over many data sets; ``cli`` is
 the command line, one module per command. ``sine`` analyses one sine record and ``records``
@@ -44,7 +44,7 @@ from .structures import get_structure, list_structures, resolve_structures  # no
 _LAZY = {"compare": "comparison", "write_outputs": "comparison", "load": "comparison",
          "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison",
          "predict": "predictions", "Prediction": "predictions",
-         "mastercurve": "tts", "MasterCurve": "tts"}
+         "mastercurve": "tts", "MasterCurve": "tts", "design": "planning", "Design": "planning"}
 
 
 #: Subpackages reachable as attributes without an import of their own (``bf.plotting``), loaded
@@ -65,10 +65,12 @@ __all__ = [
     "BayesfoError",
     "Comparison",
     "Criteria",
+    "Design",
     "OutputError",
     "Prediction",
     "StructureResult",
     "compare",
+    "design",
     "load",
     "mastercurve",
     "predict",

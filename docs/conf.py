@@ -119,7 +119,8 @@ def escape_plain_text_bars(app, what, name, obj, options, lines):
 
 #: The packages of the API reference (docs/api/index.rst lists the same), in data-flow order.
 API_PACKAGES = ("bayesfo.data", "bayesfo.structures", "bayesfo.identify", "bayesfo.inference",
-                "bayesfo.comparison", "bayesfo.tts", "bayesfo.predictions", "bayesfo.verdict",
+                "bayesfo.comparison", "bayesfo.tts", "bayesfo.predictions", "bayesfo.planning",
+                "bayesfo.verdict",
                 "bayesfo.report", "bayesfo.plotting", "bayesfo.batch", "bayesfo.errors")
 
 

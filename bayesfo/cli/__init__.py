@@ -24,8 +24,8 @@ from ..errors import InputError, OutputError
 #: The commands, in the order of ``bayesfo --help``; each is the module ``bayesfo.cli.<name>``
 #: with ``add_parser(subparsers)`` and ``run(args) -> int``, imported when the parser is built
 #: (they import the computing modules only when they run).
-COMMANDS = ("inspect", "compare", "predict", "export", "mastercurve", "identify", "simulate",
-            "structures", "extract", "batch")
+COMMANDS = ("inspect", "compare", "predict", "export", "mastercurve", "design", "identify",
+            "simulate", "structures", "extract", "batch")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -15,6 +15,9 @@ Modules
     :func:`plot_bode`, :func:`plot_nyquist` (log-magnitude form for data over many decades),
     :func:`plot_residuals`: posterior response bands against the data; structures whose
     curves coincide are named in the legend.
+``design``
+    :func:`~bayesfo.plotting.design.plot_design`: the predictions over an instrument window
+    with the proposed frequencies (:func:`bayesfo.design`).
 ``moduli``
     :func:`plot_moduli`: storage and loss parts (G′, G″ or J′, J″) and tan δ with the
     posterior bands.

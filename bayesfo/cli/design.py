@@ -1,0 +1,105 @@
+"""``bayesfo design``: the frequencies to measure next to settle a comparison's model choice."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import InputError
+
+
+def add_parser(subparsers):
+    """Register ``bayesfo design``."""
+    p = subparsers.add_parser(
+        "design", help="where to measure next: the frequencies that would best tell the "
+                       "structures of a comparison apart",
+        description="Score candidate frequencies in the instrument window by the expected "
+                    "information about which structure is right (the mutual information "
+                    "between the structure and one more measurement, under each structure's "
+                    "posterior predictive and the current model probabilities), propose the "
+                    "best points, and state what they would do to the leading structures' log "
+                    "Bayes factor.")
+    p.add_argument("directory", metavar="DIR", help="output directory of bayesfo compare")
+    p.add_argument("--window", metavar="WMIN,WMAX", default=None,
+                   help="the instrument's frequency window [rad/s] (default: the data's, a "
+                        "decade wider on each side)")
+    p.add_argument("--points", type=int, default=3, metavar="N",
+                   help="how many frequencies to propose (default 3)")
+    p.add_argument("--structures", default=None, metavar="S,...",
+                   help="the structures to tell apart (default: those that could still win)")
+    p.add_argument("--cost", default="uniform", choices=("uniform", "low-frequency"),
+                   help="low-frequency: choose by information per second of measuring time "
+                        "(10 s plus three periods per point)")
+    p.add_argument("--figure", metavar="FILE.png", default=None,
+                   help="draw the predictions over the window with the proposed points")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--json", action="store_true", help="print the design as JSON")
+    return p
+
+
+def run(args) -> int:
+    from ..comparison import load
+    from ..options import parse_floats
+    from ..planning import design
+
+    window = None
+    if args.window is not None:
+        window = parse_floats(args.window, "--window")
+        if len(window) != 2:
+            raise InputError(f"--window takes WMIN,WMAX, got {args.window!r}")
+    figure = None
+    if args.figure is not None:
+        figure = Path(args.figure)
+        if figure.suffix.lower().lstrip(".") not in ("png", "pdf", "svg"):
+            raise InputError(f"--figure {args.figure}: give a .png, .pdf or .svg file name")
+        if not figure.parent.is_dir():
+            raise InputError(f"--figure {args.figure}: directory '{figure.parent}' does not "
+                             "exist")
+    result = load(args.directory, models=getattr(args, "models", ()) or ())
+    structures = None if args.structures is None else [
+        s.strip() for s in args.structures.split(",") if s.strip()]
+    try:
+        plan = design(result, window=window, points=args.points, structures=structures,
+                      cost=args.cost, seed=args.seed)
+    except InputError as exc:  # the API's words, in the command line's
+        raise InputError(str(exc).replace("argument 'window'", "--window")
+                         .replace("argument 'points'", "--points")) from None
+    if figure is not None:
+        import matplotlib.pyplot as plt
+
+        from ..plotting.design import plot_design
+        from ..plotting.output import save_figure
+
+        drawn = plot_design(result, plan, seed=args.seed)
+        save_figure(drawn.figure, figure)
+        plt.close(drawn.figure)
+    if args.json:
+        print(json.dumps(plan.to_dict(), indent=1))
+        return 0
+    _print(plan, figure)
+    return 0
+
+
+def _print(plan, figure) -> None:
+    names = ", ".join(f"{n} (P {p:.3f})" for n, p in zip(plan.structures, plan.probabilities,
+                                                           strict=True))
+    print(f"telling apart {names}: {plan.entropy:.3f} nats of information still missing")
+    print(f"window {plan.window[0]:.4g}-{plan.window[1]:.4g} rad/s; proposed measurements "
+          + ("(by information per second of measuring time)" if plan.cost == "low-frequency"
+             else "(by information)") + ":")
+    print(f"{'#':>3} {'omega [rad/s]':>14} {'gain [nats]':>12} {'total [nats]':>13} "
+          f"{'time [s]':>9}")
+    for i, p in enumerate(plan.proposed):
+        print(f"{i + 1:>3} {p['omega']:14.4g} {p['gain']:12.3f} {p['information']:13.3f} "
+              f"{p['seconds']:9.0f}")
+    total = plan.proposed[-1]["information"]
+    others = ", ".join(f"{k} {v:.3f}" for k, v in plan.alternatives.items())
+    print(f"as many points by rules of thumb give: {others} nats (proposed: {total:.3f})")
+    a, b = plan.leading
+    print(f"{a} against {b}: ln B now {plan.log_bayes_factor:+.2f}; expected change "
+          f"{plan.expected_change[a]:+.2f} if {a} is right, {plan.expected_change[b]:+.2f} if "
+          f"{b} is; decisive afterwards (|ln B| > 4.6) with probability {plan.p_decisive:.2f}")
+    for n in plan.notes:
+        print(f"note: {n}")
+    if figure is not None:
+        print(f"wrote {figure}")

@@ -1,0 +1,361 @@
+"""Where to measure next: the frequencies whose measurement would best settle the model choice.
+
+From a finished comparison, each candidate frequency ω in a window is scored by the expected
+information about the model index M that one more complex measurement y there would bring: the
+mutual information
+
+    I(M; y) = Σ_m p_m E_{y ~ p(y | m)} [ln p(y | m) − ln p(y)],   p(y) = Σ_m p_m p(y | m),
+
+under each structure's posterior predictive p(y | m) (its posterior draws of the parameters and
+of the noise) and the current posterior model probabilities p_m. I is in nats, at most the
+entropy of the p_m (the information still missing about M), and zero where the structures
+predict the same. Several distinct points are chosen greedily: each next point is the one
+that adds the most to the information of the set chosen so far (the joint y of the set), or
+the most per second of measuring time with ``cost="low-frequency"`` (a sweep point at ω takes
+about :data:`SETTLE_S` plus :data:`PERIODS` periods 2π/ω).
+
+Each structure's predictive of a set of measurements is taken as a normal distribution in the
+coordinates (ln|G|, arg G) of each point, with the mean and covariance of its posterior draws'
+responses plus the noise variance of its noise model (its σ for constant noise, σ_rel for
+proportional noise, σ_rel of each part for relative parts; with σ given per point, the data's
+median relative σ). The posterior spread of a structure is often far wider than the noise
+outside the measured window, so that a mixture over a few hundred draws would be a poor density
+(its Monte Carlo estimate of I is biased, even below zero); the normal form gives exact
+densities, and I is then a plain Monte Carlo mean over simulated y, with the same standard
+normals for every candidate so that the candidates differ by what they measure. The normal form
+does not represent a predictive with several separate branches (two modes of a posterior):
+there the numbers are a rough guide.
+
+The model probabilities are those of the structures' ln Z with equal prior odds, over the
+structures considered.
+
+For the two leading structures the result states what the proposed points would do to their
+log Bayes factor: its expected change if either is true, and the probability (under the current
+model probabilities) that after them it is decisive, |ln B| > ln 100.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.special import logsumexp
+
+from .errors import InputError
+
+__all__ = ["COSTS", "Design", "design", "seconds"]
+
+#: Draws of each structure's posterior used (half simulate y, half give its density).
+N_DRAWS = 160
+#: Simulated measurements y per structure.
+N_Y = 200
+#: Candidate frequencies on a log grid over the window.
+N_CANDIDATES = 61
+#: Structures below this posterior probability carry no information about the choice (they
+#: cannot win) and are left out, with at most :data:`MAX_STRUCTURES` kept.
+MIN_PROBABILITY = 1e-4
+MAX_STRUCTURES = 4
+#: Measuring time of a sweep point at ω: SETTLE_S + PERIODS · 2π/ω seconds.
+SETTLE_S = 10.0
+PERIODS = 3.0
+#: |ln B| beyond which the evidence is decisive (Jeffreys: B > 100).
+DECISIVE = math.log(100.0)
+COSTS = ("uniform", "low-frequency")
+
+
+@dataclass(frozen=True)
+class Design:
+    """The proposed measurements (:func:`design`).
+
+    Attributes
+    ----------
+    omega : ndarray
+        The candidate frequencies [rad/s].
+    information : ndarray
+        Expected information of one measurement at each candidate [nats].
+    proposed : tuple of dict
+        The chosen points in the order chosen: ``omega``, ``information`` (of the set so far,
+        nats), ``gain`` (what this point added), ``seconds`` (its measuring time).
+    structures : tuple of str
+        The structures considered (probability ≥ :data:`MIN_PROBABILITY`), best first.
+    probabilities : tuple of float
+        Their posterior probabilities, renormalised over them.
+    entropy : float
+        The entropy of those probabilities [nats]: the most any measurement can tell.
+    leading : tuple of str
+        The two leading structures.
+    log_bayes_factor : float
+        Their current ln B (first over second).
+    expected_change : dict
+        ``{structure: E[Δ ln B]}`` if that structure is true, for the proposed set.
+    p_decisive : float
+        Probability that ln B of the two is decisive after the proposed points.
+    alternatives : dict
+        The expected information of as many points placed by rules of thumb: ``log-uniform``
+        over the window, ``decade below`` (log-uniform over the decade below the data, as far
+        as the window reaches), ``decade above``.
+    window : tuple of float
+    cost : str
+    notes : tuple of str
+    """
+
+    omega: np.ndarray = field(repr=False)
+    information: np.ndarray = field(repr=False)
+    proposed: tuple
+    structures: tuple[str, ...]
+    probabilities: tuple[float, ...]
+    entropy: float
+    leading: tuple[str, ...]
+    log_bayes_factor: float
+    expected_change: dict
+    p_decisive: float
+    alternatives: dict
+    window: tuple[float, float]
+    cost: str
+    notes: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        """The design as JSON (``bayesfo design --json``)."""
+        return {"window": list(self.window), "cost": self.cost,
+                "structures": dict(zip(self.structures, self.probabilities, strict=True)),
+                "entropy": self.entropy,
+                "proposed": [dict(p) for p in self.proposed],
+                "leading": list(self.leading), "log_bayes_factor": self.log_bayes_factor,
+                "expected_change": dict(self.expected_change),
+                "p_decisive": self.p_decisive, "alternatives": dict(self.alternatives),
+                "candidates": {"omega": self.omega.tolist(),
+                               "information": self.information.tolist()},
+                "notes": list(self.notes)}
+
+
+def seconds(omega) -> np.ndarray:
+    """Measuring time of a sweep point at ``omega`` [s] (see the module)."""
+    return SETTLE_S + PERIODS * 2.0 * np.pi / np.asarray(omega, dtype=float)
+
+
+def _noise_var(result, draws, g, rel_sigma) -> np.ndarray:
+    """Variance of a measurement's ln|G| and arg G [rad] (last axis) for model responses ``g``
+    (draws × frequencies) under the structure's noise model (small-noise approximation)."""
+    noise = result.posterior.noise
+    g2 = np.abs(g) ** 2
+    if noise == "known":
+        v = np.full(g.shape, rel_sigma**2 / 2.0)
+        return np.stack([v, v], axis=-1)
+    sigma = draws[:, -1][:, None]  # the noise parameter, last (physical units)
+    if noise == "constant":
+        v = sigma**2 / (2.0 * g2)
+        return np.stack([v, v], axis=-1)
+    if noise == "relative_parts":
+        re2, im2 = g.real**2, g.imag**2
+        return np.stack([sigma**2 * (re2**2 + im2**2) / g2**2,
+                         sigma**2 * 2.0 * re2 * im2 / g2**2], axis=-1)
+    v = np.broadcast_to(sigma**2 / 2.0, g.shape)  # proportional
+    return np.stack([v, v], axis=-1)
+
+
+@dataclass
+class _Predictive:
+    """Each structure's posterior predictive of measurements at the candidates, in the
+    coordinates (ln|G|, arg G): the draws' responses ``z`` (structures, draws, candidates, 2)
+    and the noise variances ``noise`` (structures, candidates, 2; the mean over draws). The
+    predictive of a set of candidates is taken as a normal distribution with the draws' mean and
+    covariance plus the noise (parameter uncertainty and noise; replicates at one frequency share
+    the first and not the second)."""
+
+    z: np.ndarray
+    noise: np.ndarray
+
+    def _normals(self, sets):
+        """Means (M, n_sets, 2k) and inverse Cholesky factors and log-determinants of the
+        covariances (M, n_sets, 2k, 2k), (M, n_sets) of the candidate ``sets`` (n_sets, k)."""
+        m, n_draws = self.z.shape[:2]
+        n_sets, k = sets.shape
+        zz = self.z[:, :, sets, :].reshape(m, n_draws, n_sets, 2 * k)
+        mu = zz.mean(axis=1)
+        dev = zz - mu[:, None]
+        cov = np.einsum("msnd,msne->mnde", dev, dev) / (n_draws - 1)
+        idx = np.arange(2 * k)
+        cov[..., idx, idx] += self.noise[:, sets, :].reshape(m, n_sets, 2 * k)
+        chol = np.linalg.cholesky(cov)
+        inv = np.linalg.inv(chol)
+        logdet = 2.0 * np.log(np.diagonal(chol, axis1=-2, axis2=-1)).sum(axis=-1)
+        return mu, chol, inv, logdet
+
+    def simulate(self, sets, n: int, rng):
+        """``n`` measurements of each set from each structure's predictive, and their log
+        densities under every structure: (M_true, n, n_sets, 2k), (M_true, M, n, n_sets)."""
+        mu, chol, inv, logdet = self._normals(sets)
+        m, n_sets, d = mu.shape
+        # The same standard normals for every set (common random numbers): the sets'
+        # estimates differ by what the sets do, not by the Monte Carlo draws.
+        e = np.broadcast_to(rng.standard_normal((m, n, 1, d)), (m, n, n_sets, d))
+        y = mu[:, None] + np.einsum("mnde,mNne->mNnd", chol, e)
+        diff = y[:, None] - mu[None, :, None]  # (M_true, M, n, n_sets, d)
+        x = np.einsum("knde,tkNne->tkNnd", inv, diff)
+        log_p = (-0.5 * np.einsum("...d,...d->...", x, x) - 0.5 * logdet[None, :, None, :]
+                 - 0.5 * d * math.log(2.0 * math.pi))
+        return y, log_p
+
+    def information(self, sets, log_prior, rng, n: int = None):
+        """I(M; y_set) [nats] of each candidate set (n_sets,), and the log densities."""
+        _, log_p = self.simulate(sets, n or N_Y, rng)
+        m = log_p.shape[0]
+        own = log_p[np.arange(m), np.arange(m)]  # (M, n, n_sets)
+        mix = logsumexp(log_p + log_prior[None, :, None, None], axis=1)  # (M, n, n_sets)
+        info = np.einsum("m,mn->n", np.exp(log_prior), (own - mix).mean(axis=1))
+        return np.maximum(info, 0.0), log_p
+
+
+def _predictive(results, omega, kind, rel_sigma, rng) -> _Predictive:
+    """The posterior predictive of each structure at ``omega`` (see :class:`_Predictive`)."""
+    zs, noise = [], []
+    for r in results:
+        post = r.posterior
+        k = r.structure.n_params
+        pick = rng.choice(post.samples.shape[0], size=min(N_DRAWS, post.samples.shape[0]),
+                          replace=False)
+        draws = post.samples[pick]
+        with np.errstate(all="ignore"):
+            g = r.structure.response(draws[:, :k], omega, kind)
+        ok = np.all(np.isfinite(g) & (g != 0), axis=1)
+        draws, g = draws[ok], g[ok]
+        zs.append(np.stack([np.log(np.abs(g)), np.angle(g)], axis=-1))
+        noise.append(_noise_var(r, draws, g, rel_sigma).mean(axis=0))
+    n = min(len(z) for z in zs)
+    if n < 20:
+        raise InputError("design: too few posterior draws with a finite response in the window")
+    return _Predictive(np.stack([z[:n] for z in zs]), np.stack(noise))
+
+
+def design(result, *, window=None, points: int = 3, structures=None, cost: str = "uniform",
+           seed: int = 0) -> Design:
+    """The frequencies to measure next to tell the structures of ``result`` apart.
+
+    Parameters
+    ----------
+    result : Comparison
+        From :func:`bayesfo.compare` or :func:`bayesfo.load`.
+    window : (float, float), optional
+        The instrument's frequency window [rad/s] (default: the data's, a decade wider on each
+        side).
+    points : int
+        How many frequencies to propose (1-20).
+    structures : sequence of str, optional
+        The structures to tell apart (default: every one with a posterior probability of at
+        least :data:`MIN_PROBABILITY`, at most :data:`MAX_STRUCTURES`).
+    cost : {"uniform", "low-frequency"}
+        ``low-frequency`` chooses by information per second of measuring time.
+    seed : int
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    InputError
+        Fewer than two structures to tell apart, a window that is not two positive increasing
+        frequencies, an unknown cost or structure.
+    """
+    if cost not in COSTS:
+        raise InputError(f"argument 'cost' must be one of {', '.join(COSTS)}, got {cost!r}")
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or not 1 <= points <= 20:
+        raise InputError(f"argument 'points' must be an integer from 1 to 20, got {points!r}")
+    data = result.data
+    lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
+    if window is None:
+        window = (lo_d / 10.0, hi_d * 10.0)
+    try:
+        w_lo, w_hi = (float(w) for w in window)
+    except (TypeError, ValueError):
+        raise InputError(f"argument 'window' must be two frequencies (low, high) in rad/s, "
+                         f"got {window!r}") from None
+    if not (0 < w_lo < w_hi and math.isfinite(w_hi)):
+        raise InputError(f"argument 'window' must have 0 < low < high, got ({w_lo:g}, {w_hi:g})")
+    ranked = [result[n] for n in result.ranking]
+    if structures is not None:
+        names = [structures] if isinstance(structures, str) else list(structures)
+        known = {r.name for r in ranked}
+        for n in names:
+            if n not in known:
+                raise InputError(f"design: no structure '{n}' with a posterior in the "
+                                 f"comparison; it has {', '.join(sorted(known))}")
+        ranked = [r for r in ranked if r.name in names]
+    # Probabilities from ln Z over the structures considered, equal prior odds.
+    log_z = np.array([r.criteria["evidence"].log_z if r.criteria.get("evidence") is not None
+                      else -np.inf for r in ranked])
+    with np.errstate(invalid="ignore"):
+        probs = np.exp(log_z - log_z.max()) if np.isfinite(log_z).any() else np.zeros(len(ranked))
+    probs = probs / probs.sum() if probs.sum() > 0 else probs
+    keep = [i for i in range(len(ranked)) if probs[i] >= MIN_PROBABILITY][:MAX_STRUCTURES]
+    notes = []
+    if len(keep) < 2:
+        leader = ranked[0].name if ranked else "none"
+        raise InputError(
+            "design needs two or more structures that could still win; "
+            + (f"{leader} has posterior probability {probs[0]:.4f} and the others below "
+               f"{MIN_PROBABILITY:g}: the choice is settled by these data"
+               if len(ranked) > 1 else "the comparison has one structure with a posterior"))
+    if len(keep) < sum(probs >= MIN_PROBABILITY):
+        notes.append(f"the {MAX_STRUCTURES} most probable structures are considered")
+    results = [ranked[i] for i in keep]
+    p = probs[keep] / probs[keep].sum()
+    log_prior = np.log(p)
+    entropy = float(-np.sum(p * np.log(p)))
+    omega = np.logspace(math.log10(w_lo), math.log10(w_hi), N_CANDIDATES)
+    rel = (float(np.median(data.sigma / np.abs(data.response))) if data.sigma is not None
+           else math.nan)
+    rng = np.random.default_rng(seed)
+    # Rules of thumb, inside the window: as many points log-uniform over it, or over the
+    # decade below (above) the data where the window reaches there.
+    extra = {"log-uniform": np.logspace(math.log10(w_lo), math.log10(w_hi), points + 2)[1:-1]}
+    below = (max(w_lo, lo_d / 10.0), min(lo_d, w_hi))
+    above = (max(hi_d, w_lo), min(hi_d * 10.0, w_hi))
+    if below[1] > below[0] * 1.01:
+        extra["decade below"] = np.logspace(*np.log10(below), points + 1)[:-1]
+    if above[1] > above[0] * 1.01:
+        extra["decade above"] = np.logspace(*np.log10(above), points + 1)[1:]
+    grid = np.concatenate([omega, *extra.values()])
+    pred = _predictive(results, grid, data.kind, rel, rng)
+    c = np.arange(omega.size)
+    single, _ = pred.information(c[:, None], log_prior, rng)
+    time = seconds(omega)
+    chosen, proposed, info_so_far = [], [], 0.0
+    for _ in range(points):
+        sets = np.array([chosen + [j] for j in c])
+        info, _ = pred.information(sets, log_prior, rng)
+        gains = info - info_so_far
+        score = gains / time if cost == "low-frequency" else gains
+        score[chosen] = -np.inf  # distinct frequencies, as a sweep measures them
+        j = int(np.argmax(score))
+        # A point cannot remove information: a negative gain is Monte Carlo noise about none.
+        total = max(float(info[j]), info_so_far)
+        proposed.append({"omega": float(omega[j]), "information": total,
+                         "gain": total - info_so_far, "seconds": float(time[j])})
+        chosen.append(j)
+        info_so_far = total
+    offset = omega.size
+    alternatives = {}
+    for name, w in extra.items():
+        cols = np.arange(offset, offset + w.size)[None, :]
+        offset += w.size
+        alternatives[name] = float(pred.information(cols, log_prior, rng)[0][0])
+    # The two leading structures' ln B after the proposed points.
+    z = [r.criteria["evidence"].log_z if r.criteria.get("evidence") is not None else math.nan
+         for r in results[:2]]
+    ln_b = z[0] - z[1]
+    _, log_p = pred.information(np.array([chosen]), log_prior, rng, n=4 * N_Y)
+    delta = log_p[:, 0, :, 0] - log_p[:, 1, :, 0]  # (M_true, n): ln p(y|first) − ln p(y|second)
+    expected = {results[m].name: float(delta[m].mean()) for m in (0, 1)}
+    base = ln_b if math.isfinite(ln_b) else 0.0
+    p_decisive = float(np.sum(p * (np.abs(base + delta) > DECISIVE).mean(axis=1)))
+    if not math.isfinite(ln_b):
+        notes.append("the leading structures have no ln Z: the change of ln B is stated "
+                     "without its present value")
+    return Design(omega=omega, information=single, proposed=tuple(proposed),
+                  structures=tuple(r.name for r in results), probabilities=tuple(map(float, p)),
+                  entropy=entropy, leading=(results[0].name, results[1].name),
+                  log_bayes_factor=float(ln_b), expected_change=expected,
+                  p_decisive=p_decisive, alternatives=alternatives, window=(w_lo, w_hi),
+                  cost=cost, notes=tuple(notes))

@@ -29,9 +29,12 @@ def add_parser(subparsers):
                         "from this one); the numbers do not depend on it")
     p.add_argument("--no-figures", action="store_true",
                    help="skip the figures and report.html (faster; summary, table and NetCDF only)")
-    p.add_argument("--figure-formats", default="png,pdf", metavar="F1,F2",
-                   help="file formats of the figures (default png,pdf; png alone is about "
-                        "twice as fast; report.html embeds the PNG files)")
+    p.add_argument("--figure-formats", default="png", metavar="F1,F2",
+                   help="file formats of the figures (default png, which report.html embeds; "
+                        "png,pdf adds vector figures for publication, at about twice the time)")
+    p.add_argument("--structure-figures", default="3", metavar="N|all",
+                   help="how many structures, the best by the ranking, get corner and trace "
+                        "figures (default 3; 'all' for every one)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
     return p
 
@@ -97,7 +100,9 @@ def _compare(data, structures, out, n_proc, workers, formats, no_figures, option
     from ..comparison import compare, write_outputs
     from ..parallel import lazy_process_pool, process_pool
 
-    figures = {} if formats is None else {"formats": formats}
+    figures = {} if formats is None else {"formats": formats,
+                                          "structure_figures": options.pop("structure_figures")}
+    options.pop("structure_figures", None)
     if workers == 0:
         # The quick steps here, the long ones in worker processes started only if some
         # structure needs them; those then draw the figures too. Otherwise the figures are
@@ -187,6 +192,10 @@ def run(args) -> int:
 
         formats = check_formats([f for f in args.figure_formats.split(",") if f.strip()],
                                 "--figure-formats")
+    detail = args.structure_figures.strip().lower()
+    if detail != "all" and not detail.isdigit():
+        raise InputError(f"--structure-figures takes a number of structures or 'all', got "
+                         f"{args.structure_figures!r}")
     holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
     if args.workers < 0:
         raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
@@ -195,6 +204,7 @@ def run(args) -> int:
                    evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,
                    sampler=args.sampler)
     options.update(sampler_options(settings))
+    options["structure_figures"] = None if detail == "all" else int(detail)
     n_proc = min(args.workers or available_cpus(), len(structures))
     target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
     created = not target.exists()

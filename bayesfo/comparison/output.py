@@ -94,8 +94,8 @@ def _write_netcdf(comparison: Comparison, stage: Path) -> dict[str, Path]:
 
 
 def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
-                  formats=("png", "pdf"), pool=None, figure_processes: int = 1
-                  ) -> dict[str, Path]:
+                  formats=("png",), pool=None, figure_processes: int = 1,
+                  structure_figures: int | None = 3) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
     One NetCDF per structure (an ArviZ DataTree with the attributes that :func:`load` needs,
@@ -117,7 +117,11 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     figures : bool
         Draw the figures and the report (matplotlib; a few seconds per structure).
     formats : sequence of str
-        Figure file formats.
+        Figure file formats (default PNG, which the report embeds; add ``"pdf"`` for
+        vector figures).
+    structure_figures : int or None
+        How many structures (the best by the ranking) get corner and trace figures (every one
+        for None).
     pool : concurrent.futures.Executor, optional
         Draw the figures in these worker processes (from :func:`process_pool`; a
         :class:`~bayesfo.parallel.LazyPool` whose processes were not started is not started
@@ -142,6 +146,7 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
             # The NetCDF files are written while a forked process already draws.
             drawn = write_figures(comparison, stage / "figures", formats=formats,
                                   seed=comparison.seed, pool=pool, processes=figure_processes,
+                                  structure_figures=structure_figures,
                                   meanwhile=lambda: written.update(_write_netcdf(comparison,
                                                                                  stage)))
             written.update(drawn)

@@ -79,12 +79,32 @@ def _structure_makers(result, color) -> dict:
     }
 
 
-def figure_jobs(comparison, *, seed: int = 0) -> list[tuple[str, object]]:
+#: Structures that get their own corner and trace figures by default: the leading ones by the
+#: ranking (the combined figures show every structure; more with ``structure_figures``).
+STRUCTURE_FIGURES = 3
+
+
+def _detailed(comparison, structure_figures) -> list:
+    """The structures that get their own figures: the best ``structure_figures`` (all for
+    None)."""
+    ranked = ok_results(comparison)
+    if structure_figures is None:
+        return ranked
+    if isinstance(structure_figures, bool) or not isinstance(structure_figures, int) \
+            or structure_figures < 0:
+        raise InputError("argument 'structure_figures' must be a non-negative integer or None "
+                         f"(every structure), got {structure_figures!r}")
+    return ranked[:structure_figures]
+
+
+def figure_jobs(comparison, *, seed: int = 0,
+                structure_figures: int | None = STRUCTURE_FIGURES) -> list[tuple[str, object]]:
     """``(name, make)`` for every figure of a comparison, ``make()`` returning a
-    :class:`~bayesfo.plotting.Drawn`; structures that failed are left out."""
+    :class:`~bayesfo.plotting.Drawn`; structures that failed are left out, and only the best
+    ``structure_figures`` structures (all for None) get corner and trace figures."""
     jobs = list(_combined_makers(comparison, seed).items())
     styles = comparison_styles(comparison)
-    for r in ok_results(comparison):
+    for r in _detailed(comparison, structure_figures):
         jobs.extend(_structure_makers(r, styles[r.name].color).items())
     return jobs
 
@@ -126,14 +146,16 @@ def _draw_in_worker(task: tuple, out_dir: Path, formats, seed: int) -> dict[str,
     return _save_all(makers, out_dir, formats)
 
 
-def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0, pool=None,
-                  processes: int = 1, meanwhile=None) -> dict[str, list[Path]]:
+def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=None,
+                  processes: int = 1, meanwhile=None,
+                  structure_figures: int | None = STRUCTURE_FIGURES) -> dict[str, list[Path]]:
     """Draw every figure of a comparison and write each in every format.
 
-    Figures: ``ranking``, ``bode``, ``nyquist``, ``residuals``, ``q_posteriors`` (when some
-    structure has a free fractional order), and ``corner_<structure>`` and
-    ``trace_<structure>`` for every structure that ran (structures with ``error`` are
-    skipped). Each file is written through a temporary file and a rename
+    Figures: ``ranking``, ``bode``, ``moduli`` (modulus or compliance data), ``nyquist``,
+    ``residuals``, ``q_posteriors`` (when some structure has a free fractional order), and
+    ``corner_<structure>`` and ``trace_<structure>`` for the best ``structure_figures``
+    structures by the ranking (every one for None; structures with ``error`` are skipped).
+    Each file is written through a temporary file and a rename
     (:func:`save_figure`); each figure is closed once written.
 
     Parameters
@@ -142,9 +164,12 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
     out_dir : str or path-like
         Directory (created when missing); files are ``<name>.<format>``.
     formats : sequence of str
-        File formats matplotlib can write (``png``, ``pdf``, ``svg``, …).
+        File formats matplotlib can write (``png``, ``pdf``, ``svg``, …); PNG alone by
+        default (the report embeds it; each further format costs about as much again).
     seed : int
         Seed of the posterior draws behind the response figures.
+    structure_figures : int or None
+        How many structures (the best by the ranking) get corner and trace figures.
     pool : concurrent.futures.Executor, optional
         Worker processes that draw the figures side by side (e.g.
         :func:`bayesfo.parallel.process_pool`): the combined figures in two tasks, the figures
@@ -180,21 +205,25 @@ def write_figures(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
         # 2-core machine: 9 s here against 24-26 s in two fresh processes, PNG and PDF of
         # Voigt and Zener, busy machine).
         pool = None
+    _detailed(comparison, structure_figures)  # checks the argument before any drawing
     if pool is None and processes == 2 and can_fork():
-        return draw_forked(comparison, out_dir, formats, seed=seed, meanwhile=meanwhile)
+        return draw_forked(comparison, out_dir, formats, seed=seed, meanwhile=meanwhile,
+                           structure_figures=structure_figures)
     if meanwhile is not None:
         meanwhile()
     if pool is None:
         written: dict[str, list[Path]] = {}
-        for name, make in figure_jobs(comparison, seed=seed):
+        for name, make in figure_jobs(comparison, seed=seed,
+                                      structure_figures=structure_figures):
             written.update(_save_all({name: make}, out_dir, formats))
         return written
-    order = [name for name, _ in figure_jobs(comparison, seed=seed)]
+    order = [name for name, _ in figure_jobs(comparison, seed=seed,
+                                             structure_figures=structure_figures)]
     combined = list(_combined_makers(comparison, seed))
     styles = comparison_styles(comparison)
     # Per-structure tasks carry one result only; the combined figures need all of them.
     tasks = [("structure", r, styles[r.name].color)
-             for r in ok_results(comparison)]
+             for r in _detailed(comparison, structure_figures)]
     tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
     futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed) for t in reversed(tasks)]
     drawn = {}
@@ -305,8 +334,9 @@ def _load_before_fork(formats) -> None:
     mathtext.MathTextParser("path").parse(r"$|J^*|\ \alpha\ 10^{3}$", 72)
 
 
-def draw_forked(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
-                meanwhile=None) -> dict[str, list[Path]]:
+def draw_forked(comparison, out_dir, formats=("png",), *, seed: int = 0,
+                meanwhile=None, structure_figures: int | None = STRUCTURE_FIGURES
+                ) -> dict[str, list[Path]]:
     """Draw every figure of a comparison in this process and in one forked from it.
 
     Both take the figures one at a time from one shared table, costliest first
@@ -332,7 +362,7 @@ def draw_forked(comparison, out_dir, formats=("png", "pdf"), *, seed: int = 0,
 
     formats = check_formats(formats)
     out_dir = Path(out_dir)
-    jobs = dict(figure_jobs(comparison, seed=seed))
+    jobs = dict(figure_jobs(comparison, seed=seed, structure_figures=structure_figures))
     order = _draw_order(comparison, list(jobs))
     ctx = multiprocessing.get_context("fork")
     lock = ctx.Lock()

@@ -151,6 +151,14 @@ def test_figure_formats_png_alone(run_cli, tmp_path):
     assert (out / "report.html").read_text().count("data:image/png;base64,") == len(names)
 
 
+def test_structure_figures_takes_a_number_or_all(run_cli, tmp_path):
+    status, _, err = run_cli("compare", ADHESIVE, "--structures", "voigt", "--out",
+                             tmp_path / "x", "--structure-figures", "some")
+    assert status == 2
+    assert "--structure-figures takes a number of structures or 'all', got 'some'" in err
+    assert not (tmp_path / "x").exists()
+
+
 @pytest.mark.parametrize("formats, message", [
     ("png,xyz", "--figure-formats: cannot write 'xyz' figures; use one of"),
     (",", "--figure-formats is empty")])

@@ -611,3 +611,17 @@ def test_a_forked_figure_process_that_dies_holding_the_lock_does_not_block_the_p
     taker.join(30)
     assert not taker.is_alive(), "the parent waits forever on the dead child's lock"
     assert got == [1] and list(state) == [output._TAKEN, output._HERE, output._FREE]
+
+
+def test_only_the_leading_structures_get_corner_and_trace_figures(comparison, tmp_path):
+    written = write_figures(comparison, tmp_path / "one", structure_figures=1)
+    best = comparison.ranking[0]
+    assert [n for n in written if n.startswith(("corner_", "trace_"))] == [
+        f"corner_{best}", f"trace_{best}"]
+    assert all(p.suffix == ".png" for paths in written.values() for p in paths)  # the default
+    every = write_figures(comparison, tmp_path / "all", structure_figures=None)
+    assert {n for n in every if n.startswith("corner_")} == {
+        f"corner_{n}" for n in comparison.ranking}
+    with pytest.raises(InputError, match="'structure_figures' must be a non-negative integer"):
+        write_figures(comparison, tmp_path / "bad", structure_figures=-1)
+    assert not (tmp_path / "bad").exists() or not list((tmp_path / "bad").iterdir())

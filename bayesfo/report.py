@@ -332,8 +332,9 @@ def _diagnostics_section(comparison) -> str:
                    f"{_num(info.get('k_hat'), '.2f')} (certified below 0.7), ESS of the weights")
             widest = info.get("widest") or {}
             if widest.get("parameter"):
-                how += (f"; every parameter determined (the widest, {widest['parameter']}, "
-                        f"spans {100 * widest['share_of_prior']:.0f} % of its prior range)")
+                how += (f"; every fractional order determined (the widest, "
+                        f"{widest['parameter']}, spans {100 * widest['share_of_prior']:.0f} % of "
+                        "its prior range)")
         else:
             how = (f"{post.n_walkers} walkers × {post.n_steps} steps, τ max "
                    f"{_num(tau, '.0f')}, acceptance {_num(post.acceptance, '.2f')}")

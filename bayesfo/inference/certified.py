@@ -8,10 +8,10 @@ The routes, in order, with ``sampler="auto"``:
 
 1. importance sampling from a proposal centred on the optima
    (:func:`~bayesfo.inference.importance.importance_posterior`): certified when the Pareto k̂
-   of the weights is below 0.7, their ESS at least 1000, and every parameter determined (its
-   94 % interval within a quarter of its prior range: an undetermined element allows
-   configurations that a proposal built at the optima can miss); ln Z from the same weights
-   where k̂ < 0.5;
+   of the weights is below 0.7, their ESS at least 1000, and every fractional order
+   determined (its 94 % interval within a quarter of its prior range: an undetermined order
+   allows configurations, springpots exchanged or vanishing, that a proposal built at the
+   optima can miss); ln Z from the same weights where k̂ < 0.5;
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
    tempered ladder guided by the proposal's draws: their final particles are the posterior
    when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence;

@@ -221,6 +221,14 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
     from ..structures import get_structure
 
     entries = summary["structures"]
+    for s in entries:
+        # A name is a file stem in this directory: one that reaches elsewhere ("../x", "a/b")
+        # was not written by a run, and no file outside the directory is opened for it.
+        name = s.get("name")
+        if not isinstance(name, str) or not name or name in (".", "..") \
+                or any(c in name for c in "/\\\0") or Path(name).name != name:
+            raise InputError(f"'{d / 'summary.json'}': structure name {name!r} is not a file "
+                             "name in the directory; the file was not written by a run")
     files = {}
     for s in entries:
         if "error" not in s:

@@ -229,3 +229,22 @@ def test_the_picture_an_alias_chose_is_read_back(tmp_path):
     stored = json.loads((tmp_path / "summary.json").read_text())
     assert stored["structures"][0]["picture"] == "fractional_poynting_thomson"
     assert _diff(_json(bf.load(tmp_path).to_summary()), stored) == []
+
+
+@pytest.mark.parametrize("name", ["../../x", "a/b", "..", "", 7])
+def test_a_structure_name_that_leaves_the_directory_is_refused(written, tmp_path, name):
+    """A summary.json whose structure name is a path ("../../x") was not written by a run:
+    load refuses it instead of opening DIR/../../x.nc (a run without digests, as earlier
+    versions wrote, is checked the same way)."""
+    from bayesfo.outdir import MANIFEST
+
+    _, out = written
+    copy = tmp_path / "run"
+    shutil.copytree(out, copy)
+    (copy / MANIFEST).unlink()
+    summary = json.loads((copy / "summary.json").read_text())
+    summary["structures"][0]["name"] = name
+    (copy / "summary.json").write_text(json.dumps(summary))
+    (tmp_path / "x.nc").write_bytes(b"not to be opened")
+    with pytest.raises(InputError, match=r"structure name .* is not a file name in the directory"):
+        bf.load(copy)

@@ -29,7 +29,9 @@ structures' (2) and (3) go to the pool, whose processes start with the first of 
 promise costs time, never a different number.
 
 Every step uses the seed it uses in the serial path, so the numbers do not depend on the pool
-or the worker count. Warnings are recorded in the task that raises them and returned with its
+or the worker count. A worker process that dies (killed, out of memory) breaks the pool: its
+tasks and every one still waiting are then run in this process, with a warning, so that no
+finished structure is lost and the numbers are those of the serial path. Warnings are recorded in the task that raises them and returned with its
 value; an :class:`~bayesfo.errors.InputError` in any step gives the structure's
 ``StructureResult(s, error=...)`` (the first noise model's in the order of the serial path, when
 several fail), and its tasks still waiting are cancelled. Tasks are submitted from the parent's
@@ -42,6 +44,7 @@ import heapq
 import itertools
 import queue
 import warnings
+from concurrent.futures.process import BrokenProcessPool
 
 from ..errors import InputError
 from .results import StructureResult
@@ -90,21 +93,35 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
     runs = [{} for _ in range(n)]  # noise model -> (run, error) once its (2) is back
     in_pool = [not here] * n  # where (2) and (3) of each structure run
     order = itertools.count()
+    broken = []  # the pool's failure, once a worker died
+
+    def run_here(i, what, args):
+        # Step (1) first; otherwise first come, first run.
+        heapq.heappush(local, (what != "first", next(order), i, what, args))
 
     def submit(i, what, *args):
-        if not in_pool[i]:
-            # Step (1) first; otherwise first come, first run.
-            heapq.heappush(local, (what != "first", next(order), i, what, args))
-            return
-        future = pool.submit(_task, *args)
-        live[future] = (i, what)
+        if not in_pool[i] or broken:
+            return run_here(i, what, args)
+        try:
+            future = pool.submit(_task, *args)
+        except BrokenProcessPool as exc:
+            lost(exc)
+            return run_here(i, what, args)
+        live[future] = (i, what, args)
         future.add_done_callback(finished.put)
+
+    def lost(exc):
+        if not broken:
+            broken.append(exc)
+            warnings.warn("a worker process ended unexpectedly (killed or out of memory); the "
+                          "structures it and the other workers still held are run in this "
+                          "process", RuntimeWarning, stacklevel=4)
 
     def end(i, result):
         outcomes[i] = (result, _kept(structures[i].name, caught[i]))
         runs[i] = prepared[i] = None
         bar.update()
-        for future, (j, _) in live.items():
+        for future, (j, _, _) in live.items():
             if j == i:  # e.g. the other noise model's posterior, after an error in one
                 future.cancel()
 
@@ -144,9 +161,15 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 submit(i, noise, _sample_held, structures[i], data, noise, fit, options)
 
     def collect(future):
-        i, what = live.pop(future)
-        if not future.cancelled():
-            done(i, what, *future.result())
+        i, what, args = live.pop(future)
+        if future.cancelled():
+            return
+        try:
+            value = future.result()
+        except BrokenProcessPool as exc:  # its worker died: the task runs here instead
+            lost(exc)
+            return run_here(i, what, args)
+        done(i, what, *value)
 
     try:
         # Larger structures first (they take longest); results keep the order given.

@@ -225,10 +225,21 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
     tasks = [("structure", r, styles[r.name].color)
              for r in _detailed(comparison, structure_figures)]
     tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
-    futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed) for t in reversed(tasks)]
-    drawn = {}
-    for f in futures:
-        drawn.update(f.result())
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed)
+                   for t in reversed(tasks)]
+        drawn = {}
+        for f in futures:
+            drawn.update(f.result())
+    except BrokenProcessPool:
+        # A worker died (killed, out of memory): the figures are drawn here (a figure's file is
+        # written through a rename, so one the worker left half-done is replaced whole).
+        drawn = {}
+        for name, make in figure_jobs(comparison, seed=seed,
+                                      structure_figures=structure_figures):
+            drawn.update(_save_all({name: make}, out_dir, formats))
     return {name: drawn[name] for name in order}
 
 

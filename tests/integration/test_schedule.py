@@ -9,6 +9,7 @@ import warnings
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import bayesfo as bf
@@ -323,3 +324,58 @@ def test_pool_workers_in_a_fresh_command(tmp_path, blas_env, threads):
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == [f"lazy True [{threads}]",
                                         f"process_pool False [{threads}]"]
+
+
+class _KillingPool:
+    """A pool whose first task ends its worker process (as the kernel's OOM killer would): the
+    pool is then broken for every task still waiting and every later one."""
+
+    def __init__(self, pool):
+        self.pool, self.killed = pool, False
+
+    def submit(self, fn, *args):
+        if not self.killed:
+            self.killed = True
+            import os
+
+            return self.pool.submit(os._exit, 1)
+        return self.pool.submit(fn, *args)
+
+
+def test_a_worker_that_dies_loses_no_structure():
+    """compare with a pool whose worker dies: every structure is still run (the lost tasks in
+    this process), with the numbers of the serial path, and a warning says what happened."""
+    from bayesfo.parallel import process_pool
+
+    data = bf.read(Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+                   / "Tp020C.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
+        serial = bf.compare(data, "voigt,zener", seed=0, progress=False, workers=1)
+        with process_pool(2) as pool, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            broken = bf.compare(data, "voigt,zener", seed=0, progress=False,
+                                pool=_KillingPool(pool))
+    assert any("a worker process ended unexpectedly" in str(w.message) for w in caught)
+    assert broken.ranking == serial.ranking
+    for name in serial.ranking:
+        a, b = serial[name], broken[name]
+        assert b.error is None
+        np.testing.assert_array_equal(a.posterior.samples, b.posterior.samples)
+        assert a.criteria["evidence"].log_z == b.criteria["evidence"].log_z
+
+
+def test_figures_are_drawn_here_when_a_worker_dies(tmp_path):
+    from bayesfo.parallel import process_pool
+    from bayesfo.plotting import write_figures
+
+    data = bf.read(Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+                   / "Tp020C.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bf.errors.PredictiveWarning)
+        result = bf.compare(data, "voigt", seed=0, progress=False, workers=1)
+    with process_pool(1) as pool:
+        written = write_figures(result, tmp_path, pool=_KillingPool(pool))
+    assert set(written) == {"ranking", "bode", "moduli", "nyquist", "residuals", "q_posteriors",
+                            "corner_voigt", "trace_voigt"}
+    assert all(p.stat().st_size > 0 for paths in written.values() for p in paths)

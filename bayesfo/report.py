@@ -56,6 +56,8 @@ CAPTIONS = {
             "posterior median response (line) and its 50 % and 90 % credible bands.",
     "moduli": "Storage and loss parts and the loss tangent of the data with each structure's "
               "posterior median and its 50 % and 90 % credible bands.",
+    "time_functions": "Relaxation modulus G(t) and creep compliance J(t) of each structure "
+                      "with credible bands; shaded: beyond the measured window.",
     "nyquist": "The same in the complex plane: posterior median curve and single posterior "
                "draws (thin lines).",
     "residuals": "Residuals of the data from the posterior median prediction, real and "

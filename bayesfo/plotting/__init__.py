@@ -18,6 +18,8 @@ Modules
 ``design``
     :func:`~bayesfo.plotting.design.plot_design`: the predictions over an instrument window
     with the proposed frequencies (:func:`bayesfo.design`).
+``material``
+    :func:`~bayesfo.plotting.material.plot_time_functions`: G(t) and J(t) with their bands.
 ``moduli``
     :func:`plot_moduli`: storage and loss parts (G′, G″ or J′, J″) and tan δ with the
     posterior bands.

@@ -111,6 +111,11 @@ def figure_caption(name: str, comparison) -> str | None:
                 f"{loss}/{storage} of the data (± 1 sd) with each structure's posterior median "
                 "and its 50 % and 90 % credible bands, on logarithmic axes (values that are not "
                 "positive are left out, and the legend says how many).")
+    if name == "time_functions":
+        return ("Relaxation modulus G(t) and creep compliance J(t) of each structure's posterior "
+                "(median, 50 % and 90 % credible bands), from the inverse Laplace transform of "
+                "the model; the data inform about t between 1/ω_max and 1/ω_min, and the shaded "
+                "stretches beyond are extrapolation. 'bayesfo predict' gives the numbers.")
     if name == "nyquist":
         if nyquist_form(comparison) == "log":
             return ("The same in the complex plane, log-magnitude form (|G| spans more than "

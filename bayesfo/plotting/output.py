@@ -10,6 +10,7 @@ from pathlib import Path
 from ..errors import InputError
 from ._compute import ok_results, order_parameter
 from .captions import file_stem
+from .material import plot_time_functions
 from .moduli import PARTS, plot_moduli
 from .posterior import plot_corner, plot_q_posteriors, plot_trace
 from .ranking import plot_ranking
@@ -61,11 +62,13 @@ def _combined_makers(comparison, seed: int) -> dict:
         "ranking": lambda: plot_ranking(comparison),
         "bode": lambda: plot_bode(comparison, seed=seed),
         "moduli": lambda: plot_moduli(comparison, seed=seed),
+        "time_functions": lambda: plot_time_functions(comparison, seed=seed),
         "nyquist": lambda: plot_nyquist(comparison, seed=seed),
         "residuals": lambda: plot_residuals(comparison, seed=seed),
     }
     if comparison.data.kind not in PARTS:  # a transfer function has no storage and loss parts
-        del makers["moduli"]
+        del makers["moduli"]  # nor a relaxation modulus and creep compliance
+        del makers["time_functions"]
     if any(order_parameter(r) is not None for r in ok_results(comparison)):
         makers["q_posteriors"] = lambda: plot_q_posteriors(comparison)
     return makers
@@ -262,7 +265,8 @@ def _draw_order(comparison, names) -> list[str]:
     0.86-0.96 s (4-5 parameters), q posteriors 0.72 s, Bode 0.62 s, ranking 0.56 s,
     residuals 0.50 s, trace 0.36-0.57 s, Nyquist 0.40 s."""
     n_params = {_file_stem(r.name): r.structure.n_params for r in ok_results(comparison)}
-    base = {"q_posteriors": 7.0, "bode": 6.0, "moduli": 6.0, "ranking": 5.5, "residuals": 5.0,
+    base = {"q_posteriors": 7.0, "bode": 6.0, "moduli": 6.0, "time_functions": 6.0,
+            "ranking": 5.5, "residuals": 5.0,
             "nyquist": 4.0}
 
     def cost(name: str) -> float:

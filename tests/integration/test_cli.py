@@ -147,7 +147,7 @@ def test_figure_formats_png_alone(run_cli, tmp_path):
     assert status == 0, err
     names = sorted(p.name for p in (out / "figures").iterdir())
     assert names == ["bode.png", "corner_voigt.png", "moduli.png", "nyquist.png", "q_posteriors.png",
-                     "ranking.png", "residuals.png", "trace_voigt.png"]
+                     "ranking.png", "residuals.png", "time_functions.png", "trace_voigt.png"]
     assert (out / "report.html").read_text().count("data:image/png;base64,") == len(names)
 
 

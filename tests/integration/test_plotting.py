@@ -178,6 +178,35 @@ def test_moduli_equal_the_storage_and_loss_parts_of_the_draws(comparison):
     assert 0 <= box.x0 and box.x1 <= drawn.figure.bbox.width
 
 
+def test_time_functions_are_the_inverse_transforms_of_the_draws(comparison):
+    """G(t) and J(t) bands equal the quantiles of bayesfo.predictions.evaluate over the draws;
+    the window the data inform is 1/ω_max … 1/ω_min, the grid a decade beyond each end."""
+    from bayesfo.plotting.material import plot_time_functions
+    from bayesfo.predictions import evaluate
+
+    drawn = plot_time_functions(comparison, n_draws=ALL)
+    t = drawn.values["time"]
+    w = comparison.data.omega
+    np.testing.assert_allclose(drawn.values["window"], [1 / w.max(), 1 / w.min()])
+    assert t[0] == pytest.approx(0.1 / w.max()) and t[-1] == pytest.approx(10 / w.min())
+    for name in comparison.ranking:
+        r = comparison[name]
+        for q in ("relaxation_modulus", "creep_compliance"):
+            v = evaluate(r.structure, _draws(r), q, t)
+            np.testing.assert_allclose(drawn.values[f"{name}/{q}_median"],
+                                       np.median(v, axis=0), rtol=1e-9)
+            np.testing.assert_allclose(drawn.values[f"{name}/{q}_q05"],
+                                       np.quantile(v, 0.05, axis=0), rtol=1e-9)
+        # A solid relaxes and creeps monotonically: G falls, J rises along t (to its plateau,
+        # where the inversion's rounding, 1e-13 relative, is all that changes).
+        g = drawn.values[f"{name}/relaxation_modulus_median"]
+        j = drawn.values[f"{name}/creep_compliance_median"]
+        assert np.all(np.diff(g) < 1e-9 * g[1:]) and np.all(np.diff(j) > -1e-9 * j[1:])
+        assert g[0] > 1.5 * g[-1] and j[-1] > 1.5 * j[0]
+    g_ax, j_ax = drawn.axes
+    assert g_ax.get_ylabel() == "G(t) [Pa]" and j_ax.get_ylabel() == "J(t) [1/Pa]"
+
+
 def test_moduli_refuse_a_transfer_function(comparison):
     from bayesfo.plotting.moduli import storage_loss
 
@@ -443,7 +472,8 @@ def test_write_figures_skips_failed_structures_and_closes_figures(comparison, tm
     before = plt.get_fignums()
     written = write_figures(with_failure, tmp_path, formats=("png",))
     assert plt.get_fignums() == before
-    expected = ["ranking", "bode", "moduli", "nyquist", "residuals", "q_posteriors"]
+    expected = ["ranking", "bode", "moduli", "time_functions", "nyquist", "residuals",
+                "q_posteriors"]
     for name in comparison.ranking:
         expected += [f"corner_{name}", f"trace_{name}"]
     assert list(written) == expected
@@ -457,7 +487,8 @@ def test_write_figures_single_structure_and_formats(comparison, tmp_path):
     single = replace(comparison, results=(comparison["zener-int"],))
     written = write_figures(single, tmp_path, formats=("png", "svg"))
     # No free order: no q figure.
-    assert list(written) == ["ranking", "bode", "moduli", "nyquist", "residuals", "corner_zener-int",
+    assert list(written) == ["ranking", "bode", "moduli", "time_functions", "nyquist", "residuals",
+                             "corner_zener-int",
                              "trace_zener-int"]
     assert all([p.suffix for p in paths] == [".png", ".svg"] for paths in written.values())
     with pytest.raises(InputError, match="'formats'.*'xyz'"):

@@ -1,0 +1,101 @@
+"""What follows from the models in the time domain: the relaxation modulus G(t) and the creep
+compliance J(t) of each structure's posterior, with credible bands.
+
+G(t) and J(t) are those of :func:`bayesfo.predict` (fixed-Talbot inversion of G*(s)/s and
+J*(s)/s for every draw; :mod:`bayesfo.predictions`), for thinned posterior draws. The times run
+from a tenth of 1/ω_max to ten times 1/ω_min; the data inform about 1/ω_max … 1/ω_min, and the
+stretches beyond are shaded as extrapolation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ._base import Drawn, new_figure
+from ._compute import N_DRAWS, legend_name, quantiles, select_results, structure_draws
+from ._legend import _legend
+from .response import _band, _band_handle
+from .style import COLUMN_WIDTH, comparison_styles
+
+#: Points of the time grid.
+N_TIMES = 120
+
+
+def time_grid(data, n: int = N_TIMES) -> np.ndarray:
+    """Log-spaced times [s] from 0.1/ω_max to 10/ω_min."""
+    return np.logspace(np.log10(0.1 / data.omega.max()), np.log10(10.0 / data.omega.min()), n)
+
+
+def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS,
+                        seed: int = 0) -> Drawn:
+    """The relaxation modulus G(t) and the creep compliance J(t) of each structure: posterior
+    median and 50 %/90 % bands, on logarithmic axes, the extrapolated times shaded.
+
+    Parameters
+    ----------
+    comparison : bayesfo.comparison.Comparison
+        Of modulus or compliance data.
+    structures : sequence of str, optional
+        Default: the best three by the ranking.
+    n_draws, seed : int
+        Posterior draws used (at most) and the seed of their choice.
+
+    Returns
+    -------
+    Drawn
+        ``axes`` = (G(t), J(t)). ``values``: ``"time"``, ``"window"`` (1/ω_max, 1/ω_min) and per
+        structure ``"<name>/relaxation_modulus_median"``, ``_q05``, ``_q25``, ``_q75``,
+        ``_q95`` and the same for ``creep_compliance``. ``artists``: the median lines under the
+        same keys.
+
+    Raises
+    ------
+    InputError
+        For generic (transfer-function) data, or an unknown or failed structure.
+    """
+    from ..predictions.functions import QUANTITIES, _evaluate, _unit
+
+    data = comparison.data
+    if data.kind not in ("modulus", "compliance"):
+        raise InputError("G(t) and J(t) are defined for modulus or compliance data, not for "
+                         f"{data.kind!r} data")
+    results = select_results(comparison, structures)
+    t = time_grid(data)
+    window = (1.0 / data.omega.max(), 1.0 / data.omega.min())
+    styles = comparison_styles(comparison)
+    values, artists = {"time": t, "window": np.array(window)}, {}
+    handles, labels = [], []
+    from .style import style
+
+    quantities = ("relaxation_modulus", "creep_compliance")
+    with style():
+        fig = new_figure(fig, (COLUMN_WIDTH, 4.4))
+        axes = fig.subplots(2, 1, sharex=True)
+        for r in results:
+            theta = structure_draws(r, n_draws, seed)
+            st = styles[r.name]
+            for ax, q in zip(axes, quantities, strict=True):
+                v = _evaluate(r.structure, theta, q, t)
+                v = np.where(np.isfinite(v), v, np.nan)
+                qs = quantiles(v)
+                for p, x in qs.items():
+                    values[f"{r.name}/{q}_" + ("median" if p == 0.5
+                                               else f"q{round(100 * p):02d}")] = x
+                shown = {p: np.where(x > 0, x, np.nan) for p, x in qs.items()}
+                _, _, line = _band(ax, t, shown, st)
+                artists[f"{r.name}/{q}_median"] = line
+            handles.append(_band_handle(st))
+            labels.append(legend_name(r))
+        for ax, q in zip(axes, quantities, strict=True):
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            u = _unit(q, data) if data.units else ""
+            ax.set_ylabel(QUANTITIES[q][1] + (f" [{u}]" if u else ""))
+            lo, hi = t[0], t[-1]
+            ax.axvspan(lo, window[0], color="0.93", lw=0, zorder=0)
+            ax.axvspan(window[1], hi, color="0.93", lw=0, zorder=0)
+            ax.set_xlim(lo, hi)
+        axes[-1].set_xlabel("t [s] (shaded: beyond the measured window)")
+        _legend(fig, handles, labels)
+    return Drawn.build(fig, axes, values, artists)

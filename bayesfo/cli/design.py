@@ -30,6 +30,10 @@ def add_parser(subparsers):
     p.add_argument("--cost", default="uniform", choices=("uniform", "low-frequency"),
                    help="low-frequency: choose by information per second of measuring time "
                         "(10 s plus three periods per point)")
+    p.add_argument("--parameter", metavar="NAME", default=None,
+                   help="instead of the model choice, the frequencies that best determine this "
+                        "parameter (e.g. alpha) of the best ranked structure, or of the one "
+                        "--structures names")
     p.add_argument("--figure", metavar="FILE.png", default=None,
                    help="draw the predictions over the window with the proposed points")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -58,6 +62,8 @@ def run(args) -> int:
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     structures = None if args.structures is None else [
         s.strip() for s in args.structures.split(",") if s.strip()]
+    if args.parameter is not None:
+        return _parameter(result, args, window, structures)
     try:
         plan = design(result, window=window, points=args.points, structures=structures,
                       cost=args.cost, seed=args.seed)
@@ -103,3 +109,31 @@ def _print(plan, figure) -> None:
         print(f"note: {n}")
     if figure is not None:
         print(f"wrote {figure}")
+
+
+def _parameter(result, args, window, structures) -> int:
+    """``--parameter``: the frequencies that best determine one parameter."""
+    from ..planning import design_parameter
+
+    if structures is not None and len(structures) != 1:
+        raise InputError("--parameter takes one structure: give --structures S with one name")
+    if args.figure is not None:
+        raise InputError("--figure draws the design of the model choice; leave it out with "
+                         "--parameter")
+    try:
+        plan = design_parameter(result, args.parameter,
+                                structure=structures[0] if structures else None, window=window,
+                                points=args.points, cost=args.cost, seed=args.seed)
+    except InputError as exc:
+        raise InputError(str(exc).replace("argument 'window'", "--window")
+                         .replace("argument 'points'", "--points")) from None
+    if args.json:
+        print(json.dumps(plan.to_dict(), indent=1))
+        return 0
+    print(f"{plan.parameter} of {plan.structure}: posterior sd now {plan.sd_now:.4g}")
+    print(f"window {plan.window[0]:.4g}-{plan.window[1]:.4g} rad/s; proposed measurements:")
+    print(f"{'#':>3} {'omega [rad/s]':>14} {'gain [nats]':>12} {'sd after':>11} {'time [s]':>9}")
+    for i, p in enumerate(plan.proposed):
+        print(f"{i + 1:>3} {p['omega']:14.4g} {p['gain']:12.3f} {p['sd_after']:11.4g} "
+              f"{p['seconds']:9.0f}")
+    return 0

@@ -173,6 +173,16 @@ def test_the_command_prints_and_writes_what_the_api_gives(compared, run_cli, tmp
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "proposed measurements" in text and f"wrote {figure}" in text
     assert "as many points by rules of thumb give" in text
+    status, text, err = run_cli("design", out / "run", "--parameter", "q", "--structures",
+                                "zener", "--points", "1", "--json")
+    assert status == 0, err
+    from bayesfo.planning import design_parameter
+
+    want = design_parameter(result, "q", structure="zener", points=1)
+    assert json.loads(text)["proposed"][0]["omega"] == want.proposed[0]["omega"]
+    status, _, err = run_cli("design", out / "run", "--parameter", "q", "--figure",
+                             tmp_path / "p.png")
+    assert status == 2 and "leave it out with --parameter" in err
     status, _, err = run_cli("design", out / "run", "--window", "10,1")
     assert status == 2 and "--window must have 0 < low < high" in err
     status, _, err = run_cli("design", out / "run", "--figure", tmp_path / "no" / "d.png")
@@ -223,3 +233,36 @@ def test_the_proposed_points_settle_the_choice_faster_than_rules_of_thumb():
             after[name] = log_b(np.r_[w, extra], np.r_[y, y2], np.r_[sd, sd2])[1]
         assert after["proposed"] > DECISIVE
         assert after["proposed"] > 2 * max(v for k, v in after.items() if k != "proposed")
+
+
+def test_a_parameter_is_best_measured_where_it_shows():
+    """Voigt, J = 1/(a1 s^q + b0) with a1 = b0 = 1: b0 (the spring) shows at the lowest
+    frequencies; a1 where ln|a1 s^q| does not also carry the spread of q ln ω, near ω = 1. The
+    expected posterior sd after one point agrees with an independent regression of the parameter
+    on measurements simulated from the draws (their residual variance)."""
+    from bayesfo.planning import design_parameter
+
+    a = _result("a", [1.0, 1.0, 0.5], 0.05, 0.0, n=2000, seed=5)
+    b = _result("b", [1.0, 1.0, 0.55], 0.05, -1.0, seed=6)
+    comp = _make(a, b)
+    spring = design_parameter(comp, "b0", window=(1e-4, 1e4), points=1)
+    springpot = design_parameter(comp, "a1", window=(1e-4, 1e4), points=1)
+    assert spring.structure == "a" and spring.proposed[0]["omega"] < 1e-2
+    assert 1e-2 < springpot.proposed[0]["omega"] < 1e2
+    for plan, column in ((spring, 1), (springpot, 0)):
+        p = plan.proposed[0]
+        assert p["sd_after"] < plan.sd_now
+        assert p["information"] == pytest.approx(-math.log(p["sd_after"] / plan.sd_now), rel=1e-6)
+        # Independent: regress the parameter on (ln|J|, arg J) measured at that frequency.
+        rng = np.random.default_rng(0)
+        theta = a.posterior.samples
+        j = get_structure("voigt").response(theta[:, :3], np.array([p["omega"]]),
+                                            "compliance")[:, 0]
+        y = np.column_stack([np.log(np.abs(j)), np.angle(j)])
+        y = y + 0.01 / np.sqrt(2) * rng.standard_normal(y.shape)
+        x = np.column_stack([np.ones(len(y)), y])
+        coef, *_ = np.linalg.lstsq(x, theta[:, column], rcond=None)
+        residual_sd = np.std(theta[:, column] - x @ coef)
+        assert p["sd_after"] == pytest.approx(residual_sd, rel=0.15)
+    with pytest.raises(InputError, match="has no parameter 'zz'; its parameters are a1, b0, q"):
+        design_parameter(comp, "zz")

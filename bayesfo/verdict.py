@@ -125,6 +125,9 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     failed = [r for r in comparison.results if r.error is not None]
     out: list[tuple[str, bool]] = [(f"Data: {w.split(': ', 1)[1]}.", True)
                                    for w in comparison.data_warnings]
+    kk = comparison.data.kramers_kronig()
+    if kk is not None and not kk.consistent:
+        out.append((f"Data: {kk.describe()}.", True))
     if not rows:
         return out + [("No structure could be run on these data.", True)]
     best = rows[0]

@@ -98,9 +98,10 @@ def _print(info: dict, seen: set | None = None) -> None:
             print(f"Kramers–Kronig: the two parts are consistent (F = {kk['chi2_per_dof']:.2f})")
         else:
             print(f"warning: the two parts are not consistent by the Kramers–Kronig relations "
-                  f"(F = {kk['chi2_per_dof']:.3g}, most at omega = {worst} rad/s): an instrument "
-                  "artefact (inertia, compliance), parts from different measurements, or a master "
-                  "curve whose isotherms do not superpose")
+                  f"(F = {kk['chi2_per_dof']:.3g}, most at omega = {worst} rad/s; the best "
+                  f"causal description misses them by {100 * kk['misfit_rms']:.2g} % rms): an "
+                  "instrument artefact (inertia, compliance), parts from different measurements, "
+                  "or a master curve whose isotherms do not superpose")
     if reading["format"] == "bayesfo CSV":
         print(f"read as bayesfo CSV: columns {', '.join(reading['columns'])}; "
               + (f"temperature {info['temperature_C']:g} °C ('# temperature:' line); "

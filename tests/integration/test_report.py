@@ -235,3 +235,25 @@ def test_verdict_names_a_springpot_models_order_alpha():
                      workers=1, seed=0, progress=False)
     texts = [t for t, _ in verdict(result) if "fractional order" in t]
     assert texts and "is α = " in texts[0] and "β" not in texts[0], texts
+
+
+def test_the_verdict_says_when_the_data_fail_the_kramers_kronig_test():
+    """G′ of one Zener with G″ of one relaxing three times slower: no causal structure can fit
+    both, and the verdict says so first, with the size of the inconsistency."""
+    w = np.logspace(-1, 2, 25)
+    z = get_structure("zener")
+    theta = [2.0, 1.0, 0.1, 0.6]
+    g = (z.response(theta, w, "modulus").real
+         + 1j * z.response([6.0, 1.0, 0.3, 0.6], w, "modulus").imag)
+    rng = np.random.default_rng(0)
+    g = g * (1 + 0.005 / np.sqrt(2) * (rng.normal(size=25) + 1j * rng.normal(size=25)))
+    data = FrequencyResponse(w, g, kind="modulus", units="Pa")
+    kk = data.kramers_kronig()
+    assert not kk.consistent
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        comparison = compare(data, [get_structure("zener")], seed=0, progress=False, workers=1)
+    sentences = verdict(comparison)
+    text, flagged = sentences[0]
+    assert flagged and text.startswith("Data: the real and imaginary parts are not consistent")
+    assert f"{100 * kk.misfit_rms:.2g} % rms" in text

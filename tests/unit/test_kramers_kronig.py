@@ -75,6 +75,28 @@ def test_too_few_points_have_no_test_and_the_blocks_are_written(run_cli, tmp_pat
     block = json.loads(out)["kramers_kronig"]
     assert status == 0 and block["consistent"] is True
     assert set(block) == {"consistent", "chi2_per_dof", "worst_frequencies", "noise",
-                          "n_elements"}
+                          "n_elements", "misfit_rms", "misfit_max"}
     status, out, _ = run_cli("inspect", path)
     assert "Kramers–Kronig: the two parts are consistent (F = " in out
+
+
+def test_the_size_of_the_inconsistency_is_stated():
+    """misfit_rms is the rms of |G_fit − G|/|G| of the causal fit: about the noise on consistent
+    data (1 % complex noise: the basis absorbs a few of the 50 numbers' worth), more where the
+    parts come from different responses, and the verdict's sentence gives both (the noise of
+    a 25-point, 1 % complex-noise set leaves a relative residual of 0.4-1.2 % rms)."""
+    rng = np.random.default_rng(3)
+    theta = _zener(rng)
+    g = ZENER.response(theta, W, "modulus")
+    y, _ = _noisy(g, rng)
+    ok = kramers_kronig(FrequencyResponse(W, y, kind="modulus"))
+    assert ok.consistent and 0.004 < ok.misfit_rms < 0.012 and ok.misfit_max < 0.03
+    slower = [theta[0] * 3, theta[1], theta[2] * 3, theta[3]]
+    mixed = g.real + 1j * ZENER.response(slower, W, "modulus").imag
+    y, _ = _noisy(mixed, rng)
+    bad = kramers_kronig(FrequencyResponse(W, y, kind="modulus"))
+    assert not bad.consistent and bad.misfit_rms > 2 * ok.misfit_rms
+    text = bad.describe()
+    assert f"{100 * bad.misfit_rms:.2g} % rms" in text and "not consistent" in text
+    assert bad.to_dict()["misfit_max"] == pytest.approx(bad.misfit_max)
+    assert "consistent by the Kramers–Kronig relations (F =" in ok.describe()

@@ -57,10 +57,18 @@ def plot_design(result, plan, *, fig=None, n_draws: int = 300, seed: int = 0) ->
         handles.append(data_line)
         labels.append("data")
         axes[2].plot(omega, plan.information, "-", color="0.2", lw=1.2)
+        groups = []  # proposals within a tenth of a decade share one label ("1,2")
         for i, p in enumerate(plan.proposed):
             for ax in axes:
                 ax.axvline(p["omega"], color="#CC3311", lw=0.9, ls="--", zorder=1)
-            axes[0].annotate(str(i + 1), (p["omega"], 1.0), xycoords=("data", "axes fraction"),
+            near = next((g for g in groups
+                         if abs(np.log10(p["omega"] / g[0])) < 0.1), None)
+            if near is None:
+                groups.append([p["omega"], str(i + 1)])
+            else:
+                near[1] += f",{i + 1}"
+        for w, text in groups:
+            axes[0].annotate(text, (w, 1.0), xycoords=("data", "axes fraction"),
                              ha="center", va="bottom", fontsize=7, color="#CC3311")
         for ax in axes:
             ax.axvspan(d.omega.min(), d.omega.max(), color="0.92", zorder=0, lw=0)

@@ -420,8 +420,14 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
         A parameter of the structure as sampled (``alpha``, ``q``, ``c_beta``, ...).
     structure : str, optional
         Default: the best ranked.
-    window, points, cost, seed
+    window : (float, float), optional
         As for :func:`design`.
+    points : int
+        As for :func:`design`.
+    cost : {"uniform", "low-frequency"}
+        As for :func:`design`.
+    seed : int
+        Seed of the choice of draws.
 
     Returns
     -------

@@ -119,9 +119,6 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     formats : sequence of str
         Figure file formats (default PNG, which the report embeds; add ``"pdf"`` for
         vector figures).
-    structure_figures : int or None
-        How many structures (the best by the ranking) get corner and trace figures (every one
-        for None).
     pool : concurrent.futures.Executor, optional
         Draw the figures in these worker processes (from :func:`process_pool`; a
         :class:`~bayesfo.parallel.LazyPool` whose processes were not started is not started
@@ -130,6 +127,9 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         Without a pool (or with a lazy pool not started): 2 draws the figures in this process
         and in one forked from it, which starts drawing while this one writes the NetCDF files
         (:func:`bayesfo.plotting.output.draw_forked`); 1 draws them here.
+    structure_figures : int or None
+        How many structures (the best by the ranking) get corner and trace figures (every one
+        for None).
 
     Returns
     -------

@@ -171,8 +171,6 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
         default (the report embeds it; each further format costs about as much again).
     seed : int
         Seed of the posterior draws behind the response figures.
-    structure_figures : int or None
-        How many structures (the best by the ranking) get corner and trace figures.
     pool : concurrent.futures.Executor, optional
         Worker processes that draw the figures side by side (e.g.
         :func:`bayesfo.parallel.process_pool`): the combined figures in two tasks, the figures
@@ -186,6 +184,8 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
     meanwhile : callable, optional
         Called once in this process before it draws (with two processes: while the forked one
         already draws), e.g. to write other files.
+    structure_figures : int or None
+        How many structures (the best by the ranking) get corner and trace figures.
 
     Returns
     -------

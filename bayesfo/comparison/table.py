@@ -32,8 +32,9 @@ def order_parameters(parameters) -> list[str]:
 
 def orders_text(parameters: dict, digits: int = 3) -> str:
     """Every fractional order of a structure record's ``parameters`` (``summary.json`` form)
-    by its symbol, as the posterior mean and 94 % HDI: ``"α 0.589 [0.586, 0.592]; β 0.128
-    [0.121, 0.135]"``; empty where the structure has none."""
+    by its symbol, as the posterior mean and 94 % HDI: ``"α 0.589 [0.586–0.592]; β 0.128
+    [0.121–0.135]"`` (no commas: one CSV cell readable without quoting); empty where the
+    structure has none."""
     parts = []
     for k in order_parameters(parameters):
         p = parameters[k] or {}
@@ -42,7 +43,7 @@ def orders_text(parameters: dict, digits: int = 3) -> str:
             continue
         text = f"{ORDER_SYMBOLS[k]} {mean:.{digits}f}"
         if lo is not None and hi is not None:
-            text += f" [{lo:.{digits}f}, {hi:.{digits}f}]"
+            text += f" [{lo:.{digits}f}–{hi:.{digits}f}]"
         parts.append(text)
     return "; ".join(parts)
 

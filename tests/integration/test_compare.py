@@ -380,4 +380,4 @@ def test_every_order_of_a_two_springpot_model_is_named(tmp_path):
                        if k in ("alpha", "beta", "delta")]
     assert "δ" in symbols or record["natural_form"] != "physical"
     d = block.get("delta") or block["beta"]
-    assert f"{d['mean']:.3f} [{d['hdi_low']:.3f}, {d['hdi_high']:.3f}]" in row["orders"]
+    assert f"{d['mean']:.3f} [{d['hdi_low']:.3f}–{d['hdi_high']:.3f}]" in row["orders"]

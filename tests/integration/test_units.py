@@ -169,7 +169,8 @@ def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_ru
     assert "," not in text  # one cell, readable without quoting
     # Every fractional order by its symbol, mean and 94 % HDI (the Zener has one, q).
     q = phys["q"]
-    assert row["orders"] == f"q {q['mean']:.3f} [{q['hdi_low']:.3f}, {q['hdi_high']:.3f}]"
+    assert row["orders"] == f"q {q['mean']:.3f} [{q['hdi_low']:.3f}–{q['hdi_high']:.3f}]"
+    assert "," not in row["orders"]
 
 
 def test_units_follow_the_data_units():

@@ -232,6 +232,26 @@ def _predictive(results, omega, kind, rel_sigma, rng) -> _Predictive:
     return _Predictive(np.stack([z[:n] for z in zs]), np.stack(noise))
 
 
+def _checked(data, window, points, cost) -> tuple[float, float]:
+    """The window (default: the data's, a decade wider on each side), after checking it,
+    ``points`` and ``cost``."""
+    if cost not in COSTS:
+        raise InputError(f"argument 'cost' must be one of {', '.join(COSTS)}, got {cost!r}")
+    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) \
+            or not 1 <= points <= 20:
+        raise InputError(f"argument 'points' must be an integer from 1 to 20, got {points!r}")
+    if window is None:
+        window = (float(data.omega.min()) / 10.0, float(data.omega.max()) * 10.0)
+    try:
+        w_lo, w_hi = (float(w) for w in window)
+    except (TypeError, ValueError):
+        raise InputError(f"argument 'window' must be two frequencies (low, high) in rad/s, "
+                         f"got {window!r}") from None
+    if not (0 < w_lo < w_hi and math.isfinite(w_hi)):
+        raise InputError(f"argument 'window' must have 0 < low < high, got ({w_lo:g}, {w_hi:g})")
+    return w_lo, w_hi
+
+
 def design(result, *, window=None, points: int = 3, structures=None, cost: str = "uniform",
            seed: int = 0) -> Design:
     """The frequencies to measure next to tell the structures of ``result`` apart.
@@ -262,21 +282,9 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         Fewer than two structures to tell apart, a window that is not two positive increasing
         frequencies, an unknown cost or structure.
     """
-    if cost not in COSTS:
-        raise InputError(f"argument 'cost' must be one of {', '.join(COSTS)}, got {cost!r}")
-    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or not 1 <= points <= 20:
-        raise InputError(f"argument 'points' must be an integer from 1 to 20, got {points!r}")
     data = result.data
     lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
-    if window is None:
-        window = (lo_d / 10.0, hi_d * 10.0)
-    try:
-        w_lo, w_hi = (float(w) for w in window)
-    except (TypeError, ValueError):
-        raise InputError(f"argument 'window' must be two frequencies (low, high) in rad/s, "
-                         f"got {window!r}") from None
-    if not (0 < w_lo < w_hi and math.isfinite(w_hi)):
-        raise InputError(f"argument 'window' must have 0 < low < high, got ({w_lo:g}, {w_hi:g})")
+    w_lo, w_hi = _checked(data, window, points, cost)
     ranked = [result[n] for n in result.ranking]
     if structures is not None:
         names = [structures] if isinstance(structures, str) else list(structures)
@@ -438,10 +446,7 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
     InputError
         An unknown structure or parameter, or a bad window, count or cost.
     """
-    if cost not in COSTS:
-        raise InputError(f"argument 'cost' must be one of {', '.join(COSTS)}, got {cost!r}")
-    if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or not 1 <= points <= 20:
-        raise InputError(f"argument 'points' must be an integer from 1 to 20, got {points!r}")
+    w_lo, w_hi = _checked(result.data, window, points, cost)
     name = structure or (result.ranking[0] if result.ranking else None)
     if name not in result.ranking:
         raise InputError(f"design: no structure '{name}' with a posterior in the comparison; it "
@@ -452,10 +457,6 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
         raise InputError(f"design: structure {name} has no parameter '{parameter}'; its "
                          f"parameters are {', '.join(post.param_names[: r.structure.n_params])}")
     data = result.data
-    lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
-    w_lo, w_hi = (lo_d / 10.0, hi_d * 10.0) if window is None else (float(w) for w in window)
-    if not (0 < w_lo < w_hi and math.isfinite(w_hi)):
-        raise InputError(f"argument 'window' must have 0 < low < high, got ({w_lo:g}, {w_hi:g})")
     omega = np.logspace(math.log10(w_lo), math.log10(w_hi), N_CANDIDATES)
     rel = (float(np.median(data.sigma / np.abs(data.response))) if data.sigma is not None
            else math.nan)

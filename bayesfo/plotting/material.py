@@ -13,9 +13,9 @@ import numpy as np
 
 from ..errors import InputError
 from ._base import Drawn, new_figure
-from ._compute import N_DRAWS, legend_name, quantiles, select_results, structure_draws
+from ._compute import N_DRAWS, legend_name, select_results, structure_draws
 from ._legend import _legend
-from .response import _band, _band_handle
+from .response import _band_handle, positive_band
 from .style import COLUMN_WIDTH, comparison_styles
 
 #: Points of the time grid.
@@ -47,7 +47,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
         ``axes`` = (G(t), J(t)). ``values``: ``"time"``, ``"window"`` (1/ω_max, 1/ω_min) and per
         structure ``"<name>/relaxation_modulus_median"``, ``_q05``, ``_q25``, ``_q75``,
         ``_q95`` and the same for ``creep_compliance``. ``artists``: the median lines under the
-        same keys.
+        same keys, and the bands (``_band50``, ``_band90``).
 
     Raises
     ------
@@ -77,14 +77,8 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
             st = styles[r.name]
             for ax, q in zip(axes, quantities, strict=True):
                 v = _evaluate(r.structure, theta, q, t)
-                v = np.where(np.isfinite(v), v, np.nan)
-                qs = quantiles(v)
-                for p, x in qs.items():
-                    values[f"{r.name}/{q}_" + ("median" if p == 0.5
-                                               else f"q{round(100 * p):02d}")] = x
-                shown = {p: np.where(x > 0, x, np.nan) for p, x in qs.items()}
-                _, _, line = _band(ax, t, shown, st)
-                artists[f"{r.name}/{q}_median"] = line
+                positive_band(ax, t, np.where(np.isfinite(v), v, np.nan), st, r.name, q,
+                              values, artists)
             handles.append(_band_handle(st))
             labels.append(legend_name(r))
         for ax, q in zip(axes, quantities, strict=True):

@@ -26,12 +26,11 @@ from ._compute import (
     N_GRID,
     legend_name,
     omega_grid,
-    quantiles,
     response_draws,
     select_results,
 )
 from ._legend import _legend, _note_artists
-from .response import DATA_STYLE, HOLDOUT_STYLE, OMEGA_LABEL, _band, _band_handle
+from .response import DATA_STYLE, HOLDOUT_STYLE, OMEGA_LABEL, _band_handle, positive_band
 from .style import COLUMN_WIDTH, comparison_styles, unit_suffix
 
 #: Symbols of the panels for each kind of data: (storage, loss).
@@ -129,17 +128,7 @@ def plot_moduli(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS
                 curves = (storage, loss, loss / storage)
             st = styles[r.name]
             for ax, quantity, x in zip(axes, QUANTITIES, curves, strict=True):
-                qs = quantiles(x)
-                for p, v in qs.items():
-                    values[f"{r.name}/{quantity}_" + ("median" if p == 0.5
-                                                      else f"q{round(100 * p):02d}")] = v
-                # Where a draw's part is not positive (a misfitting structure), the log axis
-                # leaves that stretch of the band out.
-                shown = {p: np.where(v > 0, v, np.nan) for p, v in qs.items()}
-                outer, inner, line = _band(ax, omega, shown, st)
-                artists[f"{r.name}/{quantity}_band90"] = outer
-                artists[f"{r.name}/{quantity}_band50"] = inner
-                artists[f"{r.name}/{quantity}_median"] = line
+                positive_band(ax, omega, x, st, r.name, quantity, values, artists)
             handles.append(_band_handle(st))
             labels.append(legend_name(r))
         left_out = 0

@@ -72,6 +72,21 @@ def _band(ax, x, qs, st):
     return outer, inner, line
 
 
+def positive_band(ax, x, draws, st, name: str, quantity: str, values: dict,
+                  artists: dict) -> None:
+    """The quantiles of ``draws`` (draws × len(x)) under ``values["<name>/<quantity>_..."]``,
+    and their bands and median on ``ax`` (a log axis: where a quantile is not positive, a
+    misfitting structure's, that stretch is left out) under ``artists``."""
+    qs = quantiles(draws)
+    for p, v in qs.items():
+        values[_key(name, quantity, p)] = v
+    shown = {p: np.where(v > 0, v, np.nan) for p, v in qs.items()}
+    outer, inner, line = _band(ax, x, shown, st)
+    artists[f"{name}/{quantity}_band90"] = outer
+    artists[f"{name}/{quantity}_band50"] = inner
+    artists[f"{name}/{quantity}_median"] = line
+
+
 def _band_handle(st):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch

@@ -30,13 +30,13 @@ an element invisible in the window (its coefficient free down to its prior bound
 over its whole range) or two springpots of nearly equal order, where the roles of the elements
 can be exchanged (the "c_α dominant" and "c_β dominant" configurations of a two-springpot model
 under β ≤ α). A simulation-based calibration found them in two-springpot posteriors certified
-by the weights alone, missing up to half of the reference posterior's mass. The certificate
-therefore has a second part: where the weighted draws leave a fractional order undetermined
-(its central 94 % interval spans more than :data:`UNDETERMINED` of its prior range), the
-proposal built at the optima is not trusted to cover the configurations this allows, and the
-structure goes to the tempered ladder, whose independent runs start from the prior (and whose
-agreement certifies them). A posterior whose orders are determined keeps the fast route at no
-extra cost.
+by the weights alone, missing a large part of a reference posterior's mass (BENCHMARKS.md).
+The certificate therefore has a second part: where the weighted draws leave a fractional order
+undetermined (its central 94 % interval spans more than :data:`UNDETERMINED` of its prior
+range), the proposal built at the optima is not trusted to cover the configurations this allows,
+and the structure goes to the tempered ladder, whose independent runs start from the prior
+(and whose agreement certifies them). A posterior whose orders are determined keeps the fast
+route at no extra cost.
 """
 
 from __future__ import annotations
@@ -328,7 +328,7 @@ def _widest(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray) -> tuple[str, flo
             continue
         order = np.argsort(x[:, j])
         cdf = np.cumsum(w[order])
-        lo, hi = (x[order[min(np.searchsorted(cdf, p), cdf.size - 1)], j] for p in (0.03, 0.97))
+        lo, hi = (x[order[min(np.searchsorted(cdf, q), cdf.size - 1)], j] for q in (0.03, 0.97))
         if (hi - lo) / span[j] > share:
             best, share = name, float((hi - lo) / span[j])
     return best, share

@@ -144,6 +144,20 @@ def owned_entries(out_dir) -> list[str]:
             if is_output_name(name) and os.path.lexists(out_dir / name)]
 
 
+def _unrecorded(out_dir: Path, new) -> None:
+    """Warn of the output-named files left from an earlier run whose record is unreadable: they
+    cannot be told apart from a user's own, so they are left in place, and said so."""
+    import warnings
+
+    left = sorted(n for n in os.listdir(out_dir)
+                  if is_output_name(n) and n not in new and not n.startswith("."))
+    if left:
+        warnings.warn(
+            f"'{out_dir / MANIFEST}' (the record of the earlier run) is unreadable, so its files "
+            f"cannot be told from others: {', '.join(repr(n) for n in left)} left in place; "
+            "remove them by hand if they are that run's outputs", RuntimeWarning, stacklevel=4)
+
+
 def _real_directory(path: Path) -> bool:
     return path.is_dir() and not path.is_symlink()
 
@@ -412,6 +426,8 @@ def staged_run(out_dir):
                     "bayesfo would replace it: move it away or choose another output directory")
             if os.path.lexists(out_dir / MANIFEST):
                 old.append(MANIFEST)
+                if not isinstance(_read_json(out_dir / MANIFEST), dict):
+                    _unrecorded(out_dir, new)
             # From the journal on, the swap only renames (milliseconds): Ctrl-C and SIGTERM
             # wait until it is done, and a SIGKILL in between is completed by the next run.
             with held():

@@ -701,3 +701,31 @@ def _zener_points():
     g = get_structure("zener").response([10.0, 1.0, 0.1, 0.6], w, "modulus")
     rng = np.random.default_rng(0)
     return w, g * (1 + 0.01 * (rng.normal(size=w.size) + 1j * rng.normal(size=w.size)))
+
+
+def test_an_unreadable_record_leaves_the_earlier_files_in_place_and_says_so(tmp_path):
+    """With the earlier run's manifest corrupt, its files cannot be told from a user's: a run
+    with fewer structures leaves them in place (nothing a user made is lost) and warns, naming
+    them; with the manifest intact they are removed as that run's."""
+    import warnings
+
+    from bayesfo.outdir import MANIFEST, staged_run
+
+    def run(out, names):
+        with staged_run(out) as stage:
+            for name in names:
+                (stage / name).write_text(name)
+
+    for corrupt in (False, True):
+        out = tmp_path / f"out{corrupt}"
+        run(out, ["summary.json", "voigt.nc", "zener.nc"])
+        if corrupt:
+            (out / MANIFEST).write_text("{not json")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            run(out, ["summary.json", "voigt.nc"])
+        messages = [str(w.message) for w in caught]
+        assert (out / "zener.nc").exists() == corrupt
+        assert any("is unreadable" in m and "'zener.nc' left in place" in m
+                   for m in messages) == corrupt
+        assert (out / "voigt.nc").read_text() == "voigt.nc"

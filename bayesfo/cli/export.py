@@ -20,8 +20,12 @@ def add_parser(subparsers):
                    help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY) or ansys "
                         "(TB,PRONY with TBDATA)")
     p.add_argument("--out", required=True, metavar="FILE", help="the file to write")
-    p.add_argument("--per-decade", type=int, default=2, metavar="K",
-                   help="relaxation times per decade (default 2)")
+    many = p.add_mutually_exclusive_group()
+    many.add_argument("--per-decade", type=int, default=2, metavar="K",
+                      help="relaxation times per decade (default 2)")
+    many.add_argument("--terms", type=int, default=None, metavar="N",
+                      help="the number of relaxation times instead (2-100, log-spaced over the "
+                           "same span; terms of zero weight are dropped)")
     p.add_argument("--liquid", action="store_true", help="G_inf = 0: the material relaxes fully")
     who = p.add_mutually_exclusive_group()
     who.add_argument("--structure", metavar="S", help="the structure (default: the best ranked)")
@@ -39,10 +43,12 @@ def run(args) -> int:
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     try:
         prony = prony_series(result, per_decade=args.per_decade, liquid=args.liquid,
-                             structure=args.structure, average=args.average, seed=args.seed)
+                             structure=args.structure, average=args.average, seed=args.seed,
+                             terms=args.terms)
     except InputError as exc:  # the API's words, in the command line's
         raise InputError(str(exc).replace("predict: ", "", 1).replace("export: ", "", 1)
-                         .replace("terms per decade", "--per-decade")) from None
+                         .replace("terms per decade", "--per-decade")
+                         .replace("the number of terms", "--terms")) from None
     try:
         atomic_write_text(args.out, prony.text(args.format))
     except OSError as exc:
@@ -53,6 +59,8 @@ def run(args) -> int:
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
           f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
     if error > prony.band_rel_halfwidth:
+        more = (f"--terms {min(100, 2 * args.terms)}" if args.terms is not None
+                else f"--per-decade {min(10, 2 * args.per_decade)}")
         print(f"note: the series departs from the model by more than the model's uncertainty; "
-              f"more terms (--per-decade {min(10, 2 * args.per_decade)}) may help")
+              f"more terms ({more}) may help")
     return 0

@@ -112,7 +112,7 @@ class Prony:
 
 def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
                  structure: str | None = None, average: str | None = None,
-                 seed: int = 0) -> Prony:
+                 seed: int = 0, terms: int | None = None) -> Prony:
     """A Prony series fitted to a comparison's structure (default the best ranked) or average.
 
     Parameters
@@ -128,6 +128,10 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
         An average over the structures instead, as in :func:`bayesfo.predict`.
     seed : int
         Seeds the draws used.
+    terms : int, optional
+        The number of relaxation times (2 to 100, log-spaced over the same span) instead of
+        ``per_decade``; terms whose weight comes out zero are dropped, so the series may have
+        fewer.
 
     Returns
     -------
@@ -140,6 +144,10 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     if isinstance(per_decade, bool) or not isinstance(per_decade, int) or not 1 <= per_decade <= 10:
         raise InputError(f"export: terms per decade must be an integer from 1 to 10, got "
                          f"{per_decade!r}")
+    if terms is not None and (isinstance(terms, bool) or not isinstance(terms, int)
+                              or not 2 <= terms <= 100):
+        raise InputError(f"export: the number of terms must be an integer from 2 to 100, got "
+                         f"{terms!r}")
     w_lo, w_hi = float(np.min(result.data.omega)), float(np.max(result.data.omega))
     omega = np.logspace(math.log10(w_lo) - 1, math.log10(w_hi) + 1,
                         int(20 * (math.log10(w_hi / w_lo) + 2)) + 1)
@@ -152,7 +160,7 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     # The terms reach TAU_MARGIN decades past the window: a power-law spectrum (a springpot)
     # relaxes over every decade, and terms only over the window leave its edges short.
     lo_tau, hi_tau = 1 / (w_hi * 10**TAU_MARGIN), 10**TAU_MARGIN / w_lo
-    n = int(round(math.log10(hi_tau / lo_tau) * per_decade)) + 1
+    n = terms if terms is not None else int(round(math.log10(hi_tau / lo_tau) * per_decade)) + 1
     tau = np.logspace(math.log10(lo_tau), math.log10(hi_tau), n)
     s = 1j * omega[:, None] * tau
     basis = s / (1 + s)

@@ -86,6 +86,28 @@ def test_the_series_stands_for_the_model_within_its_band(written):
     assert prony.g_0 == pytest.approx(prony.g_inf + prony.g.sum())
 
 
+def test_a_number_of_terms_instead_of_terms_per_decade(written, tmp_path, run_cli):
+    """--terms N: N relaxation times over the span of the per-decade grid (those of zero weight
+    dropped), the first and last at its ends; more terms fit at least as well."""
+    result, out = written
+    few, many = prony_series(result, terms=4), prony_series(result, terms=24)
+    span = prony_series(result, per_decade=10)
+    assert few.tau.size <= 4 and many.tau.size <= 24
+    assert few.tau.min() >= span.tau.min() * (1 - 1e-9)
+    assert few.max_rel_error_modulus >= many.max_rel_error_modulus
+    status, text, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "p.csv",
+                                "--terms", "24")
+    assert status == 0, err
+    tau, g, _ = parse((tmp_path / "p.csv").read_text(), "csv")
+    np.testing.assert_allclose(tau, many.tau, rtol=1e-9)
+    status, _, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "q.csv",
+                             "--terms", "1")
+    assert status == 2 and "--terms must be an integer from 2 to 100, got 1" in err
+    status, _, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "q.csv",
+                             "--terms", "5", "--per-decade", "3")
+    assert status == 2 and "not allowed with argument" in err
+
+
 def test_a_liquid_relaxes_fully(written):
     result, _ = written
     prony = prony_series(result, structure="maxwell-int", liquid=True)

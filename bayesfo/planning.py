@@ -63,6 +63,10 @@ MAX_STRUCTURES = 4
 #: Measuring time of a sweep point at ω: SETTLE_S + PERIODS · 2π/ω seconds.
 SETTLE_S = 10.0
 PERIODS = 3.0
+#: A further point is proposed only where it adds at least this much information [nats], and
+#: this share of the entropy still missing: below, it would cost measuring time for nothing.
+NEGLIGIBLE = 1e-3
+NEGLIGIBLE_SHARE = 0.01
 #: |ln B| beyond which the evidence is decisive (Jeffreys: B > 100).
 DECISIVE = math.log(100.0)
 COSTS = ("uniform", "low-frequency")
@@ -80,7 +84,8 @@ class Design:
         Expected information of one measurement at each candidate [nats].
     proposed : tuple of dict
         The chosen points in the order chosen: ``omega``, ``information`` (of the set so far,
-        nats), ``gain`` (what this point added), ``seconds`` (its measuring time).
+        nats), ``gain`` (what this point added), ``seconds`` (its measuring time). Fewer than
+        asked where no further point adds measurable information (a note says so).
     structures : tuple of str
         The structures considered (probability ≥ :data:`MIN_PROBABILITY`), best first.
     probabilities : tuple of float
@@ -102,6 +107,8 @@ class Design:
     window : tuple of float
     cost : str
     notes : tuple of str
+    asked : int
+        The number of points asked for (the rules of thumb place as many).
     """
 
     omega: np.ndarray = field(repr=False)
@@ -118,10 +125,11 @@ class Design:
     window: tuple[float, float]
     cost: str
     notes: tuple[str, ...] = ()
+    asked: int = 0
 
     def to_dict(self) -> dict:
         """The design as JSON (``bayesfo design --json``)."""
-        return {"window": list(self.window), "cost": self.cost,
+        return {"window": list(self.window), "cost": self.cost, "points_asked": self.asked,
                 "structures": dict(zip(self.structures, self.probabilities, strict=True)),
                 "entropy": self.entropy,
                 "proposed": [dict(p) for p in self.proposed],
@@ -338,8 +346,13 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         sets = np.array([chosen + [j] for j in c])
         info, _ = pred.information(sets, log_prior, rng)
         gains = info - info_so_far
+        gains[chosen] = -np.inf  # distinct frequencies, as a sweep measures them
+        if chosen and gains.max() < max(NEGLIGIBLE, NEGLIGIBLE_SHARE * entropy):
+            notes.append(f"after {len(chosen)} point(s) no further frequency of the window "
+                         "adds measurable information: the rest of the choice lies beyond the "
+                         "window's reach")
+            break
         score = gains / time if cost == "low-frequency" else gains
-        score[chosen] = -np.inf  # distinct frequencies, as a sweep measures them
         j = int(np.argmax(score))
         # A point cannot remove information: a negative gain is Monte Carlo noise about none.
         total = max(float(info[j]), info_so_far)
@@ -370,7 +383,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
                   entropy=entropy, leading=(results[0].name, results[1].name),
                   log_bayes_factor=float(ln_b), expected_change=expected,
                   p_decisive=p_decisive, alternatives=alternatives, window=(w_lo, w_hi),
-                  cost=cost, notes=tuple(notes))
+                  cost=cost, notes=tuple(notes), asked=int(points))
 
 
 @dataclass(frozen=True)

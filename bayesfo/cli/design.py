@@ -100,7 +100,8 @@ def _print(plan, figure) -> None:
               f"{p['seconds']:9.0f}")
     total = plan.proposed[-1]["information"]
     others = ", ".join(f"{k} {v:.3f}" for k, v in plan.alternatives.items())
-    print(f"as many points by rules of thumb give: {others} nats (proposed: {total:.3f})")
+    print(f"{plan.asked} point(s) by rules of thumb give: {others} nats (proposed: "
+          f"{total:.3f})")
     a, b = plan.leading
     print(f"{a} against {b}: ln B now {plan.log_bayes_factor:+.2f}; expected change "
           f"{plan.expected_change[a]:+.2f} if {a} is right, {plan.expected_change[b]:+.2f} if "

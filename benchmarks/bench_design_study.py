@@ -64,13 +64,17 @@ def main() -> None:
     for s, seed in enumerate((1, 2, 3)):
         for name, rule in rules.items():
             for k in (1, 2, 3):
+                if name == "proposed" and k > len(plan.proposed):
+                    table[name][s, k - 1] = np.nan  # the design proposes no more
+                    continue
                 extra = rule(k)
                 y2, sd2 = simulate(extra, np.random.default_rng(100 * seed + k))
                 table[name][s, k - 1] = log_b(np.r_[w, extra], np.r_[y, y2], np.r_[sd, sd2])[1]
     print(f"{'points':>14} {'k=1':>18} {'k=2':>18} {'k=3':>18}   (ln B, min-max over 3 seeds)")
     for name, v in table.items():
-        print(f"{name:>14} " + " ".join(f"{v[:, k].min():8.1f}–{v[:, k].max():<8.1f}"
-                                        for k in range(3)))
+        print(f"{name:>14} " + " ".join(
+            f"{v[:, k].min():8.1f}–{v[:, k].max():<8.1f}" if np.isfinite(v[:, k]).all()
+            else f"{'(none)':>17}" for k in range(3)))
     print(f"{time.perf_counter() - t0:.0f} s")
     if args.figure:
         import matplotlib
@@ -84,14 +88,15 @@ def main() -> None:
         with style():
             fig, ax = plt.subplots(figsize=(COLUMN_WIDTH, 2.8), layout="constrained")
             for name, v in table.items():
-                ax.errorbar([1, 2, 3], np.median(v, axis=0),
-                            yerr=[np.median(v, 0) - v.min(0), v.max(0) - np.median(v, 0)],
+                k = np.flatnonzero(np.isfinite(v).all(axis=0))
+                m = np.median(v[:, k], axis=0)
+                ax.errorbar(k + 1, m, yerr=[m - v[:, k].min(0), v[:, k].max(0) - m],
                             marker="o", ms=3, capsize=2, label=name)
             ax.axhline(np.log(100), color="0.4", lw=0.7, ls=":")
             ax.text(3.05, np.log(100), "decisive", fontsize=6.5, va="center", color="0.3")
             # ln B stays positive in this study (the truth is the Zener): a log axis.
             ax.set_yscale("log")
-            ax.set_ylim(0.3, 2 * max(v.max() for v in table.values()))
+            ax.set_ylim(0.3, 2 * max(np.nanmax(v) for v in table.values()))
             ax.set_xlim(0.8, 3.5)
             ax.set_xticks([1, 2, 3])
             ax.set_xlabel("points added")

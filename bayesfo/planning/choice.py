@@ -33,9 +33,9 @@ For the two leading structures the result states what the proposed points would 
 log Bayes factor: its expected change if either is true, and the probability (under the current
 model probabilities) that after them it is decisive, |ln B| > ln 100.
 
-:func:`design_parameter` answers the same for one parameter of one structure (e.g. the order α
-of the leading structure): the expected information about it, and its expected posterior sd
-after the proposed points.
+:func:`~bayesfo.planning.parameter.design_parameter` answers the same for one parameter of one
+structure (e.g. the order α of the leading structure): the expected information about it, and
+its expected posterior sd after the proposed points.
 """
 
 from __future__ import annotations
@@ -46,9 +46,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import logsumexp
 
-from .errors import InputError
+from ..errors import InputError
 
-__all__ = ["COSTS", "Design", "ParameterDesign", "design", "design_parameter", "seconds"]
+__all__ = ["COSTS", "Design", "design", "seconds"]
 
 #: Draws of each structure's posterior used (half simulate y, half give its density).
 N_DRAWS = 160
@@ -384,143 +384,3 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
                   log_bayes_factor=float(ln_b), expected_change=expected,
                   p_decisive=p_decisive, alternatives=alternatives, window=(w_lo, w_hi),
                   cost=cost, notes=tuple(notes), asked=int(points))
-
-
-@dataclass(frozen=True)
-class ParameterDesign:
-    """The proposed measurements for one parameter (:func:`design_parameter`).
-
-    Attributes
-    ----------
-    structure, parameter : str
-    omega : ndarray
-        The candidate frequencies [rad/s].
-    information : ndarray
-        Expected information about the parameter of one measurement at each candidate [nats].
-    proposed : tuple of dict
-        The chosen points in the order chosen: ``omega``, ``information`` (of the set so far),
-        ``gain``, ``seconds``, ``sd_after`` (the parameter's expected posterior sd after the set).
-    sd_now : float
-        The parameter's posterior sd now.
-    window : tuple of float
-    cost : str
-    """
-
-    structure: str
-    parameter: str
-    omega: np.ndarray = field(repr=False)
-    information: np.ndarray = field(repr=False)
-    proposed: tuple
-    sd_now: float
-    window: tuple[float, float]
-    cost: str
-
-    def to_dict(self) -> dict:
-        return {"structure": self.structure, "parameter": self.parameter,
-                "window": list(self.window), "cost": self.cost, "sd_now": self.sd_now,
-                "proposed": [dict(p) for p in self.proposed],
-                "candidates": {"omega": self.omega.tolist(),
-                               "information": self.information.tolist()}}
-
-
-def design_parameter(result, parameter: str, *, structure: str | None = None, window=None,
-                     points: int = 3, cost: str = "uniform", seed: int = 0) -> ParameterDesign:
-    """The frequencies whose measurement would best determine one parameter of one structure
-    (e.g. the order α of the leading structure).
-
-    The parameter's posterior draws and the structure's predictive of a set of measurements
-    (as for :func:`design`, in ln|G| and arg G with the noise) are taken as jointly normal; the
-    expected information about the parameter is then −½ ln(1 − cᵀC⁻¹c/σ²), with C the
-    predictive covariance of the set, c its covariance with the parameter and σ² the parameter's
-    variance, and the parameter's expected posterior variance after the set σ² − cᵀC⁻¹c.
-
-    Parameters
-    ----------
-    result : Comparison
-    parameter : str
-        A parameter of the structure as sampled (``alpha``, ``q``, ``c_beta``, ...).
-    structure : str, optional
-        Default: the best ranked.
-    window : (float, float), optional
-        As for :func:`design`.
-    points : int
-        As for :func:`design`.
-    cost : {"uniform", "low-frequency"}
-        As for :func:`design`.
-    seed : int
-        Seed of the choice of draws.
-
-    Returns
-    -------
-    ParameterDesign
-
-    Raises
-    ------
-    InputError
-        An unknown structure or parameter, or a bad window, count or cost.
-    """
-    w_lo, w_hi = _checked(result.data, window, points, cost)
-    name = structure or (result.ranking[0] if result.ranking else None)
-    if name not in result.ranking:
-        raise InputError(f"design: no structure '{name}' with a posterior in the comparison; it "
-                         f"has {', '.join(result.ranking)}")
-    r = result[name]
-    post = r.posterior
-    if parameter not in post.param_names[: r.structure.n_params]:
-        raise InputError(f"design: structure {name} has no parameter '{parameter}'; its "
-                         f"parameters are {', '.join(post.param_names[: r.structure.n_params])}")
-    data = result.data
-    omega = np.logspace(math.log10(w_lo), math.log10(w_hi), N_CANDIDATES)
-    rel = (float(np.median(data.sigma / np.abs(data.response))) if data.sigma is not None
-           else math.nan)
-    rng = np.random.default_rng(seed)
-    pick = rng.choice(post.samples.shape[0], size=min(4 * N_DRAWS, post.samples.shape[0]),
-                      replace=False)
-    draws = post.samples[pick]
-    k = r.structure.n_params
-    with np.errstate(all="ignore"):
-        g = r.structure.response(draws[:, :k], omega, data.kind)
-    ok = np.all(np.isfinite(g) & (g != 0), axis=1)
-    draws, g = draws[ok], g[ok]
-    if len(draws) < 20:
-        raise InputError("design: too few posterior draws with a finite response in the window")
-    z = np.stack([np.log(np.abs(g)), np.angle(g)], axis=-1)  # (S, C, 2)
-    noise = _noise_var(r, draws, g, rel).mean(axis=0)  # (C, 2)
-    theta = draws[:, post.param_names.index(parameter)]
-    var = float(np.var(theta, ddof=1))
-    time = seconds(omega)
-
-    def explained(sets):
-        """cᵀC⁻¹c of every candidate set (n_sets, k)."""
-        n_sets, m = sets.shape
-        zz = z[:, sets, :].reshape(len(theta), n_sets, 2 * m)
-        dev = zz - zz.mean(axis=0)
-        cov = np.einsum("snd,sne->nde", dev, dev) / (len(theta) - 1)
-        idx = np.arange(2 * m)
-        cov[:, idx, idx] += noise[sets, :].reshape(n_sets, 2 * m)
-        c = np.einsum("snd,s->nd", dev, theta - theta.mean()) / (len(theta) - 1)
-        return np.einsum("nd,nd->n", c, np.linalg.solve(cov, c[..., None])[..., 0])
-
-    def info(sets):
-        frac = np.clip(explained(sets) / var, 0.0, 1.0 - 1e-12) if var > 0 else 0.0
-        return -0.5 * np.log1p(-frac)
-
-    cand = np.arange(omega.size)
-    single = info(cand[:, None])
-    chosen, proposed, so_far = [], [], 0.0
-    for _ in range(points):
-        sets = np.array([chosen + [j] for j in cand])
-        total = info(sets)
-        gains = total - so_far
-        score = gains / time if cost == "low-frequency" else gains
-        score[chosen] = -np.inf
-        j = int(np.argmax(score))
-        best = max(float(total[j]), so_far)
-        chosen.append(j)
-        sd_after = math.sqrt(max(var - float(explained(np.array([chosen]))[0]), 0.0))
-        proposed.append({"omega": float(omega[j]), "information": best, "gain": best - so_far,
-                         "seconds": float(time[j]), "sd_after": sd_after})
-        so_far = best
-    return ParameterDesign(structure=name, parameter=parameter, omega=omega, information=single,
-                           proposed=tuple(proposed), sd_now=math.sqrt(var),
-                           window=(w_lo, w_hi), cost=cost)

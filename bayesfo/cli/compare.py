@@ -10,7 +10,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..options import check_sampler_settings, parse_floats, parse_priors, sampler_options
+from ..options import (
+    STRUCTURE_FIGURES,
+    check_sampler_settings,
+    parse_floats,
+    parse_priors,
+    sampler_options,
+)
 from ._common import add_comparison_options, add_data_options, library, read_data
 
 
@@ -32,9 +38,9 @@ def add_parser(subparsers):
     p.add_argument("--figure-formats", default="png", metavar="F1,F2",
                    help="file formats of the figures (default png, which report.html embeds; "
                         "png,pdf adds vector figures for publication, at about twice the time)")
-    p.add_argument("--structure-figures", default="3", metavar="N|all",
+    p.add_argument("--structure-figures", default=str(STRUCTURE_FIGURES), metavar="N|all",
                    help="how many structures, the best by the ranking, get corner and trace "
-                        "figures (default 3; 'all' for every one)")
+                        f"figures (default {STRUCTURE_FIGURES}; 'all' for every one)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
     return p
 

@@ -71,14 +71,10 @@ def run(args) -> int:
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
     if figure is not None:
-        import matplotlib.pyplot as plt
-
         from ..plotting.design import plot_design
         from ..plotting.output import save_figure
 
-        drawn = plot_design(result, plan, seed=args.seed)
-        save_figure(drawn.figure, figure)
-        plt.close(drawn.figure)
+        save_figure(plot_design(result, plan, seed=args.seed).figure, figure, close=True)
     if args.json:
         print(json.dumps(plan.to_dict(), indent=1))
         return 0

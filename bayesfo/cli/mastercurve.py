@@ -109,15 +109,11 @@ def run(args) -> int:
             from ..plotting.output import save_figure
 
             (stage / "figures").mkdir()
-            import matplotlib.pyplot as plt
-
             from ..plotting.mastercurve import plot_van_gurp_palmen
 
             for name, plot in (("mastercurve", plot_mastercurve),
                                ("van_gurp_palmen", plot_van_gurp_palmen)):
-                drawn = plot(mc)
-                save_figure(drawn.figure, stage / "figures" / f"{name}.png")
-                plt.close(drawn.figure)
+                save_figure(plot(mc).figure, stage / "figures" / f"{name}.png", close=True)
     if args.json:
         print(json.dumps({k: summary[k] for k in ("shift_factors", "shift_law")}, indent=1,
                          ensure_ascii=False))

@@ -15,6 +15,7 @@ import numpy as np
 
 from .._io import atomic_write_text
 from ..inference import save_netcdf
+from ..options import STRUCTURE_FIGURES
 from ..outdir import final_path, staged_run
 from .results import Comparison
 from .stored import netcdf_for
@@ -95,7 +96,7 @@ def _write_netcdf(comparison: Comparison, stage: Path) -> dict[str, Path]:
 
 def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
                   formats=("png",), pool=None, figure_processes: int = 1,
-                  structure_figures: int | None = 3) -> dict[str, Path]:
+                  structure_figures: int | None = STRUCTURE_FIGURES) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
     One NetCDF per structure (an ArviZ DataTree with the attributes that :func:`load` needs,

@@ -219,24 +219,39 @@ class _Predictive:
         return np.maximum(info, 0.0), log_p
 
 
+def _relative_sigma(data) -> float:
+    """The data's median relative σ (NaN without σ): the noise of a new point under known σ."""
+    if data.sigma is None:
+        return math.nan
+    return float(np.median(data.sigma / np.abs(data.response)))
+
+
+def _draws_at(r, omega, kind, rel_sigma, rng, n_draws: int = N_DRAWS):
+    """Up to ``n_draws`` posterior draws of one structure whose response at ``omega`` is finite,
+    their responses in (ln|G|, arg G) (draws, frequencies, 2), and the mean noise variance of a
+    measurement there (frequencies, 2)."""
+    post = r.posterior
+    pick = rng.choice(post.samples.shape[0], size=min(n_draws, post.samples.shape[0]),
+                      replace=False)
+    draws = post.samples[pick]
+    with np.errstate(all="ignore"):
+        g = r.structure.response(draws[:, : r.structure.n_params], omega, kind)
+    ok = np.all(np.isfinite(g) & (g != 0), axis=1)
+    draws, g = draws[ok], g[ok]
+    if len(draws) < 20:
+        raise InputError("design: too few posterior draws with a finite response in the window")
+    z = np.stack([np.log(np.abs(g)), np.angle(g)], axis=-1)
+    return draws, z, _noise_var(r, draws, g, rel_sigma).mean(axis=0)
+
+
 def _predictive(results, omega, kind, rel_sigma, rng) -> _Predictive:
     """The posterior predictive of each structure at ``omega`` (see :class:`_Predictive`)."""
     zs, noise = [], []
     for r in results:
-        post = r.posterior
-        k = r.structure.n_params
-        pick = rng.choice(post.samples.shape[0], size=min(N_DRAWS, post.samples.shape[0]),
-                          replace=False)
-        draws = post.samples[pick]
-        with np.errstate(all="ignore"):
-            g = r.structure.response(draws[:, :k], omega, kind)
-        ok = np.all(np.isfinite(g) & (g != 0), axis=1)
-        draws, g = draws[ok], g[ok]
-        zs.append(np.stack([np.log(np.abs(g)), np.angle(g)], axis=-1))
-        noise.append(_noise_var(r, draws, g, rel_sigma).mean(axis=0))
+        _, z, v = _draws_at(r, omega, kind, rel_sigma, rng)
+        zs.append(z)
+        noise.append(v)
     n = min(len(z) for z in zs)
-    if n < 20:
-        raise InputError("design: too few posterior draws with a finite response in the window")
     return _Predictive(np.stack([z[:n] for z in zs]), np.stack(noise))
 
 
@@ -324,8 +339,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     log_prior = np.log(p)
     entropy = float(-np.sum(p * np.log(p)))
     omega = np.logspace(math.log10(w_lo), math.log10(w_hi), N_CANDIDATES)
-    rel = (float(np.median(data.sigma / np.abs(data.response))) if data.sigma is not None
-           else math.nan)
+    rel = _relative_sigma(data)
     rng = np.random.default_rng(seed)
     # Rules of thumb, inside the window: as many points log-uniform over it, or over the
     # decade below (above) the data where the window reaches there.

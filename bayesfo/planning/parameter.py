@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .choice import N_CANDIDATES, N_DRAWS, _checked, _noise_var, seconds
+from .choice import N_CANDIDATES, N_DRAWS, _checked, _draws_at, _relative_sigma, seconds
 
 __all__ = ["ParameterDesign", "design_parameter"]
 
@@ -99,21 +99,9 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
                          f"parameters are {', '.join(post.param_names[: r.structure.n_params])}")
     data = result.data
     omega = np.logspace(math.log10(w_lo), math.log10(w_hi), N_CANDIDATES)
-    rel = (float(np.median(data.sigma / np.abs(data.response))) if data.sigma is not None
-           else math.nan)
     rng = np.random.default_rng(seed)
-    pick = rng.choice(post.samples.shape[0], size=min(4 * N_DRAWS, post.samples.shape[0]),
-                      replace=False)
-    draws = post.samples[pick]
-    k = r.structure.n_params
-    with np.errstate(all="ignore"):
-        g = r.structure.response(draws[:, :k], omega, data.kind)
-    ok = np.all(np.isfinite(g) & (g != 0), axis=1)
-    draws, g = draws[ok], g[ok]
-    if len(draws) < 20:
-        raise InputError("design: too few posterior draws with a finite response in the window")
-    z = np.stack([np.log(np.abs(g)), np.angle(g)], axis=-1)  # (S, C, 2)
-    noise = _noise_var(r, draws, g, rel).mean(axis=0)  # (C, 2)
+    draws, z, noise = _draws_at(r, omega, data.kind, _relative_sigma(data), rng,
+                                n_draws=4 * N_DRAWS)
     theta = draws[:, post.param_names.index(parameter)]
     var = float(np.var(theta, ddof=1))
     time = seconds(omega)

@@ -24,7 +24,9 @@ Modules
     :func:`plot_moduli`: storage and loss parts (G′, G″ or J′, J″) and tan δ with the
     posterior bands.
 ``posterior``
-    :func:`plot_corner`, :func:`plot_trace` (one structure), :func:`plot_q_posteriors`.
+    :func:`plot_corner`, :func:`plot_trace` (one structure).
+``orders``
+    :func:`plot_q_posteriors`: every fractional order of every structure.
 ``ranking``
     :func:`plot_ranking`: Δln Z and the information criteria.
 ``output``
@@ -49,8 +51,9 @@ from __future__ import annotations
 
 from ._base import Drawn
 from .moduli import plot_moduli
+from .orders import plot_q_posteriors
 from .output import save_figure, write_figures
-from .posterior import plot_corner, plot_q_posteriors, plot_trace
+from .posterior import plot_corner, plot_trace
 from .ranking import plot_ranking
 from .response import plot_bode, plot_nyquist, plot_residuals
 from .studies import plot_rmse_surface

@@ -54,7 +54,8 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
     InputError
         For generic (transfer-function) data, or an unknown or failed structure.
     """
-    from ..predictions.functions import QUANTITIES, _evaluate, _unit
+    from ..predictions import evaluate
+    from ..predictions.functions import QUANTITIES, _unit
 
     data = comparison.data
     if data.kind not in ("modulus", "compliance"):
@@ -76,7 +77,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
             theta = structure_draws(r, n_draws, seed)
             st = styles[r.name]
             for ax, q in zip(axes, quantities, strict=True):
-                v = _evaluate(r.structure, theta, q, t)
+                v = evaluate(r.structure, theta, q, t)
                 positive_band(ax, t, np.where(np.isfinite(v), v, np.nan), st, r.name, q,
                               values, artists)
             handles.append(_band_handle(st))

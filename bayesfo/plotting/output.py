@@ -8,18 +8,28 @@ import warnings
 from pathlib import Path
 
 from ..errors import InputError
+from ..options import STRUCTURE_FIGURES
 from ._compute import ok_results, order_parameter
 from .captions import file_stem
 from .material import plot_time_functions
 from .moduli import PARTS, plot_moduli
-from .posterior import plot_corner, plot_q_posteriors, plot_trace
+from .orders import plot_q_posteriors
+from .posterior import plot_corner, plot_trace
 from .ranking import plot_ranking
 from .response import plot_bode, plot_nyquist, plot_residuals
 from .style import comparison_styles, style
 
 
-def save_figure(fig, path) -> None:
-    """Save ``fig`` to ``path`` (format from the suffix) through a temporary file."""
+def save_figure(fig, path, *, close: bool = False) -> None:
+    """Save ``fig`` to ``path`` (format from the suffix) through a temporary file; with
+    ``close``, close it afterwards (also when the save fails)."""
+    if close:
+        import matplotlib.pyplot as plt
+
+        try:
+            return save_figure(fig, path)
+        finally:
+            plt.close(fig)
     from .._io import publish
 
     path = Path(path)
@@ -82,9 +92,6 @@ def _structure_makers(result, color) -> dict:
     }
 
 
-#: Structures that get their own corner and trace figures by default: the leading ones by the
-#: ranking (the combined figures show every structure; more with ``structure_figures``).
-STRUCTURE_FIGURES = 3
 
 
 def _detailed(comparison, structure_figures) -> list:

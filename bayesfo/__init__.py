@@ -41,7 +41,7 @@ from .structures import get_structure, list_structures, resolve_structures  # no
 
 #: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
 #: ``import bayesfo`` and ``bayesfo --help`` stay fast.
-_LAZY = {"compare": "comparison", "write_outputs": "comparison", "load": "comparison",
+_LAZY = {"compare": "comparison", "write_outputs": "output", "load": "comparison",
          "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison",
          "predict": "predictions", "Prediction": "predictions",
          "mastercurve": "tts", "MasterCurve": "tts", "design": "planning", "Design": "planning"}

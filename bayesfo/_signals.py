@@ -33,24 +33,3 @@ def cause(exc: BaseException, kinds: tuple[type, ...]) -> BaseException | None:
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
     return None
-
-
-def load_libraries(formats=()) -> None:
-    """Import the compiled libraries that a comparison uses (with those that draw figures in
-    ``formats``), with signals held: a Ctrl-C
-    during the imports ends the command after them, cleanly, instead of breaking one."""
-    with held():
-        import emcee  # noqa: F401
-        import h5netcdf  # noqa: F401
-        import h5py  # noqa: F401
-        import scipy.optimize  # noqa: F401
-        import scipy.special  # noqa: F401
-        import scipy.stats  # noqa: F401
-
-        from .inference._arviz import preload
-
-        preload()
-        if formats:
-            from .plotting.output import preload as preload_plotting
-
-            preload_plotting(formats)

@@ -179,7 +179,7 @@ def terminate(pool) -> None:
 @contextmanager
 def process_pool(workers: int = 0):
     """Worker processes (spawn, one BLAS thread each) that :func:`~bayesfo.comparison.compare` and
-    :func:`~bayesfo.comparison.write_outputs` can share through their ``pool`` argument: the
+    :func:`~bayesfo.output.write_outputs` can share through their ``pool`` argument: the
     figures are then drawn by processes that have already loaded the libraries.
 
     Parameters

@@ -21,8 +21,8 @@ from .data import FrequencyResponse
 from .errors import InputError
 from .identify.linear import identify_linear
 from .identify.optimize import fit_structure
-from .response import commensurate_response
 from .structures import get_structure
+from .structures.response import commensurate_response
 
 OMEGA = np.logspace(np.log10(0.6), np.log10(300.0), 25)
 SIGMA = 1e-3

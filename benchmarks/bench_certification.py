@@ -35,7 +35,7 @@ import numpy as np
 import bayesfo as bf
 from bayesfo.inference.importance import ESS_MIN_IMPORTANCE, K_HAT_MAX
 from bayesfo.inference.results import ESS_MIN, RHAT_MAX
-from bayesfo.report import verdict
+from bayesfo.output.report import verdict
 
 ROOT = Path(__file__).resolve().parents[1]
 GPL = ROOT.parent / "shared" / "data" / "reference-gpl"

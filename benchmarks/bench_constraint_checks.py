@@ -19,11 +19,10 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from bayesfo import response
 from bayesfo.inference.likelihood import Likelihood
 from bayesfo.inference.smc import ladder_run
 from bayesfo.inference.transform import _Transform
-from bayesfo.structures import get_structure, passivity
+from bayesfo.structures import get_structure, passivity, response
 from bayesfo.studies import g_spec_data
 
 CASES = "max-n2m1:compliance,max-n2m2:compliance,max-n3m1:compliance,max-n3m3:compliance," \

@@ -14,11 +14,12 @@ import warnings
 
 import numpy as np
 
-from bayesfo.comparison import compare, write_outputs
+from bayesfo.comparison import compare
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
 from bayesfo.inference._arviz import preload
 from bayesfo.inference.evidence import nested_evidence
+from bayesfo.output import write_outputs
 from bayesfo.parallel import process_pool
 from bayesfo.structures import get_structure, resolve_structures
 

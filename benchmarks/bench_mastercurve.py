@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 import bayesfo as bf
-from bayesfo.batch.temperature import temperature_of_file
+from bayesfo.data.temperature import temperature_of_file
 
 ADHESIVE = Path(__file__).resolve().parents[1] / "examples" / "data" / "adhesive_468mp"
 T_REF = 20.0

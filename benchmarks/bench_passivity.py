@@ -23,8 +23,8 @@ import numpy as np
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood
 from bayesfo.inference.smc import ladder_run
-from bayesfo.response import dissipation_grid, is_dissipative
 from bayesfo.structures import get_structure, passivity
+from bayesfo.structures.response import dissipation_grid, is_dissipative
 from bayesfo.studies import OMEGA, g_spec
 
 X = np.logspace(-30, 30, 20_000)

@@ -12,8 +12,8 @@ import time
 
 import numpy as np
 
-from bayesfo.response import dissipation_grid
 from bayesfo.structures import get_structure
+from bayesfo.structures.response import dissipation_grid
 
 N_SETS = 20_000
 OMEGA = np.logspace(np.log10(0.6), np.log10(300), 25)

@@ -120,8 +120,8 @@ def escape_plain_text_bars(app, what, name, obj, options, lines):
 #: The packages of the API reference (docs/api/index.rst lists the same), in data-flow order.
 API_PACKAGES = ("bayesfo.data", "bayesfo.structures", "bayesfo.identify", "bayesfo.inference",
                 "bayesfo.comparison", "bayesfo.tts", "bayesfo.predictions", "bayesfo.planning",
-                "bayesfo.verdict",
-                "bayesfo.report", "bayesfo.plotting", "bayesfo.batch", "bayesfo.errors")
+                "bayesfo.output", "bayesfo.plotting", "bayesfo.batch", "bayesfo.timeseries",
+                "bayesfo.errors")
 
 
 def flat_api() -> list[str]:

@@ -11,7 +11,8 @@ import time
 import warnings
 from pathlib import Path
 
-from bayesfo.comparison import compare, write_outputs
+from bayesfo.comparison import compare
+from bayesfo.output import write_outputs
 
 #: Sampler cap of the quick forms: structures that converge do so in 750–2500 steps here;
 #: those that do not (multimodal q, vanishing terms) stop at the cap and are flagged.

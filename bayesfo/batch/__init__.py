@@ -48,6 +48,7 @@ the time and its warnings are captured per process. With ``--models``, the card 
 readable on the workers.
 """
 
+from ..data.temperature import parse_temperature, temperature_from_stem, temperature_of_file
 from .datasets import COMBINED_FILES, MANIFEST_COLUMNS, DataSet, expand_inputs
 from .executors import SCHEDULER_TIMEOUT, run_batch
 from .store import (
@@ -61,7 +62,6 @@ from .store import (
                     write_batch_outputs,
 )
 from .task import INPUT_ERROR, INTERNAL_ERROR, OK, run_task
-from .temperature import parse_temperature, temperature_from_stem, temperature_of_file
 
 __all__ = ["BATCH_FIELDS", "COMBINED_FILES", "INPUT_ERROR", "INTERNAL_ERROR", "MANIFEST_COLUMNS",
            "OK", "SCHEDULER_TIMEOUT", "TEMPERATURE_FIELDS", "BatchResult", "DataSet", "Outcome",

@@ -19,9 +19,9 @@ from pathlib import Path
 from .. import __version__
 from .._io import csv_cells, read_text_file, split_lines
 from ..data import is_contract_csv
+from ..data.temperature import parse_temperature, temperature_of_file
 from ..errors import InputError
 from ..options import DEFAULT_OPTIONS, EVIDENCE_ROUTES, KINDS, check_options, check_seed
-from .temperature import parse_temperature, temperature_of_file
 
 #: Manifest columns; ``invert`` is another name for ``reciprocal``.
 MANIFEST_COLUMNS = ("path", "id", "kind", "reciprocal", "invert", "structures", "noise", "prior",

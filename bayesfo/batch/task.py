@@ -44,7 +44,7 @@ def run_task(task: dict) -> dict:
     """Compare the structures on one data set: the function a worker runs.
 
     Reads the CSV, runs :func:`~bayesfo.comparison.compare`, writes its outputs
-    (:func:`~bayesfo.comparison.write_outputs`) into a private temporary directory and returns them.
+    (:func:`~bayesfo.output.write_outputs`) into a private temporary directory and returns them.
     Never raises for a failure of the data set (only for ``KeyboardInterrupt`` and the like).
 
     Parameters
@@ -74,8 +74,9 @@ def run_task(task: dict) -> dict:
     try:
         with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
             warnings.simplefilter("always")
-            from ..comparison import compare, write_outputs
+            from ..comparison import compare
             from ..data import read_csv
+            from ..output import write_outputs
             from ..structures import default_library, load_library, resolve_structures
 
             data = _read_task_data(task, read_csv)

@@ -5,13 +5,13 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from .._signals import load_libraries
 from ..batch import OK, BatchResult, expand_inputs, run_batch
 from ..options import (
     KINDS,
     parse_floats,
 )
 from ._common import add_comparison_options
+from ._libraries import load_libraries
 
 
 def add_parser(subparsers):

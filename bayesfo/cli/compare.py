@@ -103,7 +103,8 @@ def _figure_processes(since) -> int:
 
 def _compare(data, structures, out, n_proc, workers, formats, no_figures, options):
     """The comparison and its outputs, in the processes that ``workers`` asks for."""
-    from ..comparison import compare, write_outputs
+    from ..comparison import compare
+    from ..output import write_outputs
     from ..parallel import lazy_process_pool, process_pool
 
     figures = {} if formats is None else {"formats": formats,
@@ -178,10 +179,10 @@ def _num(x, fmt: str = ".2f") -> str:
 
 
 def run(args) -> int:
-    from .._signals import load_libraries
     from ..outdir import check_output_directory
     from ..parallel import available_cpus
     from ..structures import resolve_structures
+    from ._libraries import load_libraries
 
     data = read_data(args)
     structures = resolve_structures(args.structures, library(args))

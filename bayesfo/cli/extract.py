@@ -19,7 +19,7 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
-    from ..records import extract_frequency_response, write_extraction
+    from ..timeseries.records import extract_frequency_response, write_extraction
 
     if args.harmonics < 2:
         raise InputError(f"--harmonics must be at least 2, got {args.harmonics}")

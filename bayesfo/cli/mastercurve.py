@@ -46,8 +46,8 @@ def add_parser(subparsers):
 def read_isotherm_files(paths) -> list[tuple]:
     """(FrequencyResponse, temperature or None) of every isotherm in ``paths`` (files, or
     directories of ``*.csv``)."""
-    from ..batch.temperature import temperature_of_file
     from ..data import read_isotherms
+    from ..data.temperature import temperature_of_file
 
     files = []
     for p in map(Path, paths):
@@ -78,10 +78,10 @@ def read_isotherm_files(paths) -> list[tuple]:
 
 
 def run(args) -> int:
-    from .._signals import load_libraries
     from ..outdir import check_output_directory, staged_run
     from ..structures import resolve_structures
     from ..tts import mastercurve
+    from ._libraries import load_libraries
 
     structures = resolve_structures(args.structures)  # an unknown name fails before reading
     isotherms = read_isotherm_files(args.data)

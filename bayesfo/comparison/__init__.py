@@ -2,18 +2,26 @@
 rank them, and write the output directory; read it back.
 
 ``run`` (:func:`compare`) → ``criteria`` (per structure; ``criteria_types``: :class:`Criteria`)
-→ ``results`` (:class:`Comparison`) → ``output`` (:func:`write_outputs`) → ``stored``
-(:func:`load`).
+→ ``results`` (:class:`Comparison`); ``stored`` (:func:`load`) reads back what
+:func:`bayesfo.output.write_outputs` wrote.
 """
 
 from ..inference.certified import LADDER_SHORTFALL
 from .criteria import PARETO_K_WARN
 from .criteria_types import Criteria
-from .output import ranking_csv, write_outputs
 from .results import Comparison, StructureResult
 from .run import compare
 from .stored import load
 from .table import RANKING_FIELDS, ranking_rows
 
 __all__ = ["LADDER_SHORTFALL", "PARETO_K_WARN", "RANKING_FIELDS", "Comparison", "Criteria",
-           "StructureResult", "compare", "load", "ranking_csv", "ranking_rows", "write_outputs"]
+           "StructureResult", "compare", "load", "ranking_rows"]
+
+
+def __getattr__(name):
+    # Kept for one release: the writers moved to the output layer (bayesfo.output).
+    if name in ("write_outputs", "ranking_csv"):
+        from .. import output
+
+        return getattr(output, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,11 +1,11 @@
 """The steps of a comparison's structures as tasks of a pool of worker processes.
 
-A structure is run in three steps (:mod:`bayesfo.comparison.run`): (1) the optimisation and
-the noise screen, :func:`~bayesfo.comparison.run._fit_and_screen`; (2) one posterior per noise
-model still in the running, :func:`~bayesfo.comparison.run._sample_held`; (3) the noise model
+A structure is run in three steps (:mod:`bayesfo.comparison.steps`): (1) the optimisation and
+the noise screen, :func:`~bayesfo.comparison.steps.fit_and_screen`; (2) one posterior per noise
+model still in the running, :func:`~bayesfo.comparison.steps.sample_held`; (3) the noise model
 chosen by evidence, the evidence and adequacy checks and the result,
-:func:`~bayesfo.comparison.run._conclude`. The serial path runs them one after the other
-(:func:`~bayesfo.comparison.run._run_structure`); here the parent submits (1) for every
+:func:`~bayesfo.comparison.steps.conclude`. The serial path runs them one after the other
+(:func:`~bayesfo.comparison.steps.run_structure`); here the parent submits (1) for every
 structure, largest first, and as each comes back either has the result (a structure with one
 noise model to sample runs (2) and (3) in the task of (1): nothing to ship) or submits (2) for
 each noise model at once, and (3) when their posteriors are back. A structure whose screen
@@ -23,7 +23,7 @@ processes, not the arithmetic (measured on the 17-point isotherm: a Voigt or Zen
 with ln Z, LOO and adequacy takes 0.2-0.4 s, while spawning two workers that import the
 libraries takes 1-2 s of a loaded 2-core machine). This process runs step (1) of every
 structure, here with the screen's quick estimates of every noise model to sample
-(:func:`~bayesfo.comparison.run._fit_and_probe`); where their Pareto k̂ promises that importance
+(:func:`~bayesfo.comparison.steps.fit_and_probe`); where their Pareto k̂ promises that importance
 sampling will certify the posterior, it runs (2) and (3) as well, and only the other
 structures' (2) and (3) go to the pool, whose processes start with the first of them. A wrong
 promise costs time, never a different number.
@@ -48,7 +48,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 from ..errors import InputError
 from .results import StructureResult
-from .run import _conclude, _fit_and_probe, _fit_and_screen, _kept, _sample_held
+from .steps import conclude, fit_and_probe, fit_and_screen, kept, sample_held
 
 
 def _task(step, *args):
@@ -66,19 +66,19 @@ def _task(step, *args):
 def _first(s, data, options):
     """Step (1); with a single noise model to sample, (2) and (3) follow in the same task.
     Returns ("result", StructureResult) or ("sample", (fit, screened, noise models))."""
-    fit, screened, noises = _fit_and_screen(s, data, options)
+    fit, screened, noises = fit_and_screen(s, data, options)
     if len(noises) > 1:
         return "sample", (fit, screened, noises)
-    runs = [_sample_held(s, data, noises[0], fit, options)]
-    return "result", _conclude(s, data, fit, screened, runs, options)
+    runs = [sample_held(s, data, noises[0], fit, options)]
+    return "result", conclude(s, data, fit, screened, runs, options)
 
 
 def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> list:
     """Run the structures' steps as tasks of ``pool``; returns (result, warnings) per structure
-    in the order given, as :func:`~bayesfo.comparison.run._run_structure` does.
+    in the order given, as :func:`~bayesfo.comparison.steps.run_structure` does.
 
     With ``here``, this process runs every structure's step (1) itself
-    (:func:`~bayesfo.comparison.run._fit_and_probe`) and then steps (2) and (3) of the
+    (:func:`~bayesfo.comparison.steps.fit_and_probe`) and then steps (2) and (3) of the
     structures whose screen promises a quick certified posterior; only the others' steps go to
     ``pool`` (a :class:`~bayesfo.parallel.LazyPool` then starts no process for a comparison
     that has none). The step-(1) tasks of this process come before its others, so that the
@@ -118,7 +118,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                           "process", RuntimeWarning, stacklevel=4)
 
     def end(i, result):
-        outcomes[i] = (result, _kept(structures[i].name, caught[i]))
+        outcomes[i] = (result, kept(structures[i].name, caught[i]))
         runs[i] = prepared[i] = None
         bar.update()
         for future, (j, _, _) in live.items():
@@ -132,7 +132,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 return
             if runs[i][noise][1] is not None:
                 return end(i, StructureResult(s, error=runs[i][noise][1]))
-        submit(i, "conclude", _conclude, s, data, fit, screened,
+        submit(i, "conclude", conclude, s, data, fit, screened,
                [runs[i][noise][0] for noise in noises], options)
 
     def done(i, what, value, error, new):
@@ -150,7 +150,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
             prepared[i], quick = value
             in_pool[i] = not quick
             for noise in prepared[i][2]:
-                submit(i, noise, _sample_held, structures[i], data, noise, prepared[i][0],
+                submit(i, noise, sample_held, structures[i], data, noise, prepared[i][0],
                        options)
         elif value[0] == "result":
             end(i, value[1])
@@ -158,7 +158,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
             prepared[i] = value[1]
             fit, _, noises = prepared[i]
             for noise in noises:
-                submit(i, noise, _sample_held, structures[i], data, noise, fit, options)
+                submit(i, noise, sample_held, structures[i], data, noise, fit, options)
 
     def collect(future):
         i, what, args = live.pop(future)
@@ -175,7 +175,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
         # Larger structures first (they take longest); results keep the order given.
         for i in sorted(range(n), key=lambda i: -structures[i].n_params):
             if here:
-                submit(i, "first", _fit_and_probe, structures[i], data, options)
+                submit(i, "first", fit_and_probe, structures[i], data, options)
             else:
                 submit(i, "first", _first, structures[i], data, options)
         while live or local:

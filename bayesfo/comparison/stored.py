@@ -1,5 +1,5 @@
 """A comparison read back from its output directory (:func:`load`), and what
-:func:`~bayesfo.comparison.output.write_outputs` stores in each structure's NetCDF so that it can
+:func:`~bayesfo.output.write.write_outputs` stores in each structure's NetCDF so that it can
 be (:func:`netcdf_for`).
 
 ``summary.json`` holds every number of the contract; each ``<structure>.nc`` holds the draws,

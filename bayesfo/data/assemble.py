@@ -16,7 +16,8 @@ from .csv_reader import MAX_FREQUENCIES, _from_columns, _too_many
 from .frequency_response import FREQUENCY_RTOL
 from .reading import Isotherm, Reading
 from .tables import Table, number_like, to_number
-from .units import SI, temperature_in_text
+from .temperature import temperature_in_text
+from .units import SI
 
 #: Rows within this many °C of the running mean of their isotherm belong to it (a temperature
 #: column splits a table into isotherms where it jumps by more).

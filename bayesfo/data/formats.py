@@ -12,7 +12,7 @@ from .._io import show
 from ..errors import InputError
 from .columns import identify
 from .tables import Line, Table
-from .units import temperature_in_text
+from .temperature import temperature_in_text
 
 REPTATE_PARAMS = re.compile(r"^\s*(?:[A-Za-z][\w ]*=[^;=]*;)+\s*$")
 

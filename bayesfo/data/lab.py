@@ -52,7 +52,7 @@ from .tables import (
     sniff_decimal,
     split_file,
 )
-from .units import temperature_in_text
+from .temperature import temperature_in_text
 
 DUPLICATES = ("error", "first", "mean")
 _EXCEL = (".xlsx", ".xlsm", ".xls")

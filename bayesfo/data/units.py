@@ -197,21 +197,3 @@ def split_header(cell: str) -> tuple[str, str | None]:
             if unit is not None and unit.quantity != "dimensionless":
                 return "_".join(parts[:-k]), suffix
     return text, None
-
-
-_TEMPERATURE_TEXT = re.compile(r"([+\-−]?\d+(?:[.,]\d+)?)\s*(°\s*C|℃|deg\s*C|K|°\s*F)\b"
-                               r"|([+\-−]?\d+(?:[.,]\d+)?)\s*(°\s*C|℃)")
-
-
-def temperature_in_text(text: str) -> float | None:
-    """The temperature [°C] written with its unit in ``text`` (``"Frequency sweep (150.0 °C)"``,
-    ``"Temperature: 25 °C"``, ``"293.15 K"``), or None; the last one if several."""
-    found = None
-    for m in _TEMPERATURE_TEXT.finditer(text):
-        number, unit = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
-        u = parse_unit(unit.replace(" ", ""))
-        if u is None:
-            continue
-        value = float(number.replace("−", "-").replace(",", "."))
-        found = round(value * u.factor + u.offset, 10)
-    return found

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..response import jw_power
+from ..structures.response import jw_power
 
 METHODS = (1, 2, 3, 4, 5)
 SK_ITERATIONS = 10

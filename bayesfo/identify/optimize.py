@@ -31,8 +31,8 @@ from scipy import optimize
 from ..data import FrequencyResponse
 from ..errors import InputError
 from ..priors import LogUniform
-from ..response import commensurate_response, dissipation_grid
 from ..structures import Scaling, Structure, passivity
+from ..structures.response import commensurate_response, dissipation_grid
 
 #: The penalty weights (times the root of the optimum's cost) of :meth:`_Problem.repair`.
 REPAIR_WEIGHTS = (1e1, 1e3, 1e5)

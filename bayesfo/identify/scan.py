@@ -17,7 +17,7 @@ import numpy as np
 
 from ..data import FrequencyResponse
 from ..errors import InputError
-from ..response import commensurate_response, matignon_stable
+from ..structures.response import commensurate_response, matignon_stable
 from .linear import identify_linear
 
 DEFAULT_Q_GRID = np.round(np.arange(1, 101) * 0.01, 2)

@@ -46,8 +46,8 @@ import numpy as np
 from ..data import FrequencyResponse
 from ..errors import InputError
 from ..priors import LogUniform, Prior
-from ..response import dissipation_grid
 from ..structures import Scaling, Structure
+from ..structures.response import dissipation_grid
 
 NOISE_MODELS = ("known", "constant", "proportional", "relative_parts")
 

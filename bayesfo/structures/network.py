@@ -29,8 +29,8 @@ import numpy as np
 
 from .._io import show
 from ..errors import StructureError
-from ..response import jw_power
 from .expressions import MAX_EXPRESSION, Expr
+from .response import jw_power
 
 ELEMENTS = {"spring": 1, "dashpot": 1, "springpot": 2}
 COMBINATIONS = ("series", "parallel")

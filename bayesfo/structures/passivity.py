@@ -2,7 +2,7 @@
 for the others, sums and series of springpots and general power sums.
 
 A side of a transfer function is a power sum D(s) = Σ d_k s^(e_k) (a pseudo-polynomial in one
-s^q when commensurate; Matignon's theorem then decides, :func:`bayesfo.response.matignon_stable`).
+s^q when commensurate; Matignon's theorem then decides, :func:`bayesfo.structures.response.matignon_stable`).
 For the other sides these conditions are used, in this order:
 
 1. **Positive springpot sum** (exact, sufficient): if every d_k ≥ 0 (not all 0) and the spread of
@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..response import (
+from .response import (
     HALF_PI,
     cubic_roots,
     matignon_stable,
@@ -290,7 +290,7 @@ def _cubic_critical_check(p: np.ndarray, s: np.ndarray, deriv: np.ndarray, rtol:
     ``deriv``, 4 coefficients) is a cubic, with its roots in closed form: (ok, sure).
 
     ``sure`` marks rows whose decision is the same at any candidate points within twice the
-    error bound of :func:`~bayesfo.response.cubic_roots` (which also bounds the eigenvalues
+    error bound of :func:`~bayesfo.structures.response.cubic_roots` (which also bounds the eigenvalues
     of the companion matrix): every root is clearly off the imaginary axis and away from 0,
     and every ratio p/S at a candidate x is farther from −rtol than it can move there
     (|d(p/S)/dx| ≤ 2 S′/S ≤ 2K/x, as |p_j| ≤ s_j) plus 1e-14 of rounding."""

@@ -12,15 +12,15 @@ import numpy as np
 from .._io import show
 from ..errors import StructureError
 from ..priors import Prior
-from ..response import (
+from . import passivity
+from .passivity import commensurate_passive, side_stable, springpot_sum_passive
+from .response import (
     commensurate_response,
     dissipation_grid,
     is_dissipative,
     matignon_stable,
     power_ratio,
 )
-from . import passivity
-from .passivity import commensurate_passive, side_stable, springpot_sum_passive
 from .scaling import ScalePlan, Scaling, scale_plan
 from .terms import Inequality, Term
 
@@ -311,7 +311,7 @@ class Structure:
 
     def power_terms(self, theta) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
         """(coefficient, exponent) pairs of numerator and denominator for one parameter set,
-        as :func:`bayesfo.timedomain.simulate` takes them."""
+        as :func:`bayesfo.timeseries.timedomain.simulate` takes them."""
         theta = np.asarray(theta, dtype=float)
         if theta.ndim != 1:
             raise StructureError(f"power_terms takes one parameter set, got shape {theta.shape}")
@@ -482,7 +482,7 @@ class Structure:
         kind : {"compliance", "modulus", "generic"}
         omega_grid : array_like, optional
             The dense grid of the dissipation check, in the units of ``theta``
-            (default :func:`~bayesfo.response.dissipation_grid` around ω = 1).
+            (default :func:`~bayesfo.structures.response.dissipation_grid` around ω = 1).
         """
         theta = np.asarray(theta, dtype=float)
         ok = np.atleast_1d(self.in_support(theta)).copy()

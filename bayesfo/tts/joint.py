@@ -495,8 +495,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
     from ..identify.optimize import fit_structure
     from ..inference import Likelihood, certified_posterior
     from ..inference.transform import _Transform
-    from ..response import dissipation_grid
     from ..structures import Scaling, get_structure
+    from ..structures.response import dissipation_grid
 
     master = get_structure(structure) if isinstance(structure, str) else structure
     joint = iso.joint

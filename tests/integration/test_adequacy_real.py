@@ -58,7 +58,7 @@ def test_no_candidate_describes_the_chia_gel(tmp_path):
     assert set(fits.values()) == {"no"}, fits
     voigt = result["voigt"].adequacy
     assert voigt.max_phase_error_deg > 10 and min(voigt.systematic_at_omega) < 0.1
-    from bayesfo.report import verdict
+    from bayesfo.output.report import verdict
 
     assert any(t.startswith("None of the candidates describes these data") and flagged
                for t, flagged in verdict(result))

@@ -394,6 +394,7 @@ def test_dask_errors_are_input_errors(reference, tmp_path, monkeypatch):
 
 def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch):
     import bayesfo.comparison
+    import bayesfo.output
 
     shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
     summary = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"],
@@ -412,7 +413,7 @@ def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch)
         (out / "summary.json").write_text(json.dumps(summary))
 
     monkeypatch.setattr(bayesfo.comparison, "compare", lambda *args, **kwargs: None)
-    monkeypatch.setattr(bayesfo.comparison, "write_outputs", fake_outputs)
+    monkeypatch.setattr(bayesfo.output, "write_outputs", fake_outputs)
     sub = tmp_path / "out" / "a"
     res = run_batch(expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"}),
                     tmp_path / "out", workers=1, progress=False, write_combined=False)

@@ -49,23 +49,17 @@ def draw_truth(lik: Likelihood, rng) -> np.ndarray:
 
 
 def default_route(s, data, priors, seed: int):
-    """The posterior as ``compare`` computes it by default (:func:`bayesfo.comparison.run._sample`:
-    importance sampling from the optima where its weights certify it, else the two tempered-
-    ladder runs where they agree, else emcee), on the fixed :data:`SCALING` on which the priors
-    are declared. Returns (posterior, route)."""
-    from bayesfo.comparison.run import _ladder_first
+    """The posterior as ``compare`` computes it by default
+    (:func:`bayesfo.inference.certified_posterior`: importance sampling from the optima where its
+    weights certify it, else the two tempered-ladder runs where they agree, else emcee), on the
+    fixed :data:`SCALING` on which the priors are declared. Returns (posterior, route)."""
     from bayesfo.identify import fit_structure
-    from bayesfo.inference.importance import importance_posterior
+    from bayesfo.inference import certified_posterior, starting_points
 
     lik = Likelihood(s, data, priors=priors, scaling=SCALING)
     fit = fit_structure(lik.structure, data, rng=seed, seed_methods=True)
-    modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling), SCALING)
-    post, _, info = importance_posterior(lik, modes, seed=seed, predictive=False)
-    if post is None:
-        post, _, _ = _ladder_first(lik, seed, info.get("proposal_draws"))
-    if post is None:
-        post, _ = run_posterior(s, data, priors=priors, scaling=SCALING, seed=seed, fit=fit,
-                                progress=False, predictive=False)
+    modes, starts = starting_points(lik, fit)
+    post = certified_posterior(lik, modes, starts=starts, seed=seed).posterior
     return post, post.sampler
 
 

@@ -112,7 +112,7 @@ def test_identify_max_order_loop(run_cli, gspec_csv):
 
 
 def test_models_option_before_or_after_the_command(tmp_path, run_cli):
-    card = (Path(__file__).parents[2] / "models" / "voigt.toml").read_text()
+    card = (Path(__file__).parents[2] / "bayesfo" / "models" / "voigt.toml").read_text()
     (tmp_path / "kv.toml").write_text(card.replace('name = "voigt"', 'name = "kv2"'))
     for argv in (["--models", tmp_path, "structures"], ["structures", "--models", tmp_path]):
         status, out, _ = run_cli(*argv)
@@ -280,7 +280,7 @@ def test_distributed_stays_importable_around_the_netcdf_writes(monkeypatch):
     import sys
     import types
 
-    from bayesfo.comparison.output import _without_distributed
+    from bayesfo.output.write import _without_distributed
 
     for name in ("distributed", "dask.distributed"):
         monkeypatch.delitem(sys.modules, name, raising=False)
@@ -303,7 +303,7 @@ def test_dask_forgets_the_import_that_failed_inside_the_block(monkeypatch):
 
     import dask.base
 
-    from bayesfo.comparison.output import _without_distributed
+    from bayesfo.output.write import _without_distributed
 
     for name in ("distributed", "dask.distributed"):
         monkeypatch.delitem(sys.modules, name, raising=False)

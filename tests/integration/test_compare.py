@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from bayesfo.comparison import compare, write_outputs
+from bayesfo.comparison import compare
 from bayesfo.data import FrequencyResponse
 from bayesfo.errors import PredictiveWarning
+from bayesfo.output import write_outputs
 from bayesfo.structures import get_structure, resolve_structures
 
 W = np.logspace(np.log10(0.6), np.log10(300), 25)
@@ -95,7 +96,7 @@ def test_criteria_are_consistent(voigt_comparison):
 
 def test_interrupted_write_leaves_no_summary(voigt_comparison, tmp_path, monkeypatch):
     result, _ = voigt_comparison
-    import bayesfo.comparison.output as cmp
+    import bayesfo.output.write as cmp
 
     def boom(*a, **k):
         raise KeyboardInterrupt
@@ -239,7 +240,7 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
     assert abs(other.log_z - ev.log_z) < 4 * math.hypot(other.log_z_err, ev.log_z_err) + 0.02
     assert not any("unreliable" in w for w in short.criteria["warnings"])
     # The report marks the ladder's value and says how it was computed.
-    from bayesfo.report import render_report
+    from bayesfo.output.report import render_report
 
     html = render_report(compare(data, voigt, seed=1, progress=False, evidence="ladder"))
     assert f"{ev.log_z:.2f} L</td>" in html and "ln Z from a tempered ladder" in html
@@ -269,7 +270,7 @@ def test_data_problems_are_warned_and_stated(tmp_path):
     summary.json and first in the report's verdict."""
     from bayesfo.data import read_csv
     from bayesfo.errors import DataWarning
-    from bayesfo.report import verdict
+    from bayesfo.output.report import verdict
 
     lines = (Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" /
              "Tp150C.csv").read_text().splitlines()
@@ -298,7 +299,7 @@ def test_adequacy_of_every_structure(voigt_comparison):
     superset the Zener describe them, the integer Voigt misses the phase by tens of degrees."""
     import dataclasses
 
-    from bayesfo.report import verdict
+    from bayesfo.output.report import verdict
 
     result, out = voigt_comparison
     fits = {r.name: r.fits for r in result.results}

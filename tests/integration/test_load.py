@@ -20,9 +20,10 @@ import pytest
 from test_stored_run import _diff
 
 import bayesfo as bf
-from bayesfo.comparison import Criteria, ranking_csv
-from bayesfo.comparison.output import _finite
+from bayesfo.comparison import Criteria
 from bayesfo.errors import InputError
+from bayesfo.output import ranking_csv
+from bayesfo.output.write import _finite
 
 DATA = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp" / "Tp150C.csv"
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import bayesfo as bf
-from bayesfo.comparison.run import NOISE_DECISIVE
+from bayesfo.comparison.steps import NOISE_DECISIVE
 from bayesfo.data import FrequencyResponse
 from bayesfo.structures import get_structure
 
@@ -74,7 +74,7 @@ def test_noise_sensitive_when_the_intervals_part():
     # overlap; 0.50…0.56 against 0.55…0.60 do.
     from types import SimpleNamespace
 
-    from bayesfo.comparison.run import _choose_noise
+    from bayesfo.comparison.steps import NoiseRun, choose_noise
 
     def run(noise, lo, hi, log_z):
         summary = {"q": SimpleNamespace(hdi_low=lo, hdi_high=hi)}
@@ -83,7 +83,7 @@ def test_noise_sensitive_when_the_intervals_part():
                                                 SimpleNamespace(name="b0", role="coefficient")])
         lik = SimpleNamespace(noise=noise, structure=structure)
         ev = SimpleNamespace(log_z=log_z, log_z_err=0.01, method="importance")
-        return {"lik": lik, "post": post, "criteria": {"evidence": ev, "warnings": []}}
+        return NoiseRun(lik, post, {"evidence": ev, "warnings": []})
 
     import dataclasses
 
@@ -95,10 +95,10 @@ def test_noise_sensitive_when_the_intervals_part():
     for (lo, hi), sensitive in (((0.50, 0.52), True), ((0.50, 0.56), False)):
         runs = [run("constant", lo, hi, -10.0), run("proportional", 0.55, 0.60, -10.5)]
         for r in runs:
-            r["post"] = Post(r["post"].summary)
+            r.post = Post(r.post.summary)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            chosen, record = _choose_noise("zener", runs, None)
+            chosen, record = choose_noise("zener", runs, None)
         assert chosen is runs[0] and record["chosen"] == "constant"
         assert record["sensitive"] is sensitive
         assert record["sensitive_parameters"] == (["q"] if sensitive else [])
@@ -106,7 +106,7 @@ def test_noise_sensitive_when_the_intervals_part():
         assert record["models"]["constant"]["probability"] == pytest.approx(
             1 / (1 + np.exp(-0.5)))
         assert bool(caught) is sensitive
-        assert "chosen by evidence" in chosen["post"].noise_reason
+        assert "chosen by evidence" in chosen.post.noise_reason
 
 
 def test_q_coverage_with_half_a_decade_and_relative_noise():

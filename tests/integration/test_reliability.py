@@ -26,9 +26,10 @@ import pytest
 import bayesfo.outdir as outdir
 from bayesfo.batch import expand_inputs, run_batch
 from bayesfo.batch.executors import _run_processes
-from bayesfo.comparison import compare, write_outputs
+from bayesfo.comparison import compare
 from bayesfo.data import FrequencyResponse
 from bayesfo.errors import OutputError
+from bayesfo.output import write_outputs
 from bayesfo.structures import get_structure, resolve_structures
 
 ROOT = Path(__file__).parents[2]
@@ -65,7 +66,7 @@ def earlier(comparison, tmp_path):
 
 # ---------------------------------------------------------------------- one run per directory
 def test_an_interrupted_run_leaves_the_earlier_output(comparison, earlier, monkeypatch):
-    import bayesfo.comparison.output
+    import bayesfo.output.write
 
     out, before = earlier
     assert set(before) == {"voigt.nc", "zener.nc", "ranking.csv", "summary.json", "notes.txt"}
@@ -73,7 +74,7 @@ def test_an_interrupted_run_leaves_the_earlier_output(comparison, earlier, monke
     def interrupted(*args, **kwargs):  # after both NetCDF files were written
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(bayesfo.comparison.output, "ranking_csv", interrupted)
+    monkeypatch.setattr(bayesfo.output.write, "ranking_csv", interrupted)
     with pytest.raises(KeyboardInterrupt):
         write_outputs(comparison, out, figures=False)
     assert _tree(out) == before
@@ -274,6 +275,7 @@ SUMMARY = {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": ["voigt"
 def fake_compare(monkeypatch):
     """compare and write_outputs replaced by instant fakes (batch runs in this process)."""
     import bayesfo.comparison
+    import bayesfo.output
 
     def fake_outputs(comparison, out, figures=True):
         out = Path(out)
@@ -283,7 +285,7 @@ def fake_compare(monkeypatch):
         (out / "summary.json").write_text(json.dumps(SUMMARY))
 
     monkeypatch.setattr(bayesfo.comparison, "compare", lambda *args, **kwargs: None)
-    monkeypatch.setattr(bayesfo.comparison, "write_outputs", fake_outputs)
+    monkeypatch.setattr(bayesfo.output, "write_outputs", fake_outputs)
 
 
 def _victims(tmp_path) -> dict:
@@ -547,8 +549,8 @@ def test_a_pipe_is_not_a_data_file(tmp_path, run_cli):
 
 def test_undefined_criteria_are_empty_cells_and_rank_last(comparison):
     from bayesfo.cli.compare import _num
-    from bayesfo.comparison import ranking_csv
     from bayesfo.comparison.criteria import _frequencies
+    from bayesfo.output import ranking_csv
 
     voigt, zener = comparison.results
     broken = dataclasses.replace(zener, criteria=dict(zener.criteria, loo=np.nan,

@@ -22,8 +22,8 @@ import pytest  # noqa: E402
 from bayesfo.comparison import StructureResult, compare  # noqa: E402
 from bayesfo.data import FrequencyResponse  # noqa: E402
 from bayesfo.errors import PredictiveWarning
+from bayesfo.output.report import render_report, verdict, write_report  # noqa: E402
 from bayesfo.plotting import plot_bode, plot_ranking, save_figure  # noqa: E402
-from bayesfo.report import render_report, verdict, write_report  # noqa: E402
 from bayesfo.structures import get_structure  # noqa: E402
 
 W = np.logspace(-1, 2.5, 20)
@@ -211,12 +211,12 @@ def test_write_report_is_atomic_and_complete(comparison, figures, tmp_path):
 
 
 def test_report_module_does_not_import_matplotlib():
-    code = "import sys, bayesfo.report; sys.exit(int('matplotlib' in sys.modules))"
+    code = "import sys, bayesfo.output.report; sys.exit(int('matplotlib' in sys.modules))"
     assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
 
 
 def test_bayes_factor_wording():
-    from bayesfo.report import _bayes_factor, _strength
+    from bayesfo.output.report import _bayes_factor, _strength
 
     assert _strength(0.5).startswith("not worth") and _strength(2.0) == "positive"
     assert _strength(4.0) == "strong" and _strength(7.0) == "very strong"

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import bayesfo as bf
-import bayesfo.comparison.run as run
 import bayesfo.comparison.schedule as schedule
+import bayesfo.comparison.steps as steps
 from bayesfo import parallel
 from bayesfo.errors import InputError
 from bayesfo.parallel import LazyPool, lazy_process_pool
@@ -66,20 +66,20 @@ class _Recorder:
 
     def submit(self, fn, *args):
         self.steps.append((args[0].__name__, args[1].name,
-                           args[3] if args[0].__name__ == "_sample_held" else None))
+                           args[3] if args[0].__name__ == "sample_held" else None))
         return self.pool.submit(fn, *args)
 
 
 @pytest.fixture
 def noisy_sampler(monkeypatch):
     """Each posterior warns which noise model it ran under."""
-    sample = run._sample
+    sample = steps.sample
 
     def warning_sample(s, data, noise, fit, options):
         warnings.warn(f"{s.name}: sampled under {noise} noise", UserWarning, stacklevel=1)
         return sample(s, data, noise, fit, options)
 
-    monkeypatch.setattr(run, "_sample", warning_sample)
+    monkeypatch.setattr(steps, "sample", warning_sample)
 
 
 def test_a_pool_keeps_the_warnings_of_the_serial_path(noisy_sampler):
@@ -98,16 +98,16 @@ def test_a_pool_keeps_the_warnings_of_the_serial_path(noisy_sampler):
         assert record["models"][other]["warnings"][0] == f"{r.name}: sampled under {other} noise"
     assert sorted(recorder.steps) == sorted(
         [("_first", s, None) for s in ("zener-int", "maxwell-int")]
-        + [("_sample_held", s, n) for s in ("zener-int", "maxwell-int")
+        + [("sample_held", s, n) for s in ("zener-int", "maxwell-int")
            for n in ("constant", "proportional")]
-        + [("_conclude", s, None) for s in ("zener-int", "maxwell-int")])
+        + [("conclude", s, None) for s in ("zener-int", "maxwell-int")])
 
 
 @pytest.fixture
 def failing_steps(monkeypatch):
     """zener-int's optimisation and maxwell-int's posterior under proportional noise raise an
     InputError."""
-    fit_structure, sample = run.fit_structure, run._sample
+    fit_structure, sample = steps.fit_structure, steps.sample
 
     def failing_fit(structure, *args, **kwargs):
         if structure.name == "zener-int":
@@ -119,8 +119,8 @@ def failing_steps(monkeypatch):
             raise InputError("no posterior here")
         return sample(s, data, noise, fit, options)
 
-    monkeypatch.setattr(run, "fit_structure", failing_fit)
-    monkeypatch.setattr(run, "_sample", failing_sample)
+    monkeypatch.setattr(steps, "fit_structure", failing_fit)
+    monkeypatch.setattr(steps, "sample", failing_sample)
 
 
 def test_an_input_error_in_a_step_ends_that_structure_alone(failing_steps):
@@ -137,7 +137,7 @@ def test_an_input_error_in_a_step_ends_that_structure_alone(failing_steps):
     # A structure whose fit failed has no posterior to wait for; one whose posterior failed
     # has no conclusion.
     assert [st for st in recorder.steps if st[1] == "zener-int"] == [("_first", "zener-int", None)]
-    assert ("_conclude", "maxwell-int", None) not in recorder.steps
+    assert ("conclude", "maxwell-int", None) not in recorder.steps
 
 
 # ------------------------------------------------ the automatic schedule (workers=0)
@@ -151,7 +151,7 @@ class _LazyRecorder(LazyPool):
 
     def submit(self, fn, /, *args):
         self.steps.append((args[0].__name__, args[1].name,
-                           args[3] if args[0].__name__ == "_sample_held" else None))
+                           args[3] if args[0].__name__ == "sample_held" else None))
         future = Future()
         future.set_result(fn(*args))
         return future
@@ -181,21 +181,21 @@ def test_structures_without_the_promise_go_to_the_pool(monkeypatch, noisy_sample
     """A structure whose screen does not promise a quick posterior has its posteriors and its
     conclusion run by the pool, with the numbers and warnings of the serial path; the others
     run here."""
-    probe = schedule._fit_and_probe
+    probe = schedule.fit_and_probe
 
     def pessimistic(s, data, options):
         prepared, quick = probe(s, data, options)
         return prepared, quick and s.name != "maxwell-int"
 
-    monkeypatch.setattr(schedule, "_fit_and_probe", pessimistic)
+    monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
     serial, caught_serial = _compare(workers=1)
     pool = _LazyRecorder()
     auto, caught_auto = _compare(pool=pool)
     assert _numbers(serial.results) == _numbers(auto.results)
     assert caught_serial == caught_auto
-    assert sorted(pool.steps) == [("_conclude", "maxwell-int", None),
-                                           ("_sample_held", "maxwell-int", "constant"),
-                                           ("_sample_held", "maxwell-int", "proportional")]
+    assert sorted(pool.steps) == [("conclude", "maxwell-int", None),
+                                           ("sample_held", "maxwell-int", "constant"),
+                                           ("sample_held", "maxwell-int", "proportional")]
 
 
 def test_an_input_error_ends_that_structure_alone_on_the_automatic_schedule(failing_steps):

@@ -41,9 +41,9 @@ from bayesfo.comparison.results import (  # noqa: E402
 )
 from bayesfo.data import FrequencyResponse  # noqa: E402
 from bayesfo.inference._arviz import hdi  # noqa: E402
+from bayesfo.output.report import render_report, verdict  # noqa: E402
 from bayesfo.plotting import plot_corner, plot_trace  # noqa: E402
 from bayesfo.plotting._compute import param_symbol, unit_mathtext  # noqa: E402
-from bayesfo.report import render_report, verdict  # noqa: E402
 from bayesfo.structures import get_structure  # noqa: E402
 
 W = np.logspace(-2, 3, 30)
@@ -489,7 +489,7 @@ def test_the_verdict_names_the_undetermined_parameters_of_a_winner_without_a_pic
 def test_a_parameter_without_a_finite_median_is_named_not_dropped():
     from types import SimpleNamespace
 
-    from bayesfo.verdict import _physical_sentence
+    from bayesfo.output.verdict import _physical_sentence
 
     def summary(median, reason=None):
         return {"unit": "s", "median": median, "hdi_low": 1.0, "hdi_high": math.inf,
@@ -505,7 +505,7 @@ def test_a_parameter_without_a_finite_median_is_named_not_dropped():
 
 
 def test_the_report_shows_both_flags_of_a_parameter():
-    from bayesfo.report import _flags
+    from bayesfo.output.report import _flags
 
     s = {"not_determined": True, "not_determined_reason": "its 94 % HDI runs from 0 to 3",
          "poorly_determined": True}

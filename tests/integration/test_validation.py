@@ -12,8 +12,7 @@ factor (1–2 nats): noise flips some seeds; measured 15/20, required at least 1
 from __future__ import annotations
 
 import pytest
-
-from bayesfo.validation import hit_rate
+from validation_scenarios import hit_rate
 
 
 @pytest.mark.slow

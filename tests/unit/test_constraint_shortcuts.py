@@ -1,6 +1,6 @@
 """The shortcuts of the constraint checks make the decisions of the eigenvalue route.
 
-Matignon's test of cubics takes closed-form roots (:func:`bayesfo.response.cubic_roots`) and
+Matignon's test of cubics takes closed-form roots (:func:`bayesfo.structures.response.cubic_roots`) and
 leaves to the companion-matrix eigenvalues only the rows whose decision the roots' error bound
 cannot settle; the exact dissipation check settles most rows by a certificate
 (``_isolated_negatives_dominated``) or closed-form critical points of cubic p′. Each test below
@@ -17,8 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bayesfo import response
-from bayesfo.structures import get_structure, passivity
+from bayesfo.structures import get_structure, passivity, response
 
 
 def _eigen_only(monkeypatch):

@@ -9,10 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bayesfo import response
 from bayesfo.inference.likelihood import Likelihood
-from bayesfo.response import HALF_PI, ROOT_RTOL
-from bayesfo.structures import get_structure, passivity
+from bayesfo.structures import get_structure, passivity, response
+from bayesfo.structures.response import HALF_PI, ROOT_RTOL
 from bayesfo.studies import g_spec_data
 
 

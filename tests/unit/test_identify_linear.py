@@ -15,7 +15,7 @@ from bayesfo.identify.linear import (
     weighted_solve,
 )
 from bayesfo.identify.scan import fit_linear, max_order_members, max_order_scan, q_grid_scan
-from bayesfo.response import commensurate_response
+from bayesfo.structures.response import commensurate_response
 from bayesfo.studies import OMEGA, THESIS, g_spec, run_study, thesis_noise
 
 

@@ -17,8 +17,8 @@ from bayesfo.errors import InputError, StructureError
 from bayesfo.identify import identify
 from bayesfo.identify.linear import _solve_batch
 from bayesfo.identify.scan import fit_linear, q_grid_scan
-from bayesfo.response import matignon_stable
 from bayesfo.structures import get_structure, load_library, resolve_structures
+from bayesfo.structures.response import matignon_stable
 
 OK_ROWS = "2,1,-1\n3,1,-1\n4,1,-1\n"
 

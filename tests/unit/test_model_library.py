@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from bayesfo.errors import StructureError
-from bayesfo.response import dissipation_grid, is_dissipative, matignon_stable
 from bayesfo.structures import (
     Scaling,
     coefficient_units,
@@ -28,6 +27,7 @@ from bayesfo.structures import (
 )
 from bayesfo.structures.passivity import rhp_zero_count, side_stable
 from bayesfo.structures.physical import pictures
+from bayesfo.structures.response import dissipation_grid, is_dissipative, matignon_stable
 from bayesfo.structures.variants import identifiable_rank
 
 LIB = default_library()

@@ -13,5 +13,6 @@ def test_every_subpackage_is_listed():
     listed = set(config["packages"])
     found = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "bayesfo").rglob("__init__.py")}
     assert found <= listed, f"missing from pyproject.toml packages: {sorted(found - listed)}"
-    assert config["package-dir"]["bayesfo.models"] == "models"
-    assert any((ROOT / "models").glob("*.toml"))
+    assert "package-dir" not in config, "every package lives under bayesfo/"
+    assert any((ROOT / "bayesfo" / "models").glob("*.toml"))
+    assert config["package-data"]["bayesfo.models"] == ["*.toml"]

@@ -103,7 +103,7 @@ def test_violation_outside_the_data_range_is_caught():
     s = get_structure("max-n2m0")
     theta = np.array([-1e-3, 1.0, 1.0, 0.25])
     grid = np.logspace(-3, 3, 121)
-    from bayesfo.response import is_dissipative
+    from bayesfo.structures.response import is_dissipative
 
     assert is_dissipative(s.response(theta, grid, "compliance"), "compliance")
     assert not s.passive(theta, "compliance", grid)

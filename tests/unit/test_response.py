@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from bayesfo.response import (
+from bayesfo.structures.response import (
     commensurate_response,
     dissipation_grid,
     is_dissipative,

@@ -9,13 +9,13 @@ from scipy import signal
 from bayesfo.data import FrequencyResponse
 from bayesfo.errors import InputError, StructureError
 from bayesfo.priors import Uniform
-from bayesfo.response import dissipation_grid
 from bayesfo.structures import (
     Scaling,
     default_library,
     load_library,
     resolve_structures,
 )
+from bayesfo.structures.response import dissipation_grid
 
 W = np.logspace(-2, 2, 21)
 JW = 1j * W
@@ -261,7 +261,7 @@ def test_missing_card_path():
                                   "max-n0m1-inv", "zener-int"])
 @pytest.mark.parametrize("kind", ["compliance", "modulus"])
 def test_exact_dissipation_of_first_degree_structures_equals_grid(name, kind):
-    from bayesfo.response import is_dissipative
+    from bayesfo.structures.response import is_dissipative
 
     s = LIB[name]
     assert s._first_degree

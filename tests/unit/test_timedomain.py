@@ -1,4 +1,4 @@
-"""Time-domain validation helpers (bayesfo.timedomain, thesis §4.3.3).
+"""Time-domain validation helpers (bayesfo.timeseries.timedomain, thesis §4.3.3).
 
 Known answers: (jω)^α for the Oustaloup filter; exact rational functions for integer exponents;
 1 - exp(-t) for the step response of 1/(1+s); 1 - E_{1/2}(-t^{1/2}) = 1 - erfcx(sqrt(t)) for
@@ -15,7 +15,7 @@ import pytest
 from scipy import signal, special
 
 from bayesfo.errors import InputError
-from bayesfo.timedomain import default_band, oustaloup, rational_approximation, simulate
+from bayesfo.timeseries.timedomain import default_band, oustaloup, rational_approximation, simulate
 
 HALF = ([(1.0, 0.0)], [(1.0, 0.0), (1.0, 0.5)])
 ZENER = ([(1.0, 0.0), (0.5, 0.6)], [(1.0, 0.0), (2.0, 0.6)])
@@ -300,7 +300,7 @@ def test_simulate_rejects_bad_band_and_order():
 
 def test_simulate_structure_integer_voigt_step_and_modulus():
     from bayesfo.structures import get_structure
-    from bayesfo.timedomain import simulate_structure
+    from bayesfo.timeseries.timedomain import simulate_structure
 
     t = np.linspace(0.0, 5.0, 2001)
     u = np.ones_like(t)

@@ -1,4 +1,4 @@
-"""Sine records -> frequency response (bayesfo.sine, bayesfo.records, thesis §3.1, §4.3.1, §4.3.4).
+"""Sine records -> frequency response (bayesfo.timeseries.sine, bayesfo.timeseries.records, thesis §3.1, §4.3.1, §4.3.4).
 
 Synthetic records have a known G(jω) = 1/(1 + (jω)^0.5). Tolerances on noisy records follow from
 the noise level: white noise of standard deviation s on N samples gives each component of the
@@ -17,8 +17,12 @@ import pytest
 from scipy import signal
 
 from bayesfo.errors import InputError, NonlinearityWarning
-from bayesfo.records import extract_frequency_response, read_sine_record, write_extraction
-from bayesfo.sine import HarmonicAnalysis, analyze_sine
+from bayesfo.timeseries.records import (
+    extract_frequency_response,
+    read_sine_record,
+    write_extraction,
+)
+from bayesfo.timeseries.sine import HarmonicAnalysis, analyze_sine
 
 
 def g_true(omega):

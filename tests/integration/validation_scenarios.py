@@ -12,9 +12,9 @@ import warnings
 
 import numpy as np
 
-from .comparison import compare
-from .data import FrequencyResponse
-from .structures import get_structure, resolve_structures
+from bayesfo.comparison import compare
+from bayesfo.data import FrequencyResponse
+from bayesfo.structures import get_structure, resolve_structures
 
 OMEGA = np.logspace(np.log10(0.6), np.log10(300.0), 25)
 

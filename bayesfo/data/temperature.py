@@ -1,5 +1,7 @@
-"""Temperatures of isotherms: from a ``# temperature:`` line, the file stem (``Tm010C``) or
-a ``# name:`` line."""
+"""Temperatures, the one place they are parsed: a cell or option (:func:`parse_temperature`),
+a temperature written with its unit inside a label (:func:`temperature_in_text`), and an
+isotherm file's temperature from a ``# temperature:`` line, the file stem (``Tm010C``) or a
+``# name:`` line (:func:`temperature_of_file`)."""
 
 from __future__ import annotations
 
@@ -8,6 +10,7 @@ from pathlib import Path
 
 from .._io import read_text_file
 from ..errors import InputError
+from .units import parse_unit
 
 _NUMBER = r"[+\-\u2212]?\d+(?:\.\d*)?(?:[eE][+\-]?\d+)?"
 
@@ -99,3 +102,20 @@ def temperature_of_file(path) -> float | None:
     found = _TEMPERATURE_IN_NAME.findall(meta.get("name", ""))
     return float(found[-1].replace("\u2212", "-")) if found else None
 
+
+_TEMPERATURE_TEXT = re.compile(r"([+\-−]?\d+(?:[.,]\d+)?)\s*(°\s*C|℃|deg\s*C|K|°\s*F)\b"
+                               r"|([+\-−]?\d+(?:[.,]\d+)?)\s*(°\s*C|℃)")
+
+
+def temperature_in_text(text: str) -> float | None:
+    """The temperature [°C] written with its unit in ``text`` (``"Frequency sweep (150.0 °C)"``,
+    ``"Temperature: 25 °C"``, ``"293.15 K"``), or None; the last one if several."""
+    found = None
+    for m in _TEMPERATURE_TEXT.finditer(text):
+        number, unit = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
+        u = parse_unit(unit.replace(" ", ""))
+        if u is None:
+            continue
+        value = float(number.replace("−", "-").replace(",", "."))
+        found = round(value * u.factor + u.offset, 10)
+    return found

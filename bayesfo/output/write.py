@@ -14,15 +14,26 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write_text
+from ..comparison.results import Comparison
+from ..comparison.stored import netcdf_for
+from ..comparison.table import RANKING_FIELDS
 from ..inference import save_netcdf
 from ..options import STRUCTURE_FIGURES
 from ..outdir import final_path, staged_run
-from .results import Comparison
-from .stored import netcdf_for
-from .table import RANKING_FIELDS
 
 
 def ranking_csv(comparison: Comparison) -> str:
+    """The text of ``ranking.csv``: a row per structure, the columns of
+    :data:`~bayesfo.comparison.RANKING_FIELDS` (an undefined number is an empty cell).
+
+    Parameters
+    ----------
+    comparison : Comparison
+
+    Returns
+    -------
+    str
+    """
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=RANKING_FIELDS, extrasaction="ignore", lineterminator="\n")
     writer.writeheader()
@@ -142,7 +153,7 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     with staged_run(out_dir) as stage:
         if figures:
             from ..plotting import write_figures
-            from ..report import write_report
+            from .report import write_report
 
             # The NetCDF files are written while a forked process already draws.
             drawn = write_figures(comparison, stage / "figures", formats=formats,

@@ -1,0 +1,391 @@
+"""The steps of one structure's run on one data set, shared by the serial path and the pool.
+
+(1) :func:`fit_and_screen`: the global optimisation (the modes) and, without σ in the data,
+the quick noise screen (:func:`screen`), which may set aside a noise model that trails far
+behind; :func:`fit_and_probe` does the same and says whether the rest promises to be quick.
+(2) :func:`sample_held`: one certified posterior per noise model still in the running
+(:func:`~bayesfo.inference.certified.certified_posterior`), its warnings held back.
+(3) :func:`conclude`: the noise model chosen by evidence (:func:`choose_noise`), the evidence
+check, the adequacy checks, the held-out points, and the :class:`StructureResult`.
+:func:`run_structure` runs the three in turn; :mod:`.schedule` runs them as tasks of a pool.
+Every step takes the comparison's :class:`RunOptions` and uses its seed, so the numbers do not
+depend on where a step runs.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field, replace
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..errors import InputError, NoiseWarning
+from ..identify.optimize import fit_structure
+from ..inference import Likelihood, starting_points
+from ..inference.adequacy import check_adequacy
+from ..inference.certified import certified_posterior, evidence_check
+from ..inference.importance import K_HAT_MAX, screen_noise
+from ..inference.likelihood import NOISE_PRIORS
+from ..structures import Structure
+from .criteria import _criteria, _holdout, fit_log_likelihood
+from .criteria_types import Criteria
+from .results import StructureResult
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What every step of a comparison needs besides the structure and the data (built once by
+    :func:`~bayesfo.comparison.run.compare` from its arguments).
+
+    Attributes
+    ----------
+    noise : str
+        The noise model asked for (``"auto"`` chooses by evidence).
+    priors : dict or None
+        Prior overrides ``{name: Prior}``.
+    seed : int
+        The seed of every step.
+    evidence : str
+        The ln Z route (``"auto"``, ``"bridge"``, ``"ladder"``).
+    evidence_check : bool
+        Whether dynesty checks ln Z.
+    sampler : str
+        The posterior route (``"auto"``, ``"emcee"``).
+    sampler_kwargs : dict
+        Settings passed to emcee (``max_steps``, ``n_walkers``).
+    test : FrequencyResponse or None
+        The held-out frequencies.
+    """
+
+    noise: str = "auto"
+    priors: dict | None = None
+    seed: int = 0
+    evidence: str = "auto"
+    evidence_check: bool = False
+    sampler: str = "auto"
+    sampler_kwargs: dict = field(default_factory=dict)
+    test: FrequencyResponse | None = None
+
+    def priors_of(self, s: Structure, noise: str | None = None) -> dict:
+        """The overrides that apply to ``s`` (and to the noise parameter of ``noise``)."""
+        noise_param = NOISE_PRIORS.get(noise, ("",))[0] if noise else None
+        return {k: v for k, v in (self.priors or {}).items()
+                if k in s.param_names or k == noise_param}
+
+
+@dataclass
+class NoiseRun:
+    """One structure's posterior under one noise model (step 2), before the choice of noise
+    model: the likelihood, the certified posterior, the criteria being built (a dict of
+    :class:`Criteria` fields), and the warnings held back as (category, message, file, line)."""
+
+    lik: Any
+    post: Any
+    criteria: dict
+    caught: list = field(default_factory=list)
+
+
+class Screen(NamedTuple):
+    """The noise screen's decision: the leading noise model and every candidate's quick
+    estimate (:func:`~bayesfo.inference.importance.screen_noise`)."""
+
+    leader: str
+    quick: dict
+
+
+class _Entry(NamedTuple):
+    """A noise model in the choice: its ln Z, error and method, its exponents' intervals, and
+    its run (None for a model the screen set aside)."""
+
+    noise: str
+    log_z: float
+    log_z_err: float | None
+    method: str | None
+    intervals: dict
+    run: NoiseRun | None
+
+
+def remedy(lik) -> str:
+    """What to try when a posterior is not certified: the options that address it."""
+    walkers = max(32, 4 * lik.ndim)
+    walkers += -walkers % 4
+    exponents = [p.name for p in lik.structure.parameters if p.role == "exponent"]
+    prior = (f", or a narrower prior where you know the physics (e.g. --prior "
+             f"{exponents[0]}=uniform:0.2:1)" if exponents else "")
+    return (f"Try a longer run (--max-steps 40000; API: max_steps=40000), more walkers "
+            f"(--walkers {2 * walkers}; API: n_walkers={2 * walkers}){prior}")
+
+
+def _noise_candidates(data: FrequencyResponse, noise: str) -> tuple[str, ...]:
+    """The noise models a structure is run with: the one asked for; ``auto`` (which the
+    likelihood resolves to ``known``, saying why) when the data carry σ; else both
+    ``constant`` and ``proportional``, between which the evidence chooses. (:func:`compare`
+    refuses ``auto`` without σ where the response is exactly 0: relative noise has no scale
+    there.)"""
+    if noise != "auto" or data.sigma is not None:
+        return (noise,)
+    return NOISE_CANDIDATES
+
+
+#: The noise models between which ``noise="auto"`` chooses by evidence, when the data carry no σ.
+NOISE_CANDIDATES = ("constant", "proportional")
+
+
+def sample(s: Structure, data: FrequencyResponse, noise: str, fit,
+           options: RunOptions) -> NoiseRun:
+    """Posterior, criteria and evidence of one structure under one noise model."""
+    lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
+    modes, starts = starting_points(lik, fit)
+    # Without optima (none admissible) there is no importance proposal: emcee from the best fit.
+    sampler = options.sampler if fit.optima.size else "emcee"
+    found = certified_posterior(
+        lik, modes, starts=starts, sampler=sampler, evidence=options.evidence,
+        seed=options.seed, fit_log_likelihood=fit_log_likelihood(lik, fit), remedy=remedy(lik),
+        sampler_options=options.sampler_kwargs)
+    post = found.posterior
+    criteria = _criteria(lik, fit, post)
+    criteria["warnings"].extend(found.notes)
+    criteria.update(evidence=found.evidence, evidence_check=None, evidence_agree=None)
+    if found.importance is not None:
+        criteria["importance"] = found.importance
+    return NoiseRun(lik, post, criteria)
+
+
+def _exponent_intervals(run: NoiseRun) -> dict:
+    """94 % HDIs of the structure's exponents (q, α, β, ...) under one noise model."""
+    lik, post = run.lik, run.post
+    return {p.name: (post.summary[p.name].hdi_low, post.summary[p.name].hdi_high)
+            for p in lik.structure.parameters if p.role == "exponent"}
+
+
+#: A noise model whose quick ln Z (:func:`~bayesfo.inference.importance.screen_noise`) trails
+#: the other's by this many nats (posterior odds above 150:1) is not sampled in full, provided
+#: its own estimate is reliable (Pareto k̂ < 0.7; a heavy-tailed estimate of the leader only
+#: understates its lead).
+SCREEN_MARGIN = 5.0
+
+
+def _quick_estimates(s, data, candidates, fit, options: RunOptions) -> dict:
+    """The quick ln Z (:func:`~bayesfo.inference.importance.screen_noise`) of each candidate
+    noise model in turn, up to the first that has none (None)."""
+    quick = {}
+    for noise in candidates:
+        lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
+        modes = lik.structure.to_scaled(lik.structure.to_physical(fit.optima, fit.scaling),
+                                        lik.scaling)
+        try:
+            quick[noise] = screen_noise(lik, modes, seed=options.seed)
+        except (np.linalg.LinAlgError, FloatingPointError):
+            quick[noise] = None
+        if quick[noise] is None:
+            break
+    return quick
+
+
+def screen(s, data, candidates, fit, options: RunOptions, quick=None) -> Screen | None:
+    """The quick ln Z of each candidate noise model, and the leader where it is decisive (see
+    :data:`SCREEN_MARGIN`); None when all candidates must be sampled. ``quick``: the estimates
+    of :func:`_quick_estimates`, when already made."""
+    if len(candidates) < 2 or not fit.optima.size:
+        return None
+    if quick is None:
+        quick = _quick_estimates(s, data, candidates, fit, options)
+    if any(quick.get(noise) is None for noise in candidates):
+        return None
+    quick = {noise: quick[noise] for noise in candidates}
+    order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
+    leader, other = order[0], order[1]
+    if (quick[leader]["log_z"] - quick[other]["log_z"] < SCREEN_MARGIN
+            or not quick[other]["k_hat"] < K_HAT_MAX):
+        return None
+    return Screen(leader, quick)
+
+
+def choose_noise(name: str, runs: list[NoiseRun],
+                 screened: Screen | None) -> tuple[NoiseRun, dict]:
+    """The run whose noise model has the larger evidence, and the record of the choice: each
+    noise model's ln Z (certified, or the quick estimate of a model left out by the screen),
+    its posterior probability (equal prior odds) and the exponents' intervals, and
+    ``sensitive`` when an exponent's intervals under the two models do not overlap."""
+    entries = []
+    for r in runs:
+        e = r.criteria["evidence"]
+        entries.append(_Entry(r.lik.noise, e.log_z if e is not None else -np.inf,
+                              None if e is None else float(e.log_z_err),
+                              None if e is None else e.method, _exponent_intervals(r), r))
+    if screened is not None:
+        for noise, q in screened.quick.items():
+            if noise != screened.leader:
+                entries.append(_Entry(noise, q["log_z"], None, q["method"], q["intervals"],
+                                      None))
+    log_z = np.array([e.log_z for e in entries])
+    sampled = [i for i, e in enumerate(entries) if e.run is not None]
+    best = max(sampled, key=lambda i: log_z[i])
+    if np.isfinite(log_z[best]):
+        prob = np.exp(log_z - log_z[best])
+        prob /= prob.sum()
+    else:
+        prob = np.full(len(entries), np.nan)
+    chosen = entries[best].run
+    record = {"chosen": entries[best].noise, "models": {}}
+    for (noise, lz, err, method, hdi, _), p in zip(entries, prob, strict=True):
+        record["models"][noise] = {
+            "log_evidence": float(lz) if np.isfinite(lz) else None, "log_evidence_err": err,
+            "evidence_method": method,
+            "probability": float(p) if np.isfinite(p) else None,
+            "hdi": {k: [float(lo), float(hi)] for k, (lo, hi) in hdi.items()},
+        }
+    intervals = [e.intervals for e in entries]
+    apart = []
+    for param in intervals[best]:
+        spans = [iv[param] for iv in intervals if param in iv]
+        if max(lo for lo, _ in spans) > min(hi for _, hi in spans):
+            apart.append(param)
+    record["sensitive"] = bool(apart)
+    record["sensitive_parameters"] = apart
+    other = next(i for i in range(len(entries)) if i != best)
+    delta = log_z[best] - log_z[other]
+    reason = (f"chosen by evidence over {' and '.join(e.noise for e in entries)} noise "
+              + (f"(ln Z higher by {delta:.1f}; probability {prob[best]:.3f})"
+                 if np.isfinite(delta) else "(the other has no evidence)"))
+    chosen.post = replace(chosen.post, noise_reason=reason)
+    if apart:
+        ours, theirs = intervals[best], intervals[other]
+        shown = "; ".join(
+            f"{p} {ours[p][0]:.3g}…{ours[p][1]:.3g} under {entries[best].noise} noise, "
+            f"{theirs[p][0]:.3g}…{theirs[p][1]:.3g} under {entries[other].noise}"
+            for p in apart)
+        decided = np.isfinite(prob[best]) and prob[best] >= NOISE_DECISIVE
+        msg = (f"{name}: the exponents depend on the noise model: 94 % intervals do not overlap "
+               f"({shown}); the evidence favours {entries[best].noise} noise with probability "
+               f"{prob[best]:.3f}")
+        if not decided:
+            msg += (". Give sigma per point, or force a model with --noise, if you know how "
+                    "the instrument's error scales")
+        chosen.criteria["warnings"].append(msg)
+        if not decided:
+            warnings.warn(msg, NoiseWarning, stacklevel=3)
+    return chosen, record
+
+
+#: The evidence decides the noise model when it gives the chosen one at least this probability;
+#: below, non-overlapping exponent intervals raise a NoiseWarning (the conclusion then hangs on
+#: a choice the data do not make).
+NOISE_DECISIVE = 0.99
+
+
+def run_structure(s: Structure, data: FrequencyResponse, options: RunOptions):
+    """Optimisation, posterior, criteria and evidence of one structure, in three steps:
+    :func:`fit_and_screen`, :func:`sample_held` per noise model still in the running, and
+    :func:`conclude` (a pool runs the steps as separate tasks, :mod:`.schedule`). Returns the
+    result and the warnings raised on the way."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            fit, screened, noises = fit_and_screen(s, data, options)
+            runs = [sample_held(s, data, noise, fit, options) for noise in noises]
+            result = conclude(s, data, fit, screened, runs, options)
+        except InputError as exc:
+            result = StructureResult(s, error=str(exc))
+    return result, kept(s.name, [(w.category, str(w.message)) for w in caught])
+
+
+def fit_and_screen(s: Structure, data: FrequencyResponse, options: RunOptions):
+    """Step 1: the optimisation and the noise screen (:func:`screen`). Returns the fit, the
+    screen's record (None when it did not decide) and the noise models to sample."""
+    candidates, fit = _fit(s, data, options)
+    screened = screen(s, data, candidates, fit, options)
+    return fit, screened, [n for n in candidates if screened is None or n == screened.leader]
+
+
+def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions):
+    """Step 1 as :func:`fit_and_screen`, and whether the rest promises to be quick: the
+    screen's raw importance weights of every noise model still to sample have a Pareto k̂ below
+    :data:`~bayesfo.inference.importance.K_HAT_MAX`, so that importance sampling will most
+    likely certify the posterior (a fraction of a second) and neither the ladder nor emcee will
+    run. Returns ((fit, screened, noise models), quick). The numbers and the warnings are those
+    of :func:`fit_and_screen`: the estimates that the screen does not make itself are made
+    with their warnings discarded, and they only guide where the next steps run."""
+    candidates, fit = _fit(s, data, options)
+    quick = (_quick_estimates(s, data, candidates, fit, options)
+             if len(candidates) > 1 and fit.optima.size else {})
+    screened = screen(s, data, candidates, fit, options, quick=quick)
+    noises = [n for n in candidates if screened is None or n == screened.leader]
+    if (options.sampler != "auto" or options.evidence != "auto"
+            or options.evidence_check or not fit.optima.size):
+        return (fit, screened, noises), False
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for noise in noises:
+            if noise not in quick:
+                try:
+                    quick.update(_quick_estimates(s, data, (noise,), fit, options))
+                except (InputError, np.linalg.LinAlgError, FloatingPointError):
+                    quick[noise] = None
+    promise = all(quick.get(n) is not None and quick[n]["k_hat"] < K_HAT_MAX for n in noises)
+    return (fit, screened, noises), promise
+
+
+def _fit(s: Structure, data: FrequencyResponse, options: RunOptions):
+    """The noise models to choose from and the global optimisation (the modes)."""
+    candidates = _noise_candidates(data, options.noise)
+    structure = Likelihood(s, data, noise=candidates[0], priors=options.priors_of(s)).structure
+    fit = fit_structure(structure, data, rng=options.seed, seed_methods=True,
+                        linear_methods=True)
+    return candidates, fit
+
+
+def sample_held(s: Structure, data: FrequencyResponse, noise: str, fit,
+                options: RunOptions) -> NoiseRun:
+    """Step 2: :func:`sample` under one noise model, its warnings held back in
+    ``run.caught`` (category, message, file, line): only the chosen model's reach the user
+    (:func:`conclude`; the other's are kept in its record)."""
+    with warnings.catch_warnings(record=True) as held:
+        warnings.simplefilter("always")
+        run = sample(s, data, noise, fit, options)
+    run.caught = [(w.category, str(w.message), w.filename, w.lineno) for w in held]
+    return run
+
+
+def conclude(s: Structure, data: FrequencyResponse, fit, screened: Screen | None,
+             runs: list[NoiseRun], options: RunOptions) -> StructureResult:
+    """Step 3, once the runs of step 2 are in: the noise model chosen by evidence, the chosen
+    run's warnings issued, the evidence check, the adequacy checks, the held-out points."""
+    seed, test = options.seed, options.test
+    if len(_noise_candidates(data, options.noise)) > 1:
+        run, record = choose_noise(s.name, runs, screened)
+    else:
+        run, record = runs[0], None
+    lik, post, criteria = run.lik, run.post, run.criteria
+    for category, message, filename, lineno in run.caught:
+        warnings.warn_explicit(message, category, filename, lineno)
+    for other in runs:
+        if other is not run:
+            record["models"][other.lik.noise]["warnings"] = list(
+                dict.fromkeys(message for _, message, _, _ in other.caught))
+    criteria["noise_models"] = record
+    if options.evidence_check and criteria["evidence"] is not None:
+        check = evidence_check(lik, post, criteria["evidence"], seed)
+        criteria["warnings"].extend(check.pop("warnings"))
+        criteria.update(check)
+    try:
+        criteria["adequacy"] = check_adequacy(lik, post, seed=seed)
+    except InputError as exc:  # e.g. too few frequencies for the statistics
+        criteria["adequacy"] = None
+        criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
+    if test is not None:
+        criteria.update(_holdout(lik, post, test))
+    return StructureResult(s, fit, post, Criteria.from_dict(criteria))
+
+
+def kept(name: str, caught) -> list[tuple]:
+    """The warnings (category, message) of a structure's run, each once, said of the structure
+    (a library's gets its name in front; deprecations are dropped)."""
+    kept = {}
+    for category, text in caught:
+        text = text if text.startswith(f"{name}:") else f"{name}: {text}"
+        if not issubclass(category, (DeprecationWarning, PendingDeprecationWarning)):
+            kept.setdefault((category, text))
+    return list(kept)

@@ -1,0 +1,318 @@
+"""The verdict of a comparison in plain language: which structure the data support, by how
+much (Kass & Raftery's verbal scale of the Bayes factor), whether the information criteria and
+the posterior predictive checks agree, how well the fractional order is determined, which
+posteriors are not certified, how the noise model was chosen, and the winner's physical
+parameters with units (naming instead of valuing those the data do not determine).
+
+:func:`verdict` returns the sentences, each with a flag that marks a caution; the report
+(:mod:`bayesfo.output.report`) renders them as its first section, and scripts can print them.
+
+References
+----------
+Kass, R. E. & Raftery, A. E. (1995). Bayes factors. *J. Am. Stat. Assoc.* 90, 773–795 (the
+verbal scale of the evidence).
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names
+from ..comparison.table import ORDER_SYMBOLS
+
+#: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
+EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
+                  (5.0, "strong"), (math.inf, "very strong"))
+CRITERIA_NAMES = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
+HDI_PERCENT = 94
+
+def _finite(x) -> bool:
+    if x is None or isinstance(x, (bool, str)):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except (TypeError, ValueError):
+        return False
+
+
+
+def _prob(p) -> str:
+    if not _finite(p):
+        return "–"
+    return "< 0.001" if p < 0.001 else f"{p:.3f}"
+
+
+def _bayes_factor(d: float) -> str:
+    if d < 30:
+        return f"{math.exp(d):.3g}"
+    return f"about 10^{d / math.log(10):.0f}"
+
+
+def _strength(d: float) -> str:
+    return next(label for bound, label in EVIDENCE_SCALE if d < bound)
+
+
+def _orders(result) -> list:
+    """``(name, summary)`` of every fractional order of a result's posterior."""
+    from ..comparison.table import order_parameters
+
+    summary = result.posterior.summary
+    return [(p, summary[p]) for p in order_parameters(summary)]
+
+
+def _digits(sd: float) -> int:
+    """Decimals that show a value to the second significant digit of its standard deviation."""
+    if not _finite(sd) or sd <= 0:
+        return 3
+    return min(8, max(0, 1 - math.floor(math.log10(sd))))
+
+
+def _sentence(text: str) -> str:
+    return text if text.endswith(".") else text + "."
+
+
+def _adequacy_sentences(comparison, rows) -> list[tuple[str, bool]]:
+    """Whether the best-supported structure, and any candidate, describes the data (posterior
+    predictive checks, :mod:`bayesfo.inference.adequacy`)."""
+    checked = [(r["structure"], comparison[r["structure"]].adequacy) for r in rows]
+    checked = [(n, a) for n, a in checked if a is not None]
+    if not checked:
+        return []
+    name, best = checked[0]
+    level = f"{100 * best.level:g} %"
+    if not any(a.adequate for _, a in checked):
+        small = [n for n, a in checked if a.misfit_small]
+        text = ("None of the candidates describes these data: every structure fails the "
+                f"posterior predictive checks at the {level} level, so the ranking says only "
+                "which misfits least." + (f" {name}: {_sentence(best.reasons[0])}"
+                                          if best.reasons else ""))
+        if small:
+            text += (f" The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
+                     f"{_join(small)}.")
+        return [(text.rstrip(), True)]
+    if best.adequate and best.misfit_masked:
+        return [(f"{name} passes its posterior predictive checks at the {level} level, but "
+                 f"{best.caution} (its {best.noise} noise model treats them as noise; if they "
+                 "are more precise than that, the pass does not extend to them).", True)]
+    if best.adequate:
+        return [(f"{name} describes the data: its posterior predictive checks pass at the "
+                 f"{level} level (largest misfit {best.max_phase_error_deg:.1f}° in phase, "
+                 f"{100 * (10 ** best.max_log10_magnitude_error - 1):.1f} % in magnitude).",
+                 False)]
+    good = [n for n, a in checked if a.adequate]
+    text = (f"{name} is best supported but does not describe the data: "
+            f"{_sentence(best.reasons[0] if best.reasons else best.summary)}")
+    text += f" Structures that pass the checks: {_join(good)}."
+    return [(text, True)]
+
+
+def verdict(comparison) -> list[tuple[str, bool]]:
+    """The plain-language verdict, as sentences ``(text, flagged)``.
+
+    Parameters
+    ----------
+    comparison : bayesfo.comparison.Comparison
+
+    Returns
+    -------
+    list of (str, bool)
+        Sentences in reading order, whether the structures describe the data first, then the
+        evidence; ``flagged`` marks cautions (no convergence, poorly
+        determined order, parameters the data do not determine, an evidence difference within
+        its error).
+    """
+    rows = [r for r in comparison.table() if r.get("rank") is not None]
+    failed = [r for r in comparison.results if r.error is not None]
+    out: list[tuple[str, bool]] = [(f"Data: {w.split(': ', 1)[1]}.", True)
+                                   for w in comparison.data_warnings]
+    kk = comparison.data.kramers_kronig()
+    if kk is not None and not kk.consistent:
+        out.append((f"Data: {kk.describe()}.", True))
+    if not rows:
+        return out + [("No structure could be run on these data.", True)]
+    best = rows[0]
+    name = best["structure"]
+    result = comparison[name]
+    # Whether the structures describe the data comes first: a decisive ranking of structures
+    # that all misfit says only which misfits least.
+    out.extend(_adequacy_sentences(comparison, rows))
+    if best["log_evidence"] is None:
+        out.append((f"No structure has a log-evidence; ranked by PSIS-LOO, {name} comes first.",
+                    True))
+    elif len(rows) == 1:
+        out.append((f"Only one structure was run: {name}, with ln Z = "
+                    f"{best['log_evidence']:.2f} ± {best['log_evidence_err']:.2f}.", False))
+    else:
+        second = rows[1]
+        n = len(rows)
+        if second["log_evidence"] is None:
+            out.append((f"{name} has the highest log-evidence (ln Z = "
+                        f"{best['log_evidence']:.2f}); {second['structure']} has none.", False))
+        else:
+            d = best["log_evidence"] - second["log_evidence"]
+            err = math.hypot(best["log_evidence_err"] or 0.0, second["log_evidence_err"] or 0.0)
+            out.append((
+                f"{name} is the best-supported structure: its log-evidence exceeds that of the "
+                f"runner-up, {second['structure']}, by Δln Z = {d:.2f} ± {err:.2f} (Bayes "
+                f"factor {_bayes_factor(d)}; on the Kass–Raftery scale the evidence is "
+                f"{_strength(d)}). Its posterior probability among the {n} structures compared is "
+                f"{_prob(best['posterior_probability'])} (equal prior odds unless others were "
+                "given).", False))
+            if d < 2 * err:
+                out.append((f"The difference from {second['structure']} is within twice its "
+                            "estimation error: the evidence does not separate the two.", True))
+    if len(rows) > 1:
+        agree = [c for c in CRITERIA_NAMES if best.get(f"rank_{c}") == 1]
+        disagree = {}
+        for c in CRITERIA_NAMES:
+            if c not in agree:
+                top = next((r["structure"] for r in rows if r.get(f"rank_{c}") == 1), None)
+                disagree.setdefault(top, []).append(CRITERIA_NAMES[c])
+        if not disagree:
+            out.append(("The information criteria agree: PSIS-LOO, WAIC, AIC and BIC all rank "
+                        f"{name} first.", False))
+        else:
+            parts = [f"{_join(crit)} prefer{'s' if len(crit) == 1 else ''} {other}"
+                     for other, crit in disagree.items()]
+            lead = (f"{_join([CRITERIA_NAMES[c] for c in agree])} also rank {name} first, but "
+                    if agree else "The information criteria disagree with the evidence: ")
+            out.append((lead + "; ".join(parts) + ".", False))
+    orders = _orders(result)
+    if orders:
+        values = []
+        for p, s in orders:
+            digits = _digits(s.sd)
+            values.append(f"{ORDER_SYMBOLS[p]} = {s.mean:.{digits}f} (sd {s.sd:.2g}, "
+                          f"{HDI_PERCENT} % HDI {s.hdi_low:.{digits}f}–{s.hdi_high:.{digits}f})")
+        text = (f"The fractional order{'s' if len(orders) > 1 else ''} of {name} "
+                f"{'are' if len(orders) > 1 else 'is'} {_join(values)}.")
+        poor = [ORDER_SYMBOLS[p] for p, s in orders if s.poorly_determined]
+        if poor:
+            out.append((text + f" {_join(poor)} {'is' if len(poor) == 1 else 'are'} poorly "
+                        f"determined: {'its' if len(poor) == 1 else 'their'} {HDI_PERCENT} % "
+                        "HDI covers more than half of the prior range.", True))
+        else:
+            out.append((text, False))
+        for p, s in orders:
+            if s.multimodal:
+                out.append((f"The posterior of {ORDER_SYMBOLS[p]} has several separated modes.",
+                            True))
+    elif result.structure.integer:
+        out.append((f"{name} is an integer-order structure (its exponents are fixed at 1).",
+                    False))
+    out.extend(_physical_sentence(name, result, skip={p for p, _ in orders}))
+    out.extend(_noise_sentences(name, result))
+    poor = [r["structure"] for r in rows[1:]
+            if any(s.poorly_determined for _, s in _orders(comparison[r["structure"]]))]
+    if poor:
+        out.append(("The fractional order is poorly determined (HDI wider than half the prior "
+                    f"range) for: {', '.join(poor)}.", True))
+    # Every ranked structure, the winner first, named as the terminal names them (the form
+    # natural to the data), whether or not a sentence above gave its values.
+    vague = [f"{r['structure']} ({', '.join(names)})" for r in rows
+             if (names := _undetermined(comparison[r["structure"]]))]
+    if vague:
+        out.append((f"Parameters that the data do not determine ({HDI_PERCENT} % HDI over more "
+                    f"than {UNDETERMINED_DECADES:g} decades on a log scale, reaching 0 or "
+                    "infinity, or undefined; their numbers are not estimates): "
+                    f"{'; '.join(vague)}.", True))
+    if not best["converged"]:
+        post = result.posterior
+        out.append((f"Caution: the posterior of {name} did not converge (R-hat "
+                    f"{post.rhat_max:.3f}, ESS {post.ess_min:.0f}); its log-evidence and the "
+                    "ranking that rests on it are unreliable. Try a longer run (--max-steps "
+                    "40000), more walkers (--walkers) or a narrower prior (--prior).", True))
+        conv = next((r for r in rows if r["converged"]), None)
+        if conv is not None and conv["log_evidence"] is not None and best["log_evidence"] is not None:
+            out.append((f"The best-supported structure whose posterior converged is "
+                        f"{conv['structure']} (Δln Z = {conv['log_evidence'] - best['log_evidence']:.2f}"
+                        f" to {name}, posterior probability {_prob(conv['posterior_probability'])}).",
+                        True))
+    others = [r["structure"] for r in rows[1:] if not r["converged"]]
+    if others:
+        out.append((f"Posteriors that did not converge: {', '.join(others)}.", True))
+    if comparison.holdout is not None:
+        scored = [r for r in rows if _finite(r.get("holdout_lpd"))]
+        if scored:
+            top = max(scored, key=lambda r: r["holdout_lpd"])
+            out.append((f"On the {comparison.holdout.n_frequencies} held-out frequencies, "
+                        f"{top['structure']} predicts best (log predictive density "
+                        f"{top['holdout_lpd']:.2f}).", False))
+    if failed:
+        out.append(("Could not be run: " + "; ".join(f"{r.name} ({r.error})" for r in failed)
+                    + ".", True))
+    return out
+
+
+def _undetermined(result) -> list[str]:
+    """The parameters of ``result``, in the form natural to the data, that the data do not
+    determine (:func:`~bayesfo.comparison.parameters.not_determined`): the names the terminal
+    lists beneath the ranking."""
+    if getattr(result, "posterior", None) is None:
+        return []
+    return flagged_names(result.natural_parameters)
+
+
+def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
+    """The winner's physical parameters: posterior median and 94 % HDI with units; those the
+    data do not determine are named with the reason instead of a value."""
+    phys = getattr(result, "physical", None)
+    if not phys or phys["picture"] is None:
+        return []
+    parts, vague = [], []
+    for p, s in phys["physical"].items():
+        if skip is not None and p in skip:
+            continue
+        if s.get("not_determined"):  # before the value: an undefined median is named too
+            vague.append(f"{p} ({s['not_determined_reason']})")
+            continue
+        if not _finite(s.get("median")):
+            continue
+        unit = f" {s['unit']}" if s["unit"] else ""
+        hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"
+               if _finite(s.get("hdi_low")) and _finite(s.get("hdi_high")) else "")
+        parts.append(f"{p} = {s['median']:.3g}{unit}{hdi}")
+    out = []
+    picture = "" if phys["picture"] == name else f" ({phys['picture']})"
+    if parts:
+        out.append((f"In physical parameters{picture}, {name} has {_join(parts)} "
+                    f"(posterior medians, {HDI_PERCENT} % HDI in brackets).", False))
+    if vague:
+        out.append((f"The data do not determine {_join(vague)} of {name}: "
+                    + ("its value is not an estimate." if len(vague) == 1
+                       else "their values are not estimates."), True))
+    return out
+
+
+def _join(items) -> str:
+    items = list(items)
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _noise_sentences(name, result) -> list[tuple[str, bool]]:
+    """How the winner's noise model was chosen, and whether its exponents depend on it."""
+    from ..comparison.steps import NOISE_DECISIVE
+
+    record = result.criteria.get("noise_models")
+    if not record:
+        return []
+    chosen = record["chosen"]
+    models = record["models"]
+    p = models[chosen]["probability"]
+    others = [n for n in models if n != chosen]
+    text = (f"Noise model of {name}: {chosen}, chosen by evidence over "
+            f"{_join(others)} noise" + (f" (probability {p:.3f})." if p is not None else "."))
+    if not record["sensitive"]:
+        return [(text, False)]
+    parts = []
+    for param in record["sensitive_parameters"]:
+        spans = [f"{models[n]['hdi'][param][0]:.3g}–{models[n]['hdi'][param][1]:.3g} under {n} "
+                 "noise" for n in [chosen, *others] if param in models[n]["hdi"]]
+        parts.append(f"{param} {'; '.join(spans)}")
+    decided = p is not None and p >= NOISE_DECISIVE
+    text += (f" Its exponents depend on the noise model ({HDI_PERCENT} % intervals that do not "
+             f"overlap: {'; '.join(parts)})"
+             + ("; the evidence decides between them." if decided else
+                "; the evidence does not decide between them, so state σ per point or choose "
+                "the noise model (--noise) from what you know of the instrument."))
+    return [(text, not decided)]

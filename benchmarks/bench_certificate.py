@@ -71,7 +71,7 @@ def one(card: str, seed: int) -> dict:
     k = lik.structure.n_params
     got, want = r.posterior.samples[:, :k], ref.samples[:, :k]
     outside = float(np.mean(np.any((want < got.min(0)) | (want > got.max(0)), axis=1)))
-    widest = (r.criteria.get("importance") or {}).get("widest") or {}
+    widest = (r.criteria.importance or {}).get("widest") or {}
     return {"card": card, "seed": seed, "route": r.posterior.sampler,
             "certified": bool(r.posterior.converged), "outside": outside,
             "reference_certified": bool(ref.converged), "seconds": seconds,

@@ -74,7 +74,7 @@ def certificate(r) -> tuple[bool, str]:
     it (checked here from those figures, not taken from ``converged`` alone), and the figures."""
     post = r.posterior
     if post.sampler == "importance":
-        imp = r.criteria.get("importance") or {}
+        imp = r.criteria.importance or {}
         k_hat, ess = imp.get("k_hat", math.nan), imp.get("ess", math.nan)
         ok = k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE
         return ok, f"k̂ {k_hat:.2f}, ESS_w {ess:.0f}"
@@ -116,21 +116,21 @@ def survey(key: str, structures: str, seed: int, workers: int) -> dict | None:
             print(f"{'-':>2} {r.name:<12} failed: {r.error}")
             rows.append({"structure": r.name, "error": r.error})
             continue
-        post, ev = r.posterior, r.criteria.get("evidence")
+        post, ev = r.posterior, r.criteria.evidence
         ok, figures = certificate(r)
         z = "-" if ev is None else f"{_f(ev.log_z, '.2f')} ± {_f(ev.log_z_err, '.2f')}"
-        nm = r.criteria.get("noise_models") or {}
+        nm = r.criteria.noise_models or {}
         noise = post.noise + ("!" if nm.get("sensitive") else "")
         flag = ("yes" if ok else "NO") + ("" if ok == post.converged else "*")
         print(f"{rank[r.name]:>2} {r.name:<12} {post.sampler:<10} {flag:<4} {figures:<38} "
               f"{noise:<12} {z:>20} {'-' if ev is None else ev.method:<10} "
-              f"{_f(r.criteria.get('posterior_probability'), '.3f'):>6} {r.fits or '-':<5}")
+              f"{_f(r.criteria.posterior_probability, '.3f'):>6} {r.fits or '-':<5}")
         rows.append({
             "structure": r.name, "rank": rank[r.name], "sampler": post.sampler,
             "certified": bool(ok), "converged": bool(post.converged),
             "rhat": post.rhat_max, "ess_bulk": post.ess_bulk_min, "ess_tail": post.ess_tail_min,
             "n_chains": post.n_walkers, "n_steps": post.n_steps,
-            "importance": {k: v for k, v in (r.criteria.get("importance") or {}).items()
+            "importance": {k: v for k, v in (r.criteria.importance or {}).items()
                            if not isinstance(v, np.ndarray)},
             "noise": post.noise, "noise_sensitive": nm.get("sensitive"),
             "noise_models": {k: {kk: vv for kk, vv in v.items() if kk != "warnings"}
@@ -138,12 +138,12 @@ def survey(key: str, structures: str, seed: int, workers: int) -> dict | None:
             "log_z": None if ev is None else ev.log_z,
             "log_z_err": None if ev is None else ev.log_z_err,
             "method": None if ev is None else ev.method,
-            "probability": r.criteria.get("posterior_probability"),
+            "probability": r.criteria.posterior_probability,
             "fits": r.fits,
             "max_phase_error_deg": None if r.adequacy is None else r.adequacy.max_phase_error_deg,
             "max_log10_mag_error": (None if r.adequacy is None
                                     else r.adequacy.max_log10_magnitude_error),
-            "messages": list(post.messages), "warnings": list(r.criteria["warnings"]),
+            "messages": list(post.messages), "warnings": list(r.criteria.warnings),
         })
     print("(cert: the route's own certificate, recomputed; * where it differs from "
           "posterior.converged; noise '!': exponents depend on the noise model)")

@@ -48,7 +48,7 @@ def main(argv=None):
         if r.error:
             print(f"{r.name:<14}  not run: {r.error}")
             continue
-        ev = r.criteria["evidence"]
+        ev = r.criteria.evidence
         print(f"{r.name:<14} {r.posterior.n_steps:6d} {ev.log_z:9.2f} ± {ev.log_z_err:4.2f} "
               f"{ev.method:>7} {ev.seconds:6.1f} {r.posterior.rhat_max:6.3f} {r.posterior.converged}")
     print(f"{len(structures)} structures on {data.n_frequencies} points, {args.workers or 'one per CPU'} "

@@ -46,7 +46,7 @@ def main() -> None:
     def log_b(omega, y, sd):
         c = bf.compare(FrequencyResponse(omega, y, sd, kind="modulus"), "voigt,zener", seed=0,
                        progress=False, workers=1)
-        return c, c["zener"].criteria["evidence"].log_z - c["voigt"].criteria["evidence"].log_z
+        return c, c["zener"].criteria.evidence.log_z - c["voigt"].criteria.evidence.log_z
 
     t0 = time.perf_counter()
     y, sd = simulate(w, np.random.default_rng(0))

@@ -53,7 +53,7 @@ def main():
           f"criteria (2 processes), {t_compare - t_posteriors:.1f} s for figures and report")
     total_dynesty = 0.0
     for name in ("zener", "voigt"):
-        ev = result[name].criteria["evidence"]
+        ev = result[name].criteria.evidence
         t = time.perf_counter()
         nested = nested_evidence(Likelihood(get_structure(name), data), seed=0, nlive=500)
         dt = time.perf_counter() - t

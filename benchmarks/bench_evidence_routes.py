@@ -56,7 +56,7 @@ def main(argv=None):
             print(f"{s.name:<12} not run: {exc}", flush=True)
             continue
         t_bridge = time.perf_counter() - t
-        bridge = r.criteria["evidence"]
+        bridge = r.criteria.evidence
         lik = Likelihood(s, data)
         ladder = ladder_evidence(lik, seed=args.seed, guide=r.posterior)
         default = bridge if r.posterior.converged else ladder

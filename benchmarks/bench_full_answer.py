@@ -60,7 +60,7 @@ def one_structure() -> None:
                 times.append(time.perf_counter() - t)
                 samplers.add(r.posterior.sampler)
                 if seed == 0:
-                    first = r.criteria["evidence"]
+                    first = r.criteria.evidence
             print(f"{n:>6} {route:<8} {np.median(times):>9.3f} {np.max(times):>7.3f} "
                   f"{'/'.join(sorted(samplers)):<11} {first.log_z:>12.3f} ± {first.log_z_err:.3f}")
         lik = Likelihood(get_structure("zener"), _zener_data(n, 0))

@@ -55,7 +55,7 @@ def main(argv=None):
             warnings.simplefilter("ignore")
             r = bf.compare(data, args.structure, seed=seed, workers=1, progress=False,
                            noise=args.noise)[args.structure]
-        ev = r.criteria["evidence"]
+        ev = r.criteria.evidence
         ok, figures = certificate(r)
         values.append((ev.log_z, ev.log_z_err))
         print(f"seed {seed}: {r.posterior.sampler:<10} noise {r.posterior.noise:<12} ln Z "

@@ -142,7 +142,7 @@ def main(argv=None) -> int:
     print_orders(comp)
     best_plain = next(n for n in comp.ranking if n in plain)
     best = comp.ranking[0]
-    dz = (comp[best].criteria["evidence"].log_z - comp[best_plain].criteria["evidence"].log_z)
+    dz = (comp[best].criteria.evidence.log_z - comp[best_plain].criteria.evidence.log_z)
     print(f"\nBest structure: {best}; best without inversion: {best_plain}, "
           f"{dz:.1f} nats of ln Z below it.")
     save(comp, args.out, figures=not args.no_figures, quick=args.quick)

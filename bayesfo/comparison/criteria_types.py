@@ -2,15 +2,17 @@
 
 :func:`~bayesfo.comparison.run.compare` builds each structure's criteria as a dict while it
 runs and turns it into a :class:`Criteria` once, at the end (:meth:`Criteria.from_dict`); a
-misspelt key fails there. A :class:`Criteria` reads like the dict it replaced
-(``criteria["loo"]``, ``criteria.get("evidence")``, ``"holdout_lpd" in criteria``,
-``dict(criteria)``) but cannot be changed: a new value is a new object
-(``dataclasses.replace(criteria, posterior_probability=0.7)``).
+misspelt key fails there. Its fields are read as attributes (``criteria.loo``,
+``criteria.evidence``); it cannot be changed: a new value is a new object
+(``dataclasses.replace(criteria, posterior_probability=0.7)``). The mapping interface of earlier
+releases (``criteria["loo"]``, ``criteria.get("evidence")``, ``"holdout_lpd" in criteria``)
+still works for one release, with a :class:`DeprecationWarning`.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -130,10 +132,16 @@ class Criteria:
 
     def to_dict(self) -> dict:
         """The fields that are not None, as a plain dict (no copies of their values)."""
-        return dict(self.items())
+        return {n: getattr(self, n) for n in _NAMES if getattr(self, n) is not None}
 
-    # ---- the read side of a mapping
+    # ---- the read side of a mapping, deprecated: attribute access replaces it
+    @staticmethod
+    def _deprecated(instead: str) -> None:
+        warnings.warn("reading Criteria as a mapping is deprecated and goes in the next "
+                      f"release; use {instead}", DeprecationWarning, stacklevel=3)
+
     def _check(self, key) -> None:
+        self._deprecated(f"criteria.{key}" if isinstance(key, str) else "its attributes")
         if key not in _NAMES:
             raise KeyError(f"{key!r} is not a criteria key; the keys are " + ", ".join(_NAMES))
 
@@ -142,29 +150,37 @@ class Criteria:
         return getattr(self, key)
 
     def get(self, key, default=None):
-        """The value of field ``key``, or ``default`` when it is None."""
+        """Deprecated: the attribute ``key`` (``default`` when it is None)."""
         self._check(key)
         value = getattr(self, key)
         return default if value is None else value
 
     def __contains__(self, key) -> bool:
+        self._deprecated(f"criteria.{key} is not None")
         return key in _NAMES and getattr(self, key) is not None
 
     def keys(self) -> list[str]:
-        """The names of the fields that are not None."""
-        return [n for n in _NAMES if getattr(self, n) is not None]
+        """Deprecated: ``to_dict().keys()``."""
+        self._deprecated("criteria.to_dict()")
+        return list(self.to_dict())
 
     def __iter__(self) -> Iterator[str]:
-        return iter(self.keys())
+        self._deprecated("criteria.to_dict()")
+        return iter(self.to_dict())
 
     def __len__(self) -> int:
-        return len(self.keys())
+        self._deprecated("criteria.to_dict()")
+        return len(self.to_dict())
 
     def items(self) -> list[tuple[str, Any]]:
-        return [(n, getattr(self, n)) for n in self.keys()]
+        """Deprecated: ``to_dict().items()``."""
+        self._deprecated("criteria.to_dict()")
+        return list(self.to_dict().items())
 
     def values(self) -> list:
-        return [getattr(self, n) for n in self.keys()]
+        """Deprecated: ``to_dict().values()``."""
+        self._deprecated("criteria.to_dict()")
+        return list(self.to_dict().values())
 
     def __repr__(self) -> str:
         shown = []

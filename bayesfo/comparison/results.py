@@ -123,10 +123,28 @@ class StructureResult:
         return self.sampled_parameters
 
     @property
+    def log_z(self) -> float | None:
+        """ln Z, the log-evidence (None without one: a failed structure, or none computed)."""
+        ev = self.criteria.evidence
+        return None if ev is None else float(ev.log_z)
+
+    @property
+    def log_z_err(self) -> float | None:
+        """The Monte Carlo error of :attr:`log_z`."""
+        ev = self.criteria.evidence
+        return None if ev is None else float(ev.log_z_err)
+
+    @property
+    def probability(self) -> float | None:
+        """The posterior probability of the structure among those compared (from ln Z and the
+        prior odds), or None."""
+        return self.criteria.posterior_probability
+
+    @property
     def adequacy(self):
         """The posterior predictive checks (:class:`~bayesfo.inference.adequacy.Adequacy`), or
         None when they could not be run."""
-        return self.criteria.get("adequacy")
+        return self.criteria.adequacy
 
     @property
     def fits(self) -> str | None:
@@ -144,10 +162,10 @@ class StructureResult:
         if self.error is not None:
             return f"<StructureResult {self.name}: failed: {self.error}>"
         parts = []
-        ev = self.criteria.get("evidence")
+        ev = self.criteria.evidence
         if ev is not None:
             parts.append(f"ln Z = {_fmt(ev.log_z, '.2f')} ± {_fmt(ev.log_z_err, '.2f')}")
-        prob = self.criteria.get("posterior_probability")
+        prob = self.criteria.posterior_probability
         if prob is not None:
             parts.append(f"P = {prob:.3f}")
         post = self.posterior
@@ -168,14 +186,14 @@ class StructureResult:
             return f"{head}\n  failed: {self.error}"
         post = self.posterior
         lines = [head]
-        ev = self.criteria.get("evidence")
-        prob = self.criteria.get("posterior_probability")
+        ev = self.criteria.evidence
+        prob = self.criteria.posterior_probability
         lines.append(
             "  ln Z = " + ("-" if ev is None else
                            f"{_fmt(ev.log_z, '.2f')} ± {_fmt(ev.log_z_err, '.2f')} ({ev.method})")
             + ("" if prob is None else f", P = {prob:.3f}")
-            + f", elpd_loo = {_fmt(self.criteria.get('loo'), '.2f')}"
-            + f", BIC = {_fmt(self.criteria.get('bic'), '.2f')}")
+            + f", elpd_loo = {_fmt(self.criteria.loo, '.2f')}"
+            + f", BIC = {_fmt(self.criteria.bic, '.2f')}")
         if post is not None:
             lines.append(
                 f"  posterior: {getattr(post, 'sampler', 'emcee')}, "
@@ -208,7 +226,7 @@ class StructureResult:
                 lines.append(f"  {n:<{width}}  {_fmt(v.get('median'), '11.4g')}  "
                              f"[{_fmt(v.get('hdi_low'), '.4g')}, {_fmt(v.get('hdi_high'), '.4g')}]"
                              f"{unit}{flag}")
-        for w in self.criteria.get("warnings", ()):
+        for w in self.criteria.warnings:
             lines.append(f"  ! {w}")
         return "\n".join(lines)
 
@@ -222,8 +240,8 @@ class StructureResult:
             out["error"] = self.error
             return out
         post = self.posterior
-        ev = self.criteria.get("evidence")
-        check = self.criteria.get("evidence_check")
+        ev = self.criteria.evidence
+        check = self.criteria.evidence_check
         phys = self.physical
         out.update(
             # Each parameter as sampled (the card's coefficients and the noise), with its unit
@@ -235,28 +253,28 @@ class StructureResult:
             picture=None if phys is None else phys["picture"],
             parameters_physical=None if phys is None else phys["physical"],
             parameters_other_form=None if phys is None else phys["other"],
-            priors=self.criteria["priors"],
+            priors=self.criteria.priors,
             noise=post.noise, noise_reason=post.noise_reason,
             # Under noise="auto" without σ: each candidate noise model's ln Z, probability and
             # exponent HDIs; ``noise_sensitive`` when those HDIs do not overlap.
-            noise_models=self.criteria.get("noise_models"),
-            noise_sensitive=(None if self.criteria.get("noise_models") is None
-                             else self.criteria["noise_models"]["sensitive"]),
+            noise_models=self.criteria.noise_models,
+            noise_sensitive=(None if self.criteria.noise_models is None
+                             else self.criteria.noise_models["sensitive"]),
             log_evidence=None if ev is None else ev.log_z,
             log_evidence_err=None if ev is None else ev.log_z_err,
             evidence_method=None if ev is None else ev.method,
             log_prior_support=None if ev is None else ev.log_support,
             evidence_check=None if check is None else check.to_dict(),
-            evidence_agree=self.criteria.get("evidence_agree"),
-            posterior_probability=self.criteria.get("posterior_probability"),
-            delta_loo_se=self.criteria.get("delta_loo_se"),
+            evidence_agree=self.criteria.evidence_agree,
+            posterior_probability=self.criteria.posterior_probability,
+            delta_loo_se=self.criteria.delta_loo_se,
         )
         for key in ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
                     "pareto_k_max", "rmse"):
-            out[key] = self.criteria[key]
+            out[key] = getattr(self.criteria, key)
         for key in ("holdout_lpd", "holdout_rmse", "holdout_lpd_pointwise", "holdout_omega"):
-            if key in self.criteria:
-                value = self.criteria[key]
+            value = getattr(self.criteria, key)
+            if value is not None:
                 out[key] = list(value) if isinstance(value, tuple) else value
         out.update(
             rhat_max=post.rhat_max, ess_min=post.ess_min, ess_bulk_min=post.ess_bulk_min,
@@ -265,10 +283,10 @@ class StructureResult:
             sampler=getattr(post, "sampler", "emcee"),
             # The certificate of an importance-sampled posterior: Pareto k of its weights, their
             # ESS and the optima the proposal covered.
-            importance=None if self.criteria.get("importance") is None else {
-                k: v for k, v in self.criteria["importance"].items() if k != "seconds"},
+            importance=None if self.criteria.importance is None else {
+                k: v for k, v in self.criteria.importance.items() if k != "seconds"},
             adequacy=None if self.adequacy is None else self.adequacy.to_dict(),
-            warnings=list(self.criteria["warnings"]),
+            warnings=list(self.criteria.warnings),
             optimum=None if self.fit is None else {
                 "parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
                 "rmse": self.fit.rmse, "starts": self.fit.n_starts,
@@ -339,8 +357,8 @@ class Comparison:
         ok = [r for r in self.results if r.error is None]
 
         def key(r):
-            ev = r.criteria.get("evidence")
-            value = ev.log_z if ev is not None else r.criteria["loo"]
+            ev = r.criteria.evidence
+            value = ev.log_z if ev is not None else r.criteria.loo
             return (ev is None, not math.isfinite(value), -value if math.isfinite(value) else 0)
 
         return [r.name for r in sorted(ok, key=key)]
@@ -363,7 +381,7 @@ class Comparison:
         ranking = self.ranking
         best = ""
         if ranking:
-            prob = self[ranking[0]].criteria.get("posterior_probability")
+            prob = self[ranking[0]].probability
             best = f"; best {ranking[0]}" + ("" if prob is None else f" (P = {prob:.3f})")
         failed = sum(r.error is not None for r in self.results)
         return (f"<Comparison of {len(self.results)} structure(s) on '{self.data.label}' "
@@ -459,7 +477,7 @@ class Comparison:
             if parent is None or r.name not in done or parent not in done:
                 continue
             p = done[parent]
-            ev_p, ev_b = p.criteria.get("evidence"), r.criteria.get("evidence")
+            ev_p, ev_b = p.criteria.evidence, r.criteria.evidence
             d = None if ev_p is None or ev_b is None else ev_p.log_z - ev_b.log_z
             # Every order the baseline fixes at 1 (the Maxwell's α and β), the first as before.
             fixed = [k for k in order_parameters(p.posterior.summary) if k in r.structure.fixed]
@@ -486,21 +504,21 @@ class Comparison:
         prior weight on its members: ln Z_family = ln mean_i Z_i."""
         groups: dict[str, list] = {}
         for r in self.results:
-            if r.error is None and r.criteria.get("evidence") is not None:
+            if r.error is None and r.criteria.evidence is not None:
                 groups.setdefault(r.structure.family, []).append(r)
         out = []
         for family, members in groups.items():
             if len(members) < 2:
                 continue
-            z = np.array([m.criteria["evidence"].log_z for m in members])
-            err = np.array([m.criteria["evidence"].log_z_err for m in members])
+            z = np.array([m.log_z for m in members])
+            err = np.array([m.log_z_err for m in members])
             top = z.max()
             w = np.exp(z - top)
             log_z = float(top + np.log(w.mean()))
             out.append({
                 "family": family, "members": [m.name for m in members], "log_evidence": log_z,
                 "log_evidence_err": float(np.sqrt(np.sum((w / w.sum() * err) ** 2))),
-                "posterior_probability": float(sum(m.criteria.get("posterior_probability") or 0.0
+                "posterior_probability": float(sum(m.probability or 0.0
                                                    for m in members)),
             })
         return sorted(out, key=lambda f: -f["log_evidence"])

@@ -58,15 +58,15 @@ def netcdf_for(comparison: Comparison, result: StructureResult):
              "burn": int(post.burn), "thin": int(post.thin),
              "acceptance": float(post.acceptance),
              "tau": np.asarray(post.tau, dtype=float).ravel()}
-    ev = result.criteria.get("evidence")
+    ev = result.criteria.evidence
     if ev is not None:
         for key, value in (("n_likelihood", ev.n_likelihood), ("seconds", ev.seconds),
                            ("reached_log_likelihood", ev.reached_log_likelihood)):
             if value is not None:
                 stats[f"evidence_{key}"] = value
     copy.posterior.attrs.update(stats)
-    loo = {k: np.asarray(result.criteria[k], dtype=float)
-           for k in ("pareto_k", "loo_pointwise") if k in result.criteria}
+    loo = {k: np.asarray(getattr(result.criteria, k), dtype=float)
+           for k in ("pareto_k", "loo_pointwise") if getattr(result.criteria, k) is not None}
     copy.log_likelihood.attrs.update(loo)
     data, held = comparison.data, comparison.holdout
     observed = {}

@@ -92,7 +92,7 @@ def _noise(comparison) -> list[tuple[str, str]]:
     for r in comparison.results:
         if r.posterior is None:
             continue
-        if r.criteria.get("noise_models"):
+        if r.criteria.noise_models:
             chosen.setdefault(r.posterior.noise, []).append(r.name)
         elif (r.posterior.noise, r.posterior.noise_reason) not in seen:
             seen.append((r.posterior.noise, r.posterior.noise_reason))
@@ -201,7 +201,7 @@ def _priors_section(comparison) -> str:
     for name in comparison.ranking:
         r = comparison[name]
         rows = []
-        for name, prior in r.criteria.get("priors", {}).items():
+        for name, prior in (r.criteria.priors or {}).items():
             kind = prior.get("prior", "?")
             if "low" in prior:
                 desc = f"[{prior['low']:.4g}, {prior['high']:.4g}]"
@@ -328,7 +328,7 @@ def _diagnostics_section(comparison) -> str:
                    f"{post.samples.shape[0] // post.n_walkers} particles (R-hat and ESS across "
                    "the runs)")
         elif getattr(post, "sampler", "emcee") == "importance":
-            info = r.criteria.get("importance") or {}
+            info = r.criteria.importance or {}
             how = (f"importance sampling from {info.get('n_modes', '?')} optimum(s), "
                    f"{info.get('n_proposals', 0):,} proposal draws, Pareto k̂ "
                    f"{_num(info.get('k_hat'), '.2f')} (certified below 0.7), ESS of the weights")
@@ -343,13 +343,13 @@ def _diagnostics_section(comparison) -> str:
         line = (f"<b>{_e(r.name)}</b>: {status}; R-hat {_num(post.rhat_max, '.3f')}, ESS bulk "
                 f"{_num(post.ess_bulk_min, '.0f')}, tail {_num(post.ess_tail_min, '.0f')}, "
                 f"{how}")
-        if r.criteria.get("evidence_agree") is False:
+        if r.criteria.evidence_agree is False:
             line += "; <span class='flag'>the two ln Z estimates (default and nested) disagree</span>"
-        ev = r.criteria.get("evidence")
+        ev = r.criteria.evidence
         if ev is not None and ev.method == "ladder":
             line += (f"; ln Z from a tempered ladder ({ev.n_likelihood:,} likelihood evaluations, "
                      f"{ev.seconds:.1f} s)")
-        notes = list(post.messages) + [w for w in r.criteria.get("warnings", [])
+        notes = list(post.messages) + [w for w in r.criteria.warnings
                                        if w not in post.messages]
         if notes:
             line += "<ul>" + "".join(f"<li class='flag'>{_e(m)}</li>" for m in notes) + "</ul>"

@@ -293,7 +293,7 @@ def _noise_sentences(name, result) -> list[tuple[str, bool]]:
     """How the winner's noise model was chosen, and whether its exponents depend on it."""
     from ..comparison.steps import NOISE_DECISIVE
 
-    record = result.criteria.get("noise_models")
+    record = result.criteria.noise_models
     if not record:
         return []
     chosen = record["chosen"]

@@ -318,8 +318,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
                                  f"comparison; it has {', '.join(sorted(known))}")
         ranked = [r for r in ranked if r.name in names]
     # Probabilities from ln Z over the structures considered, equal prior odds.
-    log_z = np.array([r.criteria["evidence"].log_z if r.criteria.get("evidence") is not None
-                      else -np.inf for r in ranked])
+    log_z = np.array([-np.inf if r.log_z is None else r.log_z for r in ranked])
     with np.errstate(invalid="ignore"):
         probs = np.exp(log_z - log_z.max()) if np.isfinite(log_z).any() else np.zeros(len(ranked))
     probs = probs / probs.sum() if probs.sum() > 0 else probs
@@ -381,8 +380,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         offset += w.size
         alternatives[name] = float(pred.information(cols, log_prior, rng)[0][0])
     # The two leading structures' ln B after the proposed points.
-    z = [r.criteria["evidence"].log_z if r.criteria.get("evidence") is not None else math.nan
-         for r in results[:2]]
+    z = [math.nan if r.log_z is None else r.log_z for r in results[:2]]
     ln_b = z[0] - z[1]
     _, log_p = pred.information(np.array([chosen]), log_prior, rng, n=4 * N_Y)
     delta = log_p[:, 0, :, 0] - log_p[:, 1, :, 0]  # (M_true, n): ln p(y|first) − ln p(y|second)

@@ -202,7 +202,7 @@ def sampling_coordinates(result):
     is_log : ndarray of bool
     """
     post = result.posterior
-    priors = result.criteria.get("priors", {})
+    priors = result.criteria.priors or {}
     is_log = np.array([priors.get(n, {}).get("prior") == "log-uniform" for n in post.param_names])
     values = to_coordinates(post.samples, is_log)
     units = result_units(result)

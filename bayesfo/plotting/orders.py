@@ -91,7 +91,7 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     for i, (r, p) in enumerate(results):
         post = r.posterior
         x = post.samples[:, post.param_names.index(p)]
-        prior = r.criteria.get("priors", {}).get(p, DEFAULT_ORDER_PRIOR)
+        prior = (r.criteria.priors or {}).get(p, DEFAULT_ORDER_PRIOR)
         lo, hi = prior_range(prior, x)
         grid, dens = density_1d(x, lo, hi)
         rows.append((r, p, x, prior, (lo, hi), grid, dens))

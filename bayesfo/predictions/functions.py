@@ -253,7 +253,7 @@ def _weights(result, average: str) -> tuple[dict, list]:
     ranked = [result[n] for n in result.ranking]
     if len(ranked) < 2:
         raise InputError("predict: an average needs two or more structures with a posterior")
-    bma = {r.name: r.criteria.get("posterior_probability") for r in ranked}
+    bma = {r.name: r.probability for r in ranked}
     if any(v is None for v in bma.values()):
         bma = None
     notes = []
@@ -275,7 +275,7 @@ def _weights(result, average: str) -> tuple[dict, list]:
                          f"(by up to {apart:.2f} for one structure): the average depends on "
                          "which is taken")
     for r in ranked:
-        adequacy = r.criteria.get("adequacy")
+        adequacy = r.criteria.adequacy
         if weights[r.name] >= 0.1 and adequacy is not None and not adequacy.adequate:
             how = ("misses the data systematically, if by little" if adequacy.misfit_small
                    else "does not fit the data")

@@ -68,7 +68,7 @@ def test_weights_alone_certify_a_posterior_that_misses_a_configuration(invisible
     monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)  # the first part alone
     r = _compare(data, 24)
     assert r.posterior.sampler == "importance" and r.posterior.converged
-    assert r.criteria["importance"]["k_hat"] < importance_module.K_HAT_MAX
+    assert r.criteria.importance["k_hat"] < importance_module.K_HAT_MAX
     assert _outside(r.posterior, reference) > 0.2
 
 
@@ -77,7 +77,7 @@ def test_an_undetermined_order_sends_the_structure_to_the_ladder(invisible):
     r = _compare(data, 24)
     assert r.posterior.sampler == "ladder" and r.posterior.converged
     assert any("undetermined" in n and "tempered ladder, started from the prior" in n
-               for n in r.criteria["warnings"]), r.criteria["warnings"]
+               for n in r.criteria.warnings), r.criteria.warnings
     assert _outside(r.posterior, reference) < 0.05
 
 
@@ -85,7 +85,7 @@ def test_a_determined_posterior_keeps_the_fast_route_and_says_what_was_checked()
     data = _bench().simulate(CARD, 1)
     r = _compare(data, 1)
     assert r.posterior.sampler == "importance" and r.posterior.converged
-    widest = r.criteria["importance"]["widest"]
+    widest = r.criteria.importance["widest"]
     assert widest["parameter"] in get_structure(CARD).param_names
     assert 0 < widest["share_of_prior"] < importance_module.UNDETERMINED
     # The share is that of the reported draws' 94 % interval (resampled from the same weights).
@@ -128,7 +128,7 @@ def test_an_undetermined_coefficient_alone_keeps_the_fast_route():
         warnings.simplefilter("ignore")
         r = bf.compare(data, card, noise="known", workers=1, progress=False, seed=6)[card]
     assert r.posterior.sampler == "importance"
-    widest = r.criteria["importance"]["widest"]
+    widest = r.criteria.importance["widest"]
     assert widest["parameter"] == "alpha" and widest["share_of_prior"] < 0.25
     lik = Likelihood(get_structure(card), data, noise="known")
     tr = _Transform(lik)

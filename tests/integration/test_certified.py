@@ -39,7 +39,7 @@ def runs():
         # Pareto k near 0.7 at the lowest frequency, depending on the draws.
         warnings.simplefilter("ignore", PredictiveWarning)
         reference = bf.compare(data, "zener", seed=1, workers=1, progress=False,
-                               noise=short["zener"].criteria["noise_models"]["chosen"])
+                               noise=short["zener"].criteria.noise_models["chosen"])
     assert {w.category for w in record} <= {ConvergenceWarning, CertifiedWarning,
                                              PredictiveWarning}
     return reference["zener"], short["zener"], record
@@ -48,7 +48,7 @@ def runs():
 def test_the_ladder_certifies_where_the_walkers_did_not_converge(runs):
     reference, short, record = runs
     assert reference.posterior.sampler == "importance" and reference.posterior.converged
-    assert reference.criteria["importance"]["k_hat"] < 0.5
+    assert reference.criteria.importance["k_hat"] < 0.5
     post = short.posterior
     assert post.sampler == "ladder" and post.converged
     assert post.rhat_max < 1.01 and post.ess_min >= 400 and post.n_walkers == 2
@@ -61,7 +61,7 @@ def test_the_ladder_certifies_where_the_walkers_did_not_converge(runs):
     assert "stopped at the cap of 300 steps" in certified[0] or (
         "stopped after " in certified[0] and "cap of 300 steps" in certified[0])
     assert not any(w.category is ConvergenceWarning for w in record)
-    assert short.criteria["evidence"].method == "ladder"
+    assert short.criteria.evidence.method == "ladder"
     # LOO and WAIC come from the particles: one pointwise value per frequency and draw.
     assert post.idata.log_likelihood["G"].shape == (2, 1000, 17)
 
@@ -78,9 +78,9 @@ def test_the_ladder_posterior_agrees_with_importance_sampling(runs):
         assert abs(sa.mean - sb.mean) < 5 * se, name
         assert sa.sd == pytest.approx(sb.sd, rel=0.15), name
     # The evidence and LOO of the two routes agree within their errors.
-    ea, eb = short.criteria["evidence"], reference.criteria["evidence"]
+    ea, eb = short.criteria.evidence, reference.criteria.evidence
     assert abs(ea.log_z - eb.log_z) < 3 * math.hypot(ea.log_z_err, eb.log_z_err) + 0.05
-    assert abs(short.criteria["loo"] - reference.criteria["loo"]) < 2 * reference.criteria["loo_se"]
+    assert abs(short.criteria.loo - reference.criteria.loo) < 2 * reference.criteria.loo_se
 
 
 def test_particles_are_drawn_as_histograms_per_run(runs):
@@ -101,7 +101,7 @@ def test_importance_route_agrees_with_converged_emcee(runs):
         warnings.simplefilter("ignore", PredictiveWarning)
         fast = bf.compare(bf.read(DATA), "zener", seed=3, workers=1, progress=False)["zener"]
     post, b = fast.posterior, reference.posterior
-    info = fast.criteria["importance"]
+    info = fast.criteria.importance
     assert post.sampler == "importance" and post.converged
     assert info["k_hat"] < 0.7 and info["ess"] >= 1000
     for i, name in enumerate(b.param_names):
@@ -114,7 +114,7 @@ def test_importance_route_agrees_with_converged_emcee(runs):
         se = xb.std() * math.sqrt(1 / min(post.ess_min, post.samples.shape[0]) + 1 / b.ess_min)
         assert abs(xa.mean() - xb.mean()) < 5 * se, name
         assert xa.std() == pytest.approx(xb.std(), rel=0.1), name
-    ea, eb = fast.criteria["evidence"], reference.criteria["evidence"]
+    ea, eb = fast.criteria.evidence, reference.criteria.evidence
     assert ea.method == "importance"
     assert abs(ea.log_z - eb.log_z) < 3 * math.hypot(ea.log_z_err, eb.log_z_err) + 0.05
 
@@ -140,7 +140,7 @@ def test_mode_shares_of_a_max_order_member_agree_between_independent_runs():
                            sampler=sampler)["max-n2m2"]
             assert r.posterior.sampler == "ladder" and r.posterior.converged
             q = r.posterior.samples[:, r.posterior.param_names.index("q")]
-            runs.append((float(np.mean(q < 0.375)), r.posterior.ess_min, r.criteria["evidence"]))
+            runs.append((float(np.mean(q < 0.375)), r.posterior.ess_min, r.criteria.evidence))
     for (p1, n1, z1), (p2, n2, z2) in zip(runs, runs[1:]):
         # Binomial standard error of each share, with its ESS (a share of 0 still allows 1/ESS).
         se = math.hypot(math.sqrt(max(p1 * (1 - p1), 1 / n1) / n1),
@@ -168,4 +168,4 @@ def test_a_ladder_that_fails_first_hands_over_to_emcee_and_says_why(monkeypatch)
                        noise="constant")["zener"]
     assert r.posterior.sampler == "emcee" and r.posterior.converged
     assert ("zener: the tempered-ladder runs tried first did not certify the posterior (Matrix "
-            "is not positive definite); emcee ran instead") in r.criteria["warnings"]
+            "is not positive definite); emcee ran instead") in r.criteria.warnings

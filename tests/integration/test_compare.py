@@ -36,7 +36,7 @@ def voigt_comparison(tmp_path_factory):
     with pytest.warns(PredictiveWarning, match="voigt-int: Pareto k") as record:
         result = compare(data, resolve_structures("voigt,voigt-int,zener"), seed=1, progress=False)
     assert all("voigt-int" in str(w.message) for w in record if w.category is PredictiveWarning)
-    assert result["voigt-int"].criteria["pareto_k_max"] > 0.7
+    assert result["voigt-int"].criteria.pareto_k_max > 0.7
     out = tmp_path_factory.mktemp("cmp")
     write_outputs(result, out, figures=False)  # figures: tests/integration/test_plotting.py and the CLI test
     return result, out
@@ -86,12 +86,12 @@ def test_criteria_are_consistent(voigt_comparison):
     r = result["voigt"]
     k, n = 3, 50  # known sigma: no noise parameter; 25 complex points = 50 real numbers
     c = r.criteria
-    assert c["aic"] == pytest.approx(2 * k - 2 * c["max_log_likelihood"])
-    assert c["bic"] == pytest.approx(k * np.log(n) - 2 * c["max_log_likelihood"])
-    assert c["aicc"] == pytest.approx(c["aic"] + 2 * k * (k + 1) / (n - k - 1))
+    assert c.aic == pytest.approx(2 * k - 2 * c.max_log_likelihood)
+    assert c.bic == pytest.approx(k * np.log(n) - 2 * c.max_log_likelihood)
+    assert c.aicc == pytest.approx(c.aic + 2 * k * (k + 1) / (n - k - 1))
     # elpd estimates lie below the maximum log-likelihood by about the number of parameters.
-    assert c["max_log_likelihood"] - 10 < c["loo"] < c["max_log_likelihood"]
-    assert c["rmse"] < 0.05 * 1e-3
+    assert c.max_log_likelihood - 10 < c.loo < c.max_log_likelihood
+    assert c.rmse < 0.05 * 1e-3
 
 
 def test_interrupted_write_leaves_no_summary(voigt_comparison, tmp_path, monkeypatch):
@@ -179,11 +179,11 @@ def test_holdout_log_predictive_density_and_families():
     logp = (stats.norm.logpdf(obs.real, model.real, sd[[3, 17]] / np.sqrt(2))
             + stats.norm.logpdf(obs.imag, model.imag, sd[[3, 17]] / np.sqrt(2)))
     expected = (logsumexp(logp, axis=0) - np.log(draws.shape[0])).sum()
-    assert v.criteria["holdout_lpd"] == pytest.approx(expected, rel=1e-9)
-    assert v.criteria["holdout_lpd"] > result["voigt-int"].criteria["holdout_lpd"] + 5
-    assert v.criteria["holdout_rmse"] < 0.05 * np.abs(obs).max()
+    assert v.criteria.holdout_lpd == pytest.approx(expected, rel=1e-9)
+    assert v.criteria.holdout_lpd > result["voigt-int"].criteria.holdout_lpd + 5
+    assert v.criteria.holdout_rmse < 0.05 * np.abs(obs).max()
     (family,) = result.families()
-    z = [result[n].criteria["evidence"].log_z for n in ("voigt", "voigt-int")]
+    z = [result[n].criteria.evidence.log_z for n in ("voigt", "voigt-int")]
     assert family["log_evidence"] == pytest.approx(np.logaddexp(*z) - np.log(2))
 
 
@@ -207,7 +207,7 @@ def test_worker_processes_give_the_same_numbers(voigt_comparison):
                            workers=2)
     for name in ("voigt", "voigt-int"):
         a, b = result[name], parallel[name]
-        assert a.criteria["evidence"].log_z == b.criteria["evidence"].log_z
+        assert a.criteria.evidence.log_z == b.criteria.evidence.log_z
         assert np.array_equal(a.posterior.samples, b.posterior.samples)
     with pytest.raises(ValueError, match="workers"):
         compare(data, resolve_structures("voigt"), workers=-1)
@@ -221,9 +221,9 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
 
     result, _ = voigt_comparison
     data, voigt = result.data, resolve_structures("voigt")
-    bridge = result["voigt"].criteria["evidence"]
+    bridge = result["voigt"].criteria.evidence
     ladder = compare(data, voigt, seed=1, progress=False, evidence="ladder")["voigt"]
-    ev = ladder.criteria["evidence"]
+    ev = ladder.criteria.evidence
     assert ev.method == "ladder" and ladder.posterior.converged
     # Two independent estimators of the same integral.
     assert abs(ev.log_z - bridge.log_z) < 4 * math.hypot(ev.log_z_err, bridge.log_z_err) + 0.02
@@ -232,13 +232,13 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
         warnings.simplefilter("ignore")
         short = compare(data, voigt, seed=1, progress=False, max_steps=100,
                         sampler="emcee")["voigt"]
-    assert short.criteria["evidence"].method == "ladder"
+    assert short.criteria.evidence.method == "ladder"
     # ... and the ladder's particles, whose two runs agree, are the posterior reported.
     assert short.posterior.sampler == "ladder" and short.posterior.converged
     # The ladder's guide (the draws) differs, its integral does not.
-    other = short.criteria["evidence"]
+    other = short.criteria.evidence
     assert abs(other.log_z - ev.log_z) < 4 * math.hypot(other.log_z_err, ev.log_z_err) + 0.02
-    assert not any("unreliable" in w for w in short.criteria["warnings"])
+    assert not any("unreliable" in w for w in short.criteria.warnings)
     # The report marks the ladder's value and says how it was computed.
     from bayesfo.output.report import render_report
 
@@ -249,7 +249,7 @@ def test_ladder_evidence_where_the_posterior_did_not_converge(voigt_comparison):
     from bayesfo.inference import Likelihood
     from bayesfo.inference.certified import _evidence
 
-    lik, best = Likelihood(voigt[0], data), result["voigt"].criteria["max_log_likelihood"]
+    lik, best = Likelihood(voigt[0], data), result["voigt"].criteria.max_log_likelihood
     assert abs(best - ev.reached_log_likelihood) < 2
     ok = _evidence(lik, result["voigt"].posterior, 1, "ladder", best_log_likelihood=best)
     assert not ok["warnings"]

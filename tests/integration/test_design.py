@@ -40,7 +40,7 @@ def _result(name, theta, rel_sd, log_z, n=400, seed=0, noise=0.01):
     post = SimpleNamespace(samples=samples, noise="proportional",
                            param_names=("a1", "b0", "q", "sigma_rel"))
     return SimpleNamespace(name=name, structure=get_structure("voigt"), posterior=post,
-                           criteria={"evidence": SimpleNamespace(log_z=log_z)})
+                           log_z=log_z, criteria=SimpleNamespace(evidence=SimpleNamespace(log_z=log_z)))
 
 
 class _Comparison(SimpleNamespace):
@@ -215,7 +215,7 @@ def test_the_proposed_points_settle_the_choice_faster_than_rules_of_thumb():
             warnings.simplefilter("ignore")
             c = bf.compare(FrequencyResponse(omega, y, sd, kind="modulus"), "voigt,zener",
                            seed=0, progress=False, workers=1)
-        return c, c["zener"].criteria["evidence"].log_z - c["voigt"].criteria["evidence"].log_z
+        return c, c["zener"].criteria.evidence.log_z - c["voigt"].criteria.evidence.log_z
 
     y, sd = simulate(w, np.random.default_rng(0))
     first, before = log_b(w, y, sd)

@@ -107,9 +107,9 @@ def test_routes_agree_on_the_thesis_set_up():
                                                   "max-n1m1"), seed=0, progress=False,
                          evidence_check=True, workers=2)
     for r in result.results:
-        bridge, nested = r.criteria["evidence"], r.criteria["evidence_check"]
+        bridge, nested = r.criteria.evidence, r.criteria.evidence_check
         assert abs(bridge.log_z - nested.log_z) < 0.3, r.name
-        assert r.criteria["evidence_agree"]
+        assert r.criteria.evidence_agree
 
 
 # dynesty ln Z on g_spec_data(0) (random-direction slice sampling, max(25, 5 ndim) slices, seed
@@ -149,7 +149,7 @@ def test_ladder_evidence_of_unconverged_posteriors_on_the_thesis_set_up():
         result = compare(g_spec_data(0), resolve_structures(",".join(NESTED_REFERENCE)), seed=0,
                          progress=False, workers=2)
     for r in result.results:
-        ev = r.criteria["evidence"]
+        ev = r.criteria.evidence
         ref, ref_err, _ = NESTED_REFERENCE[r.name]
         # The route follows the posterior's: importance weights (their own ln Z, or the ladder
         # where k >= 0.5), the ladder where it certified the posterior or emcee did not

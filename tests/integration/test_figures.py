@@ -21,6 +21,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
 
+from bayesfo.comparison import Criteria  # noqa: E402
 from bayesfo.data import FrequencyResponse, read  # noqa: E402
 from bayesfo.errors import InputError  # noqa: E402
 from bayesfo.plotting import (  # noqa: E402
@@ -78,7 +79,9 @@ def _result(name, structure, theta, rel_sd=0.002, n=120, seed=0, priors=None, co
         rhat_max=1.002 if converged else 1.08, ess_min=900.0 if converged else 120.0,
         n_walkers=8, n_steps=n // 8, burn=0, thin=1)
     return SimpleNamespace(name=name, structure=structure, posterior=post, error=None, fit=None,
-                           criteria={"priors": priors or {}}, adequacy=None, fits="yes")
+                           criteria=SimpleNamespace(**{**dict.fromkeys(Criteria.names()),
+                                                       "priors": priors or {}}),
+                           adequacy=None, fits="yes")
 
 
 @dataclass
@@ -480,7 +483,7 @@ def test_ranking_shows_pareto_k_and_says_once_why_waic_is_not_shown():
     rng = np.random.default_rng(0)
     rows = []
     for i, r in enumerate(comp.results):
-        r.criteria["loo_pointwise"] = rng.normal(-10.0 - 3 * i, 0.5, 17)
+        r.criteria.loo_pointwise = rng.normal(-10.0 - 3 * i, 0.5, 17)
         rows.append({"rank": i + 1, "structure": r.name, "delta_log_evidence": -2.0 * i,
                      "log_evidence_err": 0.1, "posterior_probability": [0.7, 0.3, 0.0][i],
                      "delta_loo": -3.0 * 17 * i, "aic": 10.0 + 5 * i, "bic": 12.0 + 6 * i,

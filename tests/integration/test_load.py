@@ -103,7 +103,7 @@ def test_known_sigma_and_held_out_points_are_stored_and_read_back(with_sigma):
     np.testing.assert_array_equal(loaded.holdout.response, result.holdout.response)
     np.testing.assert_array_equal(loaded.holdout.sigma, result.holdout.sigma)
     assert loaded["voigt"].posterior.noise == "known"
-    assert "holdout_lpd" in loaded["voigt"].criteria
+    assert loaded["voigt"].criteria.holdout_lpd is not None
     stored = json.loads((out / "summary.json").read_text())
     assert _diff(_json(loaded.to_summary()), stored) == []
     assert _diff(loaded.table(), result.table()) == []
@@ -159,19 +159,24 @@ def test_missing_or_damaged_outputs_are_input_errors(written, tmp_path):
 
 
 # ---------------------------------------------------------------------- Criteria
-def test_criteria_are_frozen_read_like_a_dict_and_refuse_unknown_keys(written):
+def test_criteria_are_frozen_attributes_and_refuse_unknown_keys(written):
     result, _ = written
     r = result["voigt"]
     c = r.criteria
     assert isinstance(c, Criteria)
-    assert c["loo"] == c.loo and c.get("loo") == c.loo and "loo" in c
-    assert c.get("holdout_lpd") is None and "holdout_lpd" not in c
-    assert c.get("holdout_lpd", 1.0) == 1.0
-    assert isinstance(c["warnings"], tuple)
-    assert dict(c)["aic"] == c.aic and list(Criteria.from_dict(dict(c)).to_dict()) == c.keys()
+    assert isinstance(c.warnings, tuple) and c.holdout_lpd is None
+    assert r.log_z == c.evidence.log_z and r.log_z_err == c.evidence.log_z_err
+    assert r.probability == c.posterior_probability
+    assert Criteria.from_dict(c.to_dict()).to_dict().keys() == c.to_dict().keys()
+    assert "holdout_lpd" not in c.to_dict() and c.to_dict()["aic"] == c.aic
     with pytest.raises(KeyError, match="unknown criteria key 'posterior_probabilty'"):
         Criteria.from_dict({"posterior_probabilty": 0.5})
-    with pytest.raises(KeyError, match="'lo' is not a criteria key"):
+    # The mapping interface of earlier releases still reads, with a DeprecationWarning.
+    with pytest.warns(DeprecationWarning, match=r"use criteria\.loo"):
+        assert c["loo"] == c.loo
+    with pytest.warns(DeprecationWarning):
+        assert c.get("holdout_lpd", 1.0) == 1.0 and "loo" in c and dict(c)["aic"] == c.aic
+    with pytest.warns(DeprecationWarning), pytest.raises(KeyError, match="'lo' is not a criteria key"):
         c.get("lo")
     with pytest.raises(TypeError):
         c["loo"] = 1.0
@@ -193,8 +198,8 @@ def test_model_probabilities_make_new_results():
     results = [bf.StructureResult(get_structure(n), criteria={"evidence": e})
                for n, e in zip(("voigt", "zener"), ev, strict=True)]
     new = _model_probabilities(results, {})
-    assert [r.criteria.get("posterior_probability") for r in results] == [None, None]
-    assert [r.criteria["posterior_probability"] for r in new] == pytest.approx([0.75, 0.25])
+    assert [r.criteria.posterior_probability for r in results] == [None, None]
+    assert [r.criteria.posterior_probability for r in new] == pytest.approx([0.75, 0.25])
 
 
 # ---------------------------------------------------------------------- summaries

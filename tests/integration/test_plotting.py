@@ -357,7 +357,7 @@ def test_ranking_loo_error_is_that_of_the_difference(comparison):
     for name, se in zip(drawn.values["structures"], drawn.values["delta_loo_se"]):
         assert se == pytest.approx(float(ref.loc[name, "dse"]), rel=1e-6, abs=1e-9)
         # Computed once, with the criteria: the table and summary.json hold the same number.
-        assert rows[name]["delta_loo_se"] == se == comparison[name].criteria["delta_loo_se"]
+        assert rows[name]["delta_loo_se"] == se == comparison[name].criteria.delta_loo_se
 
 
 def test_ranking_flags_a_posterior_that_did_not_converge(comparison):
@@ -380,7 +380,7 @@ def test_corner_marks_the_mode_and_the_optimum(comparison):
     names = r.posterior.param_names
     ndim = len(names)
     assert len(drawn.axes) == ndim * ndim
-    log = np.array([r.criteria["priors"][n]["prior"] == "log-uniform" for n in names])
+    log = np.array([r.criteria.priors[n]["prior"] == "log-uniform" for n in names])
     coords = np.where(log, np.log10(r.posterior.samples), r.posterior.samples)
     np.testing.assert_allclose(drawn.values["samples"] * drawn.values["factor"], coords)
     expected_map = np.where(log, np.log10(r.posterior.map_theta), r.posterior.map_theta)
@@ -417,7 +417,7 @@ def test_corner_marks_the_linear_methods(comparison):
     assert 0.0 < fits["method 2"][-1] <= 1.0
     drawn = plot_corner(r, linear=fits)
     names = r.posterior.param_names
-    log = np.array([r.criteria["priors"][n]["prior"] == "log-uniform" for n in names])
+    log = np.array([r.criteria.priors[n]["prior"] == "log-uniform" for n in names])
     k = r.structure.n_params
     for row, label in zip(drawn.values["linear"], drawn.values["linear_labels"]):
         theta = fits[label]

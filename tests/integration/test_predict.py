@@ -82,7 +82,7 @@ def test_extrapolation_is_flagged_outside_the_window(result):
 
 def test_averages_weigh_the_structures(result):
     bma = result.predict("relaxation_modulus", T, average="bma")
-    probs = {n: result[n].criteria["posterior_probability"] for n in result.ranking}
+    probs = {n: result[n].criteria.posterior_probability for n in result.ranking}
     assert bma.weights == probs and bma.structure is None
     stack = result.predict("relaxation_modulus", T, average="stacking")
     assert sum(stack.weights.values()) == pytest.approx(1.0)

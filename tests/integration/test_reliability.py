@@ -553,8 +553,8 @@ def test_undefined_criteria_are_empty_cells_and_rank_last(comparison):
     from bayesfo.output import ranking_csv
 
     voigt, zener = comparison.results
-    broken = dataclasses.replace(zener, criteria=dict(zener.criteria, loo=np.nan,
-                                                      loo_se=np.nan, pareto_k_max=np.inf))
+    broken = dataclasses.replace(zener, criteria=dataclasses.replace(
+        zener.criteria, loo=np.nan, loo_se=np.nan, pareto_k_max=np.inf))
     fake = dataclasses.replace(comparison, results=(voigt, broken))
     rows = {r["structure"]: r for r in fake.table()}
     assert rows["zener"]["rank_loo"] == 2 and rows["voigt"]["rank_loo"] == 1

@@ -93,7 +93,7 @@ def _verdict_text(text: str) -> str:
 
 
 def test_verdict_names_the_structure_with_the_highest_evidence(comparison):
-    z = {r.name: r.criteria["evidence"].log_z for r in comparison.results}
+    z = {r.name: r.criteria.evidence.log_z for r in comparison.results}
     best = max(z, key=z.get)
     second = sorted(z, key=z.get)[-2]
     sentences = verdict(comparison)
@@ -105,7 +105,7 @@ def test_verdict_names_the_structure_with_the_highest_evidence(comparison):
     assert first.startswith(f"{best} is the best-supported structure")
     assert f"runner-up, {second}," in first
     assert f"Δln Z = {z[best] - z[second]:.2f}" in first
-    p = comparison[best].criteria["posterior_probability"]
+    p = comparison[best].criteria.posterior_probability
     assert (f"{p:.3f}" if p >= 0.001 else "< 0.001") in first
     q = comparison[best].posterior.summary["q"]
     digits = 1 - math.floor(math.log10(q.sd))

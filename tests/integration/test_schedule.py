@@ -36,9 +36,8 @@ def _numbers(results) -> dict:
     out = {}
     for r in results:
         c = r.criteria
-        out[r.name] = (c["evidence"].log_z, c["evidence"].log_z_err, c["loo"], c["waic"],
-                       c["noise_models"]["chosen"],
-                       {k: m["log_evidence"] for k, m in c["noise_models"]["models"].items()},
+        out[r.name] = (r.log_z, r.log_z_err, c.loo, c.waic, c.noise_models["chosen"],
+                       {k: m["log_evidence"] for k, m in c.noise_models["models"].items()},
                        r.posterior.samples.mean(axis=0).tolist())
     return out
 
@@ -47,7 +46,7 @@ def test_one_and_two_workers_give_the_same_numbers():
     one, caught_one = _compare(workers=1)
     two, caught_two = _compare(workers=2)
     for r in one.results:  # both noise models sampled: the case the schedule splits
-        models = r.criteria["noise_models"]["models"]
+        models = r.criteria.noise_models["models"]
         assert set(models) == {"constant", "proportional"}
         assert all(m["log_evidence_err"] is not None for m in models.values())
     assert _numbers(one.results) == _numbers(two.results)
@@ -90,7 +89,7 @@ def test_a_pool_keeps_the_warnings_of_the_serial_path(noisy_sampler):
     assert _numbers(serial.results) == _numbers(pooled.results)
     assert caught_serial == caught_pooled
     for r in pooled.results:
-        record = r.criteria["noise_models"]
+        record = r.criteria.noise_models
         other = next(n for n in record["models"] if n != record["chosen"])
         # Only the chosen model's warning reaches the user; the other's is in its record.
         assert (UserWarning, f"{r.name}: sampled under {record['chosen']} noise") in caught_pooled
@@ -362,7 +361,7 @@ def test_a_worker_that_dies_loses_no_structure():
         a, b = serial[name], broken[name]
         assert b.error is None
         np.testing.assert_array_equal(a.posterior.samples, b.posterior.samples)
-        assert a.criteria["evidence"].log_z == b.criteria["evidence"].log_z
+        assert a.criteria.evidence.log_z == b.criteria.evidence.log_z
 
 
 def test_figures_are_drawn_here_when_a_worker_dies(tmp_path):

@@ -7,8 +7,6 @@ import os
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from ..errors import InputError
 from ..options import (
     STRUCTURE_FIGURES,
@@ -172,13 +170,8 @@ def _print_undetermined(result) -> None:
               + "; ".join(poor))
 
 
-def _num(x, fmt: str = ".2f") -> str:
-    """A number for the terminal table; '-' for one that is undefined (its reason is among
-    the warnings)."""
-    return format(x, fmt) if x is not None and np.isfinite(x) else "-"
-
-
 def run(args) -> int:
+    from ..comparison.table import ranking_lines
     from ..outdir import check_output_directory
     from ..parallel import available_cpus
     from ..structures import resolve_structures
@@ -236,28 +229,8 @@ def run(args) -> int:
               "probability, equal prior odds; ok = posterior certified; fits = posterior "
               "predictive checks pass (small: a systematic misfit within 2° and 3.5 %; partly: "
               "pass, but the fitted noise swamps points the fit misses)")
-        width = max([16] + [len(row['structure']) for row in result.table()])
-        means = {row["structure"]: _order_means(row) for row in result.table()}
-        o_width = max([13] + [len(v) for v in means.values()])
-        print(f"{'#':>2} {'structure':<{width}} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
-              f"{'elpd_loo':>10} {'BIC':>10} {'orders (mean)':>{o_width}} {'R-hat':>6} "
-              f"{'ok':>3} {'fits':>6}")
-        for row in result.table():
-            if row.get("error"):
-                print(f"{'-':>2} {row['structure']:<{width}} {row['n_params']:>2}  skipped: {row['error']}")
-                continue
-            q = means[row["structure"]]
-            if row["log_evidence"] is None:
-                z = dz = p = "-"
-            else:
-                z = f"{row['log_evidence']:.2f} ± {row['log_evidence_err']:.2f}"
-                z += " L" if row["evidence_method"] == "ladder" else "  "
-                dz = f"{row['delta_log_evidence']:.2f}"
-                p = f"{row['posterior_probability']:.3f}"
-            print(f"{row['rank']:>2} {row['structure']:<{width}} {row['n_params']:>2} {z:>18} {dz:>8} "
-                  f"{p:>6} {_num(row['loo']):>10} {_num(row['bic']):>10} {q:>{o_width}} "
-                  f"{_num(row['rhat_max'], '.3f'):>6} {'yes' if row['converged'] else 'NO':>3} "
-                  f"{(row['fits'] or '-').replace('no', 'NO'):>6}")
+        for line in ranking_lines(result.table()):
+            print(line)
         _print_undetermined(result)
         pairs = result.baselines()
         if pairs:
@@ -290,9 +263,3 @@ def run(args) -> int:
             print(f"report: {out / 'report.html'} (figures in {out / 'figures'}; summary.json, "
                   "ranking.csv and one NetCDF per structure beside it)")
     return 0
-
-
-def _order_means(row: dict) -> str:
-    """The posterior means of every fractional order of a ranking row, by symbol
-    (``"α 0.589 β 0.128"``), from its ``orders`` cell."""
-    return " ".join(part.split(" [")[0] for part in (row.get("orders") or "").split("; ") if part)

@@ -90,20 +90,21 @@ def _criteria(lik: Likelihood, fit: FitResult, post: PosteriorResult) -> dict:
     }
 
 
-def _holdout(lik, post, test: FrequencyResponse) -> dict:
+def _holdout(lik, post, held_out: FrequencyResponse) -> dict:
     """Log pointwise predictive density and RMSE on held-out frequencies."""
     from scipy.special import logsumexp
 
     # Same structure, noise model, priors and units as the fit: the draws apply unchanged.
-    held = Likelihood(lik.structure, test, noise=lik.noise, priors=lik.priors,
+    held = Likelihood(lik.structure, held_out, noise=lik.noise, priors=lik.priors,
                       scaling=lik.scaling, require_points=False)
     draws = post.samples_scaled
     pointwise = held.pointwise(draws)
     lpd = logsumexp(pointwise, axis=0) - np.log(draws.shape[0])
-    model = lik.structure.response(post.map_theta[: lik.structure.n_params], test.omega, test.kind)
-    rmse = float(np.sqrt(np.sum(np.abs(test.response - model) ** 2)) / test.n_frequencies)
+    model = lik.structure.response(post.map_theta[: lik.structure.n_params], held_out.omega,
+                                   held_out.kind)
+    rmse = float(np.sqrt(np.sum(np.abs(held_out.response - model) ** 2)) / held_out.n_frequencies)
     return {"holdout_lpd": float(lpd.sum()), "holdout_lpd_pointwise": lpd.tolist(),
-            "holdout_rmse": rmse, "holdout_omega": test.omega.tolist()}
+            "holdout_rmse": rmse, "holdout_omega": held_out.omega.tolist()}
 
 
 def delta_loo_se(results) -> dict[str, float]:

@@ -28,8 +28,10 @@ from .parameters import (  # noqa: F401  (re-exported: the names results offered
 from .table import (  # noqa: F401  (re-exported)
     ORDER_SYMBOLS,
     RANKING_FIELDS,
+    number,
     order_parameter,
     order_parameters,
+    ranking_lines,
     ranking_rows,
 )
 
@@ -164,7 +166,7 @@ class StructureResult:
         parts = []
         ev = self.criteria.evidence
         if ev is not None:
-            parts.append(f"ln Z = {_fmt(ev.log_z, '.2f')} ± {_fmt(ev.log_z_err, '.2f')}")
+            parts.append(f"ln Z = {number(ev.log_z, '.2f')} ± {number(ev.log_z_err, '.2f')}")
         prob = self.criteria.posterior_probability
         if prob is not None:
             parts.append(f"P = {prob:.3f}")
@@ -190,15 +192,15 @@ class StructureResult:
         prob = self.criteria.posterior_probability
         lines.append(
             "  ln Z = " + ("-" if ev is None else
-                           f"{_fmt(ev.log_z, '.2f')} ± {_fmt(ev.log_z_err, '.2f')} ({ev.method})")
+                           f"{number(ev.log_z, '.2f')} ± {number(ev.log_z_err, '.2f')} ({ev.method})")
             + ("" if prob is None else f", P = {prob:.3f}")
-            + f", elpd_loo = {_fmt(self.criteria.loo, '.2f')}"
-            + f", BIC = {_fmt(self.criteria.bic, '.2f')}")
+            + f", elpd_loo = {number(self.criteria.loo, '.2f')}"
+            + f", BIC = {number(self.criteria.bic, '.2f')}")
         if post is not None:
             lines.append(
                 f"  posterior: {getattr(post, 'sampler', 'emcee')}, "
                 + ("certified" if post.converged else "NOT certified")
-                + f" (R-hat {_fmt(post.rhat_max, '.3f')}, ESS {_fmt(post.ess_min, '.0f')}); "
+                + f" (R-hat {number(post.rhat_max, '.3f')}, ESS {number(post.ess_min, '.0f')}); "
                 f"noise {post.noise}; fits: {self.fits or '-'}")
         phys = self.physical
         if phys is not None:
@@ -223,8 +225,8 @@ class StructureResult:
                     ["poorly determined: the HDI covers more than half of the prior range"]
                     if v.get("poorly_determined") else [])
                 flag = f"  ({'; '.join(flags)})" if flags else ""
-                lines.append(f"  {n:<{width}}  {_fmt(v.get('median'), '11.4g')}  "
-                             f"[{_fmt(v.get('hdi_low'), '.4g')}, {_fmt(v.get('hdi_high'), '.4g')}]"
+                lines.append(f"  {n:<{width}}  {number(v.get('median'), '11.4g')}  "
+                             f"[{number(v.get('hdi_low'), '.4g')}, {number(v.get('hdi_high'), '.4g')}]"
                              f"{unit}{flag}")
         for w in self.criteria.warnings:
             lines.append(f"  ! {w}")
@@ -296,13 +298,6 @@ class StructureResult:
                                    for k, v in self.fit.linear.items()}},
         )
         return out
-
-
-def _fmt(value, spec: str) -> str:
-    """``value`` formatted by ``spec``, ``-`` for None and NaN."""
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    return format(value, spec)
 
 
 def _parent(structure) -> str | None:
@@ -389,30 +384,17 @@ class Comparison:
                 + (f"; {failed} failed" if failed else "") + ">")
 
     def summary(self) -> str:
-        """The ranking in a few lines: per structure ln Z ± error, Δln Z, the posterior
-        probability P, whether its posterior is certified and whether it fits the data
+        """The ranking as ``bayesfo compare`` prints it (:func:`~bayesfo.comparison.table.
+        ranking_lines`): per structure ln Z ± error (L: from a tempered ladder), Δln Z, the
+        posterior probability P, elpd by PSIS-LOO, BIC, the fractional orders' means, R-hat,
+        whether the posterior is certified (ok) and whether the structure fits the data
         (posterior predictive checks); the structures that failed with their reason.
         ``print(result.summary())``; per structure, :meth:`StructureResult.summary`."""
         d = self.data
         held = "" if self.holdout is None else f", {self.holdout.n_frequencies} held out"
-        width = max([16] + [len(row['structure']) for row in self.table()])
         lines = [f"{d.label}: {d.n_frequencies} frequencies{held} "
                  f"({d.omega.min():.4g} to {d.omega.max():.4g} rad/s), {d.kind}; seed "
-                 f"{self.seed}; ranked by ln Z",
-                 f"{'#':>2} {'structure':<{width}} {'k':>2} {'ln Z':>18} {'dlnZ':>8} {'P':>6} "
-                 f"{'certified':>9} {'fits':>6}"]
-        for row in self.table():
-            if row.get("error"):
-                lines.append(f"{'-':>2} {row['structure']:<{width}} {row['n_params']:>2}  failed: "
-                             f"{row['error']}")
-                continue
-            z = ("-" if row["log_evidence"] is None else
-                 f"{_fmt(row['log_evidence'], '.2f')} ± {_fmt(row['log_evidence_err'], '.2f')}")
-            lines.append(
-                f"{row['rank']:>2} {row['structure']:<{width}} {row['n_params']:>2} {z:>18} "
-                f"{_fmt(row['delta_log_evidence'], '.2f'):>8} "
-                f"{_fmt(row['posterior_probability'], '.3f'):>6} "
-                f"{'yes' if row['converged'] else 'NO':>9} {(row['fits'] or '-'):>6}")
+                 f"{self.seed}; ranked by ln Z", *ranking_lines(self.table())]
         for w in self.data_warnings:
             lines.append(f"! {w}")
         return "\n".join(lines)

@@ -125,9 +125,9 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         from ..inference.likelihood import zero_part
         if (why := zero_part(data)) is not None:
             raise InputError(why)
-    test = None
+    held_out = None
     if holdout is not None and len(holdout):
-        data, test = data.split(holdout)
+        data, held_out = data.split(holdout)
     for problem in data_problems(data):
         warnings.warn(problem, DataWarning, stacklevel=2)
     if progress is None:
@@ -135,7 +135,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     n_proc = min(workers or available_cpus(), len(structures))
     options = RunOptions(noise=noise, priors=priors, seed=seed, evidence=evidence,
                          evidence_check=evidence_check, sampler=sampler,
-                         sampler_kwargs=sampler_kwargs, test=test)
+                         sampler_kwargs=sampler_kwargs, holdout=held_out)
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
     # Each step gets the same seed whatever the worker count or the process that runs it, so
     # the numbers do not depend on them.
@@ -166,7 +166,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     if all(r.error is not None for r in results):
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
     results = _model_probabilities(results, prior_odds or {})
-    return Comparison(data, tuple(results), seed, holdout=test)
+    return Comparison(data, tuple(results), seed, holdout=held_out)
 
 
 def _as_structures(spec) -> list:

@@ -55,7 +55,7 @@ class RunOptions:
         The posterior route (``"auto"``, ``"emcee"``).
     sampler_kwargs : dict
         Settings passed to emcee (``max_steps``, ``n_walkers``).
-    test : FrequencyResponse or None
+    holdout : FrequencyResponse or None
         The held-out frequencies.
     """
 
@@ -66,7 +66,7 @@ class RunOptions:
     evidence_check: bool = False
     sampler: str = "auto"
     sampler_kwargs: dict = field(default_factory=dict)
-    test: FrequencyResponse | None = None
+    holdout: FrequencyResponse | None = None
 
     def priors_of(self, s: Structure, noise: str | None = None) -> dict:
         """The overrides that apply to ``s`` (and to the noise parameter of ``noise``)."""
@@ -353,7 +353,7 @@ def conclude(s: Structure, data: FrequencyResponse, fit, screened: Screen | None
              runs: list[NoiseRun], options: RunOptions) -> StructureResult:
     """Step 3, once the runs of step 2 are in: the noise model chosen by evidence, the chosen
     run's warnings issued, the evidence check, the adequacy checks, the held-out points."""
-    seed, test = options.seed, options.test
+    seed, held_out = options.seed, options.holdout
     if len(_noise_candidates(data, options.noise)) > 1:
         run, record = choose_noise(s.name, runs, screened)
     else:
@@ -375,8 +375,8 @@ def conclude(s: Structure, data: FrequencyResponse, fit, screened: Screen | None
     except InputError as exc:  # e.g. too few frequencies for the statistics
         criteria["adequacy"] = None
         criteria["warnings"].append(f"{s.name}: no adequacy check: {exc}")
-    if test is not None:
-        criteria.update(_holdout(lik, post, test))
+    if held_out is not None:
+        criteria.update(_holdout(lik, post, held_out))
     return StructureResult(s, fit, post, Criteria.from_dict(criteria))
 
 

@@ -156,3 +156,69 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se",
                   "not_determined", "poorly_determined", "orders")
 
+
+
+def number(value, spec: str = ".2f", missing: str = "-") -> str:
+    """One number of a table in text: ``value`` formatted by ``spec``, or ``missing`` where it
+    is undefined (None, NaN or infinite; the reason is among the warnings).
+
+    Examples
+    --------
+    >>> number(-12.3456), number(float("nan")), number(None, missing="–")
+    ('-12.35', '-', '–')
+    """
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return missing
+    return format(value, spec)
+
+
+def order_means(row: dict) -> str:
+    """The posterior means of every fractional order of a ranking row, by symbol
+    (``"α 0.589 β 0.128"``), from its ``orders`` cell."""
+    return " ".join(part.split(" [")[0] for part in (row.get("orders") or "").split("; ")
+                    if part)
+
+
+#: The ranking in text: (header, minimum width, cell of a ranked row). The structure's name is
+#: left-aligned, every other column right-aligned; a column is as wide as its widest cell.
+TEXT_COLUMNS = (
+    ("#", 2, lambda r: str(r["rank"])),
+    ("structure", 16, lambda r: r["structure"]),
+    ("k", 2, lambda r: str(r["n_params"])),
+    ("ln Z", 18, lambda r: "-" if r["log_evidence"] is None else
+     f"{number(r['log_evidence'])} ± {number(r['log_evidence_err'])}"
+     + (" L" if r["evidence_method"] == "ladder" else "  ")),
+    ("dlnZ", 8, lambda r: "-" if r["log_evidence"] is None else
+     number(r["delta_log_evidence"])),
+    ("P", 6, lambda r: "-" if r["log_evidence"] is None else
+     number(r["posterior_probability"], ".3f")),
+    ("elpd_loo", 10, lambda r: number(r["loo"])),
+    ("BIC", 10, lambda r: number(r["bic"])),
+    ("orders (mean)", 13, order_means),
+    ("R-hat", 6, lambda r: number(r["rhat_max"], ".3f")),
+    ("ok", 3, lambda r: "yes" if r["converged"] else "NO"),
+    ("fits", 6, lambda r: (r["fits"] or "-").replace("no", "NO")),
+)
+
+
+def ranking_lines(rows: list[dict]) -> list[str]:
+    """The ranking table in text (``bayesfo compare`` prints it; :meth:`Comparison.summary`
+    too): a header and a line per structure of :func:`ranking_rows`, the ranked ones first and
+    each one that failed with its reason; columns as wide as their widest cell, so that a huge
+    ln Z keeps the table aligned."""
+    ranked = [r for r in rows if not r.get("error")]
+    cells = [[cell(r) for _, _, cell in TEXT_COLUMNS] for r in ranked]
+    widths = [max([minimum, len(header)] + [len(c[k]) for c in cells])
+              for k, (header, minimum, _) in enumerate(TEXT_COLUMNS)]
+    widths[1] = max([widths[1]] + [len(r["structure"]) for r in rows])
+
+    def line(values):
+        return " ".join(f"{v:<{w}}" if k == 1 else f"{v:>{w}}"
+                        for k, (v, w) in enumerate(zip(values, widths, strict=True)))
+
+    lines = [line([header for header, _, _ in TEXT_COLUMNS]), *map(line, cells)]
+    for r in rows:
+        if r.get("error"):
+            lines.append(f"{'-':>{widths[0]}} {r['structure']:<{widths[1]}} "
+                         f"{r['n_params']:>{widths[2]}}  failed: {r['error']}")
+    return lines

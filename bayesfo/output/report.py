@@ -20,6 +20,7 @@ from pathlib import Path
 
 from .._io import atomic_write_text
 from ..comparison.parameters import UNDETERMINED_DECADES
+from ..comparison.table import number
 from ..errors import InputError
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
@@ -72,7 +73,7 @@ def _e(x) -> str:
 
 
 def _num(x, fmt: str = ".2f") -> str:
-    return format(x, fmt) if _finite(x) else "–"
+    return number(x, fmt, missing="–")
 
 
 def _cell(x, fmt: str = ".2f", text: str | None = None, cls: str = "") -> str:
@@ -144,7 +145,7 @@ def _ranking_table(comparison) -> str:
         cols.insert(9, ("holdout_lpd", "held-out lpd", ".2f"))
     head = ('<tr><th>#</th><th class="text">structure</th><th>k</th>'
             + "".join(f"<th>{_e(h)}</th>" for _, h, _ in cols)
-            + '<th>q (sd)</th><th class="text">converged</th></tr>')
+            + '<th class="text">orders</th><th class="text">converged</th></tr>')
     body = []
     for row in comparison.table():
         name = row["structure"]
@@ -164,8 +165,7 @@ def _ranking_table(comparison) -> str:
                 cells.append(_cell(v, fmt, cls="flag"))
             else:
                 cells.append(_cell(v, fmt))
-        q = row.get("q_mean")
-        cells.append(_cell(q, text=f"{q:.3f} ({row['q_sd']:.3f})" if _finite(q) else "–"))
+        cells.append(_text_cell(row.get("orders") or "–"))
         ok = row["converged"]
         cells.append(f'<td class="text{"" if ok else " flag"}">{"yes" if ok else "NO"}</td>')
         body.append(f'<tr id="row-{_e(name)}">' + "".join(cells) + "</tr>")
@@ -176,8 +176,8 @@ def _ranking_table(comparison) -> str:
             "better) with the standard error of each estimate, by PSIS-LOO, whose Pareto k "
             "says where it is unreliable (WAIC, which estimates the same without a diagnostic "
             "of its own, is in ranking.csv and summary.json); AIC and BIC: lower is better; "
-            "RMSE at the posterior mode (thesis eq. (3.23)); q: posterior mean and sd of the "
-            "fractional order (β for the generalised Maxwell model).</p>")
+            "RMSE at the posterior mode (thesis eq. (3.23)); orders: each fractional order by "
+            "its symbol, posterior mean and 94 % HDI.</p>")
     return f"<table>{head}{''.join(body)}</table>{note}"
 
 

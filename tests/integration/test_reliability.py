@@ -548,8 +548,8 @@ def test_a_pipe_is_not_a_data_file(tmp_path, run_cli):
 
 
 def test_undefined_criteria_are_empty_cells_and_rank_last(comparison):
-    from bayesfo.cli.compare import _num
     from bayesfo.comparison.criteria import _frequencies
+    from bayesfo.comparison.table import number, ranking_lines
     from bayesfo.output import ranking_csv
 
     voigt, zener = comparison.results
@@ -564,7 +564,10 @@ def test_undefined_criteria_are_empty_cells_and_rank_last(comparison):
     header, *lines = [line.split(",") for line in text.splitlines()]
     zrow = dict(zip(header, next(li for li in lines if li[1] == "zener"), strict=True))
     assert zrow["loo"] == zrow["loo_se"] == zrow["pareto_k_max"] == ""
-    assert _num(np.nan) == "-" and _num(None) == "-" and _num(1.234) == "1.23"
+    assert number(np.nan) == "-" and number(None) == "-" and number(1.234) == "1.23"
+    header, *table = ranking_lines(fake.table())
+    elpd = header.index("elpd_loo") + len("elpd_loo")
+    assert next(li for li in table if " zener " in li)[elpd - 1] == "-"
     assert _frequencies(np.arange(1.0, 201.0)) == "omega = 1, 2, 3, 4, 5, 6 and 194 more rad/s"
     assert _frequencies(np.array([0.5, 2.0])) == "omega = 0.5, 2 rad/s"
 

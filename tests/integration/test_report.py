@@ -151,6 +151,9 @@ def test_ranking_table_numbers_match_the_comparison(comparison):
                 mark = " L" if key == "log_evidence" and row["evidence_method"] == "ladder" else ""
                 assert text == f"{row[key]:.2f}{mark}"
         assert cells[-1][0] == ("yes" if row["converged"] else "NO")
+        # Every fractional order by its symbol, as in ranking.csv (none for integer orders).
+        assert cells[-2][0] == (row["orders"] or "–")
+    assert any("q " in parser.rows[f"row-{r['structure']}"][-2][0] for r in table)
 
 
 def test_parameter_summaries_and_priors_are_listed(comparison):

@@ -135,10 +135,9 @@ def new_pool(workers: int, *, fork: bool = False):
     With ``fork``, the processes are forked from this one instead where :func:`fork_safe`
     holds when it is created (they start at the first task, before the executor starts its
     manager thread): each then has the libraries this process has loaded, where a spawned one
-    imports them again (measured: 1.9 s of CPU for a fresh interpreter to import what a
-    worker needs, twice for the two workers of the full comparison of the thesis' G_spec
-    set-up, whose serial run takes 58 s of CPU). The workers are forked at the first task
-    and hold copies of the descriptors open at that moment (an output directory's lock, if
+    imports them again, a cost that is not small next to a comparison's own work
+    (BENCHMARKS.md, "Measurements behind design choices"). The workers are forked at the first
+    task and hold copies of the descriptors open at that moment (an output directory's lock, if
     one were held then, until they end): only for pools that live within one call, started
     before any output is written, as :func:`lazy_process_pool` in ``compare``. ``fork_safe``
     counts Python threads: the BLAS's own threads cope with a fork (OpenBLAS re-creates its
@@ -211,8 +210,8 @@ def single_blas_thread():
 
     The matrices of a comparison are a few parameters wide: threads cannot speed them up, and on
     a busy machine OpenBLAS's spinning threads slow the optimiser's small factorisations several
-    fold (measured: L-BFGS-B's steps 4.5 ms instead of about 0.3 ms). It also makes the
-    arithmetic of this process that of the workers.
+    fold (BENCHMARKS.md, "Measurements behind design choices"). It also makes the arithmetic of
+    this process that of the workers.
     """
     from threadpoolctl import threadpool_limits
 

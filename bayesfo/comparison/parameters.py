@@ -115,19 +115,14 @@ def not_determined(summary: dict, draws=None) -> str | None:
     NaN is likewise not determined. Fewer NaN draws are left out.
 
     The threshold is a judgement: a quantity known only to within more than a factor of 100
-    has no order of magnitude that the data fix. It lies in the gap measured on real data, the
-    default structures at seed 0 on the 20 °C isotherm of the 3M 468MP adhesive and on pyRheo's
-    chia gel: the log-scale HDIs of the quantities with units spanned 0.009 to 1.85 decades
-    below the threshold and 2.9 or more above it. Above: the time τ of a Zener reduced to a
-    Voigt (2.9 and 4.6 decades) and every quantity of the fractional Maxwell, whose order ran to
-    0 (c_β 3.6–3.8, c_δ 3.2–4.0, b1 7.1–7.9, τ and E 42 to 251 decades: draws up to 1e250).
-    Highest below: the Zener's G_m and b1 (1.6–1.8 decades), which the data bound on one side
-    only, and the integer Maxwell on the gel, whose time lies beyond the lowest frequency (c_β
-    and τ 1.8); the HDIs of the values had put those at 2.0–2.5 decades. A quantity near the
-    threshold can fall on either side from one seed to another. A quantity bounded by the data
-    on one side only is judged by how far its posterior spreads on the log scale, which its
-    prior shapes: a coefficient under a uniform prior that the data bound only from above has
-    most of its draws within a decade or two of that bound.
+    has no order of magnitude that the data fix. It lies in a gap between the spans of the
+    quantities with units on real data: the undetermined ones (a Zener reduced to a Voigt, a
+    fractional Maxwell whose order ran to 0) above it, the rest below, some of which the HDIs
+    of the values would have put above it (BENCHMARKS.md, "Measurements behind design
+    choices"). A quantity near the threshold can fall on either side from one seed to another.
+    A quantity bounded by the data on one side only is judged by how far its posterior spreads
+    on the log scale, which its prior shapes: a coefficient under a uniform prior that the data
+    bound only from above has most of its draws within a decade or two of that bound.
     """
     if not summary.get("unit"):
         return None

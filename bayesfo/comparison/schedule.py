@@ -12,17 +12,17 @@ each noise model at once, and (3) when their posteriors are back. A structure wh
 cannot choose between constant and proportional noise thus costs one posterior on the
 comparison's critical path, not two in sequence.
 
-(3) runs in a worker, not in the parent: shipping the two runs to it costs tens of
-milliseconds (a run with its posterior pickles to about 1.6 MB in a few ms), less than the
-step itself (the adequacy checks, about 0.1 s; the evidence check, seconds to minutes), which
-in the parent would run one structure at a time and take a core from the workers.
+(3) runs in a worker, not in the parent: shipping the two runs to it costs less than the step
+itself (the adequacy checks and the evidence check), which in the parent would run one
+structure at a time and take a core from the workers (BENCHMARKS.md, "Measurements behind
+design choices").
 
 The automatic schedule (``compare(workers=0)``, the command's default; ``here=True`` with a
 :class:`~bayesfo.parallel.LazyPool`) starts from the other end: a small job's cost is the
-processes, not the arithmetic (measured on the 17-point isotherm: a Voigt or Zener posterior
-with ln Z, LOO and adequacy takes 0.2-0.4 s, while spawning two workers that import the
-libraries takes 1-2 s of a loaded 2-core machine). This process runs step (1) of every
-structure, here with the screen's quick estimates of every noise model to sample
+processes, not the arithmetic (a small posterior with ln Z, LOO and adequacy takes less time
+than spawning workers that import the libraries: BENCHMARKS.md, "Measurements behind design
+choices"). This process runs step (1) of every structure, here with the screen's quick
+estimates of every noise model to sample
 (:func:`~bayesfo.comparison.steps.fit_and_probe`); where their Pareto k̂ promises that importance
 sampling will certify the posterior, it runs (2) and (3) as well, and only the other
 structures' (2) and (3) go to the pool, whose processes start with the first of them. A wrong

@@ -57,10 +57,9 @@ MAX_PHASE_DEG = 360.0
 #: Most frequencies (after averaging replicates) a data set may have. A likelihood evaluation
 #: costs time and memory proportional to the number of frequencies, and a comparison runs some
 #: 10⁵–10⁶ of them per structure (emcee up to 10 000 steps of 32+ walkers, the tempered ladder,
-#: PSIS-LOO over up to 2000 stored draws × frequencies). Measured in one process: zener and
-#: max-n2m2 together take 74 s at 200 frequencies and 315 s (0.8 GB) at 2000; voigt alone 11 s
-#: at 200 and 56 s (1.1 GB) at 5000, about 0.2 MB per frequency in every worker process. At
-#: 100 000 frequencies a comparison would run for hours and need tens of GB per worker.
+#: PSIS-LOO over up to 2000 stored draws × frequencies): with thousands of frequencies a
+#: comparison grows slow and needs much memory in every worker process (BENCHMARKS.md,
+#: "Measurements behind design choices").
 #: Rheometers and dynamic mechanical analysers give tens to a few hundred points (5–10 per
 #: decade), and a smooth response is determined by far fewer than 1000.
 MAX_FREQUENCIES = 1000

@@ -15,9 +15,9 @@ admissible, with a cost below twice the best admissible one so far, is re-solved
 residuals of growing weight (:func:`~bayesfo.structures.passivity.dissipation_shortfall`: the
 wrong-signed end coefficients of the dissipation polynomial and its worst value at a critical
 point, with a margin of 1e-8 into the passive region), first from its start, which leads to the
-boundary point of the start's basin, then from the optimum. Measured: the G_spec set-up and the
-NREL master curve get admissible max-n2m0 optima (none without it), and the q ≈ 0.25 mode of
-G_spec max-n2m2 (a1 = 0) is kept among the optima.
+boundary point of the start's basin, then from the optimum. The repair gives admissible optima
+where the plain fit has none, and keeps boundary modes among the optima (BENCHMARKS.md,
+"Measurements behind design choices").
 """
 
 from __future__ import annotations
@@ -248,7 +248,8 @@ def fit_structure(
         structures of the thesis form B(λ)/A(λ) or A(λ)/B(λ) (see :func:`linear_seeds`).
     linear_methods : bool
         Keep the fits of the linear methods 1–5 at their best q in ``FitResult.linear``
-        (:func:`linear_fits`, which figures mark; 20–60 ms per structure of the thesis form).
+        (:func:`linear_fits`, which figures mark; a small cost per structure: BENCHMARKS.md,
+        "Measurements behind design choices").
     min_starts, stop_after : int
         Stop once at least ``min_starts`` starts have run and ``stop_after`` of them ended at
         the best admissible cost found so far (``stop_after=None`` runs every start). Given and

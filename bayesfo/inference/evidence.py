@@ -226,11 +226,9 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
     share no random input: their agreement, which certifies the posterior, and the spread of
     their ln Z, which enters its error, then also show how much the result depends on the
     guide's draws. What they do share, the optima the guide was drawn around and the estimate
-    of ln P(S), no agreement between them can check: the error of ln P(S) enters whole.
-    Measured on max-n2m1 of the bundled 20 °C isotherm (proportional noise, seed 0), where both
-    runs were guided by the same 2 000 draws of a broad importance proposal: both put every
-    particle in one of the posterior's three modes, agreed (R-hat 1.004) and gave ln Z
-    −309.34 ± 0.04, against −308.95 ± 0.05 from the other seeds (see
+    of ln P(S), no agreement between them can check: the error of ln P(S) enters whole. Runs
+    guided by the same draws can agree with each other and still miss a mode, and ln Z with it
+    (BENCHMARKS.md, "Measurements behind design choices"; see
     :class:`~bayesfo.inference.smc._Guide` for the cause and the fix).
 
     Returns
@@ -287,8 +285,8 @@ def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: 
     it; on the thin curved ridges of over-parameterised structures (near pole–zero
     cancellations) it accepts almost nothing and may take hours. ``"rslice"`` (random-direction
     slice sampling) follows such ridges; it needs ``slices`` well above dynesty's default of
-    3 + ndim, which gives ln Z too low by 0.5–1.3 nats on the thesis' G_spec data (measured:
-    ``benchmarks/bench_evidence_routes.py``); 25 slices give the values of uniform draws.
+    3 + ndim, which gives ln Z too low, where more slices agree with uniform draws
+    (BENCHMARKS.md, "Measurements behind design choices").
     """
     import dynesty
 

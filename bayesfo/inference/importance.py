@@ -62,15 +62,16 @@ K_HAT_EVIDENCE = 0.5
 #: may span for the route to be certified (see the module's docstring). Orders only: an
 #: undetermined coefficient alone (a dashpot or spring invisible in the window) leaves no other
 #: configuration to miss, and on real data it is common (misfitting structures, whose noise is
-#: large); the alternative configurations of springpot models all move an order. Measured on
-#: simulated springpot data (benchmarks/bench_certificate.py, BENCHMARKS.md).
+#: large); the alternative configurations of springpot models all move an order. On simulated
+#: springpot data, every posterior that missed a mode had an order spanning more than this,
+#: and few that missed nothing did (BENCHMARKS.md, "Measurements behind design choices").
 UNDETERMINED = 0.25
 
 NEWTON = 4
 #: Rounds of importance sampling: the Laplace mixture, then one adapted to the weighted draws
-#: of the first (see _adapted). Measured on the 20 °C isotherm: the second round certifies the
-#: Zener under constant noise (k̂ 0.82 → 0.27); third and fourth rounds left the Maxwell's ridge
-#: at an ESS of 190-230 of 20 000, uncertified, so they are not run.
+#: of the first (see _adapted). A second round certifies posteriors that the first alone does
+#: not; further rounds did not certify what two left uncertified, so they are not run
+#: (BENCHMARKS.md, "Measurements behind design choices").
 MAX_ROUNDS = 2
 DF = 5.0        # Student-t degrees of freedom: heavier tails than the Laplace approximation
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
@@ -109,9 +110,9 @@ def _polish(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """The maximum of the log posterior ``f`` near ``u0`` within the box, by L-BFGS-B.
 
     The optima come from least squares weighted by the data's magnitude; under another noise
-    model (a constant σ) the posterior's mode lies elsewhere, tens of nats higher (measured on
-    the bundled 20 °C isotherm: 31 nats for the Zener), beyond the reach of a few Newton steps
-    that must stay inside the box where a coefficient sits on its prior bound."""
+    model (a constant σ) the posterior's mode lies elsewhere, much higher (BENCHMARKS.md,
+    "Measurements behind design choices"), beyond the reach of a few Newton steps that must
+    stay inside the box where a coefficient sits on its prior bound."""
     from scipy.optimize import minimize
 
     f0 = f(u0[None, :])[0]
@@ -379,9 +380,9 @@ def _adapted(first, n_proposals: int, rng: np.random.Generator):
     Student-t matched to the mean and covariance of the first round's weighted draws (one step
     of population Monte Carlo). The half of the first proposal keeps its coverage of every
     mode; the matched component reaches the skewed or bounded directions the Laplace
-    approximations miss (measured on the bundled 20 °C isotherm: the Zener under constant noise,
-    whose b1 leans on its prior bound, goes from Pareto k̂ 0.75-0.82 to certified). None where
-    the first round's draws are too few to estimate a covariance."""
+    approximations miss, such as a parameter leaning on its prior bound (BENCHMARKS.md,
+    "Measurements behind design choices"). None where the first round's draws are too few to
+    estimate a covariance."""
     x, log_w, finite, n_modes, prop = first
     xs = x[finite]
     smoothed, _ = psis(log_w[finite])

@@ -139,12 +139,10 @@ def _snooker_move():
     emcee's own DESnookerMove up to 3.1.6 (:data:`LAST_UNFIXED_EMCEE`) is not used: it divides x − z by
     √|x − z| instead of |x − z| (the step is then the projection times |x − z|) and takes half
     the exponent d − 1, so it does not leave the target invariant (fixed upstream by
-    dfm/emcee#531; a later release's own move is used, with the null move below). Measured: on a 5-D normal of sd 1 (0.03) alone it keeps walkers
-    with sd 0.83 (0.61) of the truth; in bayesfo's mixture (a fifth of the moves) the Zener's
-    posterior sds on the bundled 20 °C isotherm came out 2–5 % below those of importance
-    sampling and of random-walk Metropolis (mean of 20 converged runs: a1 −2.4 %, q −3.4 %,
-    σ −2.1 %, b1 −6.6 %); with this move they agree within 1 % (+0.2 %, +0.2 %, +1.1 %, +1.6 %,
-    each ± 0.5–1.4 %).
+    dfm/emcee#531; a later release's own move is used, with the null move below). Its walkers
+    come out narrower than the target, alone and in bayesfo's mixture of moves, where this move
+    agrees with importance sampling and random-walk Metropolis (BENCHMARKS.md, "Measurements
+    behind design choices").
 
     A proposal through a walker's own position (z = x: walkers that coincide, all of them
     pinned in a corner of the prior box, as the integer Voigt is on the 26-decade NREL curve)
@@ -241,8 +239,8 @@ def sample_posterior(
         Stop once a fifth of ``max_steps`` has run if the autocorrelation time estimated so far
         already needs more than ``max_steps`` for ``tau_factor`` of them (such estimates only
         grow with the chain). ``compare`` sets it: the tempered ladder then gives the
-        posterior (measured on the bundled 20 °C isotherm, the Maxwell's walkers stop at 3 250
-        instead of 10 000 steps).
+        posterior, and the walkers stop well before ``max_steps`` (BENCHMARKS.md, "Measurements
+        behind design choices").
 
     Returns
     -------

@@ -242,11 +242,11 @@ def _count_modes(u: np.ndarray, lo: float, hi: float) -> int:
     deviation of draws from two separated modes is that of their distance, and a bandwidth set
     by it smooths a minor mode away. The density is the binned Gaussian kernel estimate on a
     512-point grid (draws shared linearly between the two nearest grid points, then convolved
-    with the kernel). It equals the exact kernel sum of ``scipy.stats.gaussian_kde`` on that
-    grid within 0.2 % of the peak height (measured on normal, skewed, uniform and two-mode draws
-    of 200–40 000 points; tested at 1 %) at 1/90 of its cost (0.7 ms against 64 ms for 8 000
-    draws), and unlike a kernel sum taken only at the grid points it does not turn scattered
-    tail draws into peaks where the kernel is narrower than a grid step.
+    with the kernel). It matches the exact kernel sum of ``scipy.stats.gaussian_kde`` on that
+    grid closely (tested at 1 % of the peak height) at a small fraction of its cost
+    (BENCHMARKS.md, "Measurements behind design choices"), and unlike a kernel sum taken only
+    at the grid points it does not turn scattered tail draws into peaks where the kernel is
+    narrower than a grid step.
     """
     from scipy import signal
 

@@ -6,9 +6,10 @@ L^(β' − β), resamples them and moves them with Metropolis steps that leave �
 rungs are chosen so that the reweighting keeps 80 % of the effective sample size (Jasra et al.
 2011; Zhou, Johansen and Aston 2016). The product of the rungs' mean weights is the
 stepping-stone estimate of ln Z (Del Moral, Doucet and Jasra 2006; Xie et al. 2011), kept in
-``LadderRun.log_z``; it depends on every rung being in equilibrium and scatters by 0.3–1 nats
-between runs here, so :func:`bayesfo.inference.evidence.ladder_evidence` takes ln Z by bridge
-sampling from the final particles instead (a few hundredths of a nat).
+``LadderRun.log_z``; it depends on every rung being in equilibrium and scatters between runs
+far more than bridge sampling from the final particles, so
+:func:`bayesfo.inference.evidence.ladder_evidence` takes ln Z by bridge sampling instead
+(BENCHMARKS.md, "Measurements behind design choices").
 
 The moves are differential-evolution proposals (ter Braak 2006) drawn from the population at
 the start of the rung: u' = u + γ (u_a − u_b) for two other particles a, b. The difference of
@@ -163,8 +164,9 @@ def _next_beta(beta: float, log_lik: np.ndarray, ess_fraction: float) -> float:
     """The largest β' ≤ 1 whose weights L^(β' − β) keep ``ess_fraction`` of the sample size.
 
     The bisection evaluates the ESS 60 times per rung; with the weights shifted by their
-    maximum it is (Σw)²/Σw² directly (scipy's ``logsumexp``, twice per evaluation, took 12 %
-    of a tempered-ladder run in its argument checks)."""
+    maximum it is (Σw)²/Σw² directly (scipy's ``logsumexp``, twice per evaluation, cost a
+    noticeable share of a tempered-ladder run in its argument checks: BENCHMARKS.md,
+    "Measurements behind design choices")."""
     finite = log_lik[np.isfinite(log_lik)]
     n = log_lik.size
     if not finite.size:
@@ -196,13 +198,9 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
     At each rung the particles take Metropolis steps until each has made ``accepted_moves``
     accepted moves on average (at most ``max_moves`` steps). Where fewer than one step in
     twenty is accepted (the late rungs of the Maxwell and the max-order members) the cap sets
-    the cost; elsewhere the target does. Measured on the thesis' G_spec set-up
-    (``benchmarks/bench_ladder_budget.py``; eight seeds of the ladder on the same data and
-    guide), 5 accepted moves instead of 10 took 18-19 % fewer likelihood evaluations on the
-    Maxwell and max-n3m3 (43-45 % on max-n2m1, max-n2m2, max-n3m0) and left ln Z where it was:
-    Maxwell mean −1472.295 with a scatter of 0.040 between seeds (10: −1472.295, 0.050),
-    max-n3m3 191.04, scatter 0.073 (10: 190.98, 0.140); 7 of 8 max-n3m3 pairs and 8 of 8
-    Maxwell pairs certified (10: 8 of 8 each).
+    the cost; elsewhere the target does. The default of 5 accepted moves takes fewer likelihood
+    evaluations than 10 and leaves ln Z where it was (BENCHMARKS.md, "Measurements behind
+    design choices").
 
     ``guide`` (draws in the sampling coordinates, e.g. emcee's) adds ``guided_moves``
     independence Metropolis–Hastings steps per rung, proposing from an equal mixture of a
@@ -214,12 +212,9 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
     guide, ``own_moves`` such steps propose from the mixture fitted to the particles alone,
     and ``final_moves`` more are taken at β = 1: they
     move particles between distant regions of the posterior, which the differential-evolution
-    steps connect only through a narrow neck. Measured on the Maxwell of the bundled 20 °C
-    isotherm (constant noise, 1 000 particles, six seeds; its posterior is two arms that meet
-    where the order α vanishes): the two runs of :func:`ladder_runs` agreed (R-hat < 1.01) on
-    0 of 4 seeds without these moves and with ``ess_fraction=0.5`` (the rungs of earlier
-    versions), on 5 of 6 with them, and on 6 of 6 with them and 0.8 (twice the rungs and the
-    likelihood calls).
+    steps connect only through a narrow neck. These moves, with ``ess_fraction=0.8``, let the
+    two runs of :func:`ladder_runs` agree on a posterior of two arms that meet in such a neck
+    (BENCHMARKS.md, "Measurements behind design choices").
     """
     return ladder_runs_together(lik, [rng], n_particles=n_particles, ess_fraction=ess_fraction,
                                 accepted_moves=accepted_moves, max_moves=max_moves,
@@ -235,11 +230,10 @@ def ladder_runs_together(lik: Likelihood, rngs, *, guides=None, **kwargs) -> lis
 
     Each run draws from its own generator and decides alone (its rungs, its moves), so its
     result is that of :func:`ladder_run` with the same generator; only the batching differs.
-    Why: a run takes some 3 000 Metropolis steps, each one or two evaluation calls of 100–1 000
-    points, and each call has a fixed cost (the likelihood about 0.3 ms, the constraint checks
-    about 0.5 ms, measured on max-n3m3 of the thesis' G_spec set-up) that runs in one call pay
-    once: the two runs of that structure took 43.6 s in lock-step against 49.6 s one after the
-    other (medians of 4 interleaved repeats on a machine loaded to 4.4 on 2 cores).
+    Why: a run takes thousands of Metropolis steps, each one or two evaluation calls of hundreds
+    of points, and each call has a fixed cost (the likelihood's and the constraint checks') that
+    runs in one call pay once, so runs in lock-step take less time than one after the other
+    (BENCHMARKS.md, "Measurements behind design choices").
     """
     guides = [None] * len(rngs) if guides is None else list(guides)
     if len(guides) != len(rngs):
@@ -345,8 +339,8 @@ def _ladder_steps(lik: Likelihood, target: _Target, rng: np.random.Generator, *,
             a = rng.integers(n, size=n)
             b = (a + rng.integers(1, n, size=n)) % n
             g = np.where(rng.random(n) < jump_fraction, 1.0, gamma)
-            # u + g (snapshot[a] − snapshot[b]), in place (the same numbers, in 40 % of the
-            # time of the expression at 1 000 particles).
+            # u + g (snapshot[a] − snapshot[b]), in place (the same numbers, in less time than
+            # the expression: BENCHMARKS.md, "Measurements behind design choices").
             prop = np.take(snapshot, a, axis=0)
             prop -= np.take(snapshot, b, axis=0)
             prop *= g[:, None]
@@ -389,17 +383,13 @@ class _Guide:
     Why the reweighting: the draws of the importance proposal (multivariate t components at the
     optima, with tails wide enough for its weights) are far broader than a narrow mode of the
     posterior, and a mixture fitted to them as they are proposes into that mode too rarely to
-    be accepted there. Measured on max-n2m1 of the bundled 20 °C isotherm (proportional noise;
-    the posterior holds q ≈ 0.58, 0.48 and 0.34 with shares 0.65, 0.11 and 0.24, the latter
-    two narrow): guided by the 2 000 proposal draws of seed 0 as they are, 3 runs of 3 ended
-    with every particle at q ≈ 0.58 and ln Z −309.31 to −309.35; reweighted, 6 of 6 found the
-    three modes with their shares and ln Z −308.90 to −309.02 (guided by posterior draws:
-    −308.90 to −308.92). Each run of :func:`~bayesfo.inference.evidence.ladder_runs` has half
-    the draws; of 8 runs guided by 1 000 of them, 4 gave a narrow mode less than half its share
-    (ln Z low by up to 1 nat), none of 12 once :data:`GUIDE_EXTRA` draws of g, whose density is
-    exact, were added before the reweighting (ln Z −308.89 to −309.03). Where the reweighted
-    draws are too few distinct points for a mixture (at small β, where the weights follow
-    1/g), the mixture of the draws as they are is used.
+    be accepted there: guided by the draws as they are, runs miss the narrow modes, and ln Z
+    with them; reweighted, they find every mode with its share. Each run of
+    :func:`~bayesfo.inference.evidence.ladder_runs` has half the draws, with which a narrow mode
+    can get too small a share unless :data:`GUIDE_EXTRA` draws of g, whose density is exact, are
+    added before the reweighting (BENCHMARKS.md, "Measurements behind design choices"). Where
+    the reweighted draws are too few distinct points for a mixture (at small β, where the
+    weights follow 1/g), the mixture of the draws as they are is used.
     """
 
     def __init__(self, draws: np.ndarray, rng: np.random.Generator):

@@ -49,8 +49,8 @@ def _legend_columns(fig, labels, max_columns: int = 3) -> int:
 
 def _wrapped(note: str, width: int = 60) -> str:
     """The note in lines of at most ``width`` characters, one clause (``;``) per line: a note
-    naming several groups would otherwise run past both edges of the figure (measured: 95
-    characters on the demo's seven structures)."""
+    naming several groups would otherwise run past both edges of the figure (BENCHMARKS.md,
+    "Measurements behind design choices")."""
     import textwrap
 
     return "\n".join(line for part in note.split("; ") if part

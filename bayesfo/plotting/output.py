@@ -211,9 +211,8 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
         raise InputError(f"argument 'processes' must be 1 or 2, got {processes!r}")
     if pool is not None and getattr(pool, "started", True) is False:
         # A lazy pool that the comparison did not need: spawning processes now (each imports
-        # matplotlib and the rest) costs more than drawing the figures here (measured on the
-        # 2-core machine: 9 s here against 24-26 s in two fresh processes, PNG and PDF of
-        # Voigt and Zener, busy machine).
+        # matplotlib and the rest) costs more than drawing the figures here (BENCHMARKS.md,
+        # "Measurements behind design choices").
         pool = None
     _detailed(comparison, structure_figures)  # checks the argument before any drawing
     if pool is None and processes == 2 and can_fork():
@@ -268,9 +267,8 @@ def can_fork() -> bool:
 def _draw_order(comparison, names) -> list[str]:
     """The figures in the order both processes take them: the costliest first (corner plots,
     larger structures first; the q densities; the response figures; traces), so that the two
-    processes end close together. Measured per figure, PNG and PDF, quiet machine: corner
-    0.86-0.96 s (4-5 parameters), q posteriors 0.72 s, Bode 0.62 s, ranking 0.56 s,
-    residuals 0.50 s, trace 0.36-0.57 s, Nyquist 0.40 s."""
+    processes end close together. The relative costs below follow the time each figure takes
+    (BENCHMARKS.md, "Measurements behind design choices")."""
     n_params = {_file_stem(r.name): r.structure.n_params for r in ok_results(comparison)}
     base = {"q_posteriors": 7.0, "bode": 6.0, "moduli": 6.0, "time_functions": 6.0,
             "ranking": 5.5, "residuals": 5.0,
@@ -287,7 +285,8 @@ def _draw_order(comparison, names) -> list[str]:
 
 
 #: Seconds :func:`draw_forked` waits for the forked process once this one has no figure left
-#: to take (it is then drawing its last one, 0.4-1 s on a quiet machine).
+#: to take (it is then drawing its last one, which takes far less than this: BENCHMARKS.md,
+#: "Measurements behind design choices").
 CHILD_TIMEOUT = 120.0
 
 #: States of a figure in :func:`draw_forked`'s shared table.
@@ -342,9 +341,9 @@ def preload(formats) -> None:
 def _load_before_fork(formats) -> None:
     """Import, before forking, the modules every figure needs that nothing has imported yet
     (corner, the PDF backend and its font subsetter, the PNG writer) and build the mathtext
-    parser, so that both processes share them instead of each loading them (about 0.1 s).
-    Drawing a first figure here would share more but cost this process 0.26 s before the
-    fork, more than the two processes gain."""
+    parser, so that both processes share them instead of each loading them. Drawing a first
+    figure here would share more but cost this process more before the fork than the two
+    processes gain (BENCHMARKS.md, "Measurements behind design choices")."""
     import corner  # noqa: F401
     from matplotlib import mathtext
 
@@ -364,19 +363,17 @@ def draw_forked(comparison, out_dir, formats=("png",), *, seed: int = 0,
     Both take the figures one at a time from one shared table, costliest first
     (:func:`_draw_order`), so that they end close together; ``meanwhile()``, when given, runs
     here first while the forked process already draws. A fork shares everything this process
-    has loaded (a spawned process would import matplotlib, arviz and scipy again: about 3 s of
-    CPU, which on a busy machine made the command slower, not faster). BLAS runs one thread in
-    both (:func:`bayesfo.parallel.single_blas_thread`): no BLAS thread pool is used across the
-    fork. If the forked process fails, this one draws the figures it had taken, so the files
-    and any error are those of drawing here. The files are those of :func:`write_figures` in
-    one process; the result is in its order. Call it where :func:`can_fork` holds.
+    has loaded (a spawned process would import matplotlib, arviz and scipy again, which on a
+    busy machine made the command slower, not faster: BENCHMARKS.md, "Measurements behind
+    design choices"). BLAS runs one thread in both
+    (:func:`bayesfo.parallel.single_blas_thread`): no BLAS thread pool is used across the fork.
+    If the forked process fails, this one draws the figures it had taken, so the files and any
+    error are those of drawing here. The files are those of :func:`write_figures` in one
+    process; the result is in its order. Call it where :func:`can_fork` holds.
 
-    Measured for Voigt and Zener on the 20 °C adhesive isotherm (9 figures, PNG and PDF, 5.2-5.5
-    s of CPU in one process): ``bayesfo compare`` as a whole process 8.7-9.1 s in one process,
-    6.2-6.7 s with the figures in two, on a quiet 2-core machine; 0.3-0.8 s of CPU more in all.
-    With another job keeping one core busy the two shared the other and the command took
-    0.6-0.8 s longer, so the command forks only when a CPU is idle
-    (:func:`bayesfo.cli.compare._figure_processes`).
+    Two processes make the command faster on a machine with an idle core, and slower when
+    another job keeps a core busy (BENCHMARKS.md, "Measurements behind design choices"), so
+    the command forks only when a CPU is idle (:func:`bayesfo.cli.compare._figure_processes`).
     """
     import multiprocessing
 

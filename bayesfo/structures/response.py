@@ -61,8 +61,8 @@ def power_sum(omega, coef, exponent) -> np.ndarray:
     # Σ_t phase_t · modulus_t with real arithmetic: Re = 0 + Σ Re(phase_t) modulus_t and likewise
     # Im, summed over t in order from zero, as the einsum of the complex phases with the real
     # moduli sums its products (the same values and signs of zeros for finite terms; an einsum
-    # casts the moduli to a complex temporary of shape (..., n_terms, n_freq) and takes 0.32
-    # against 0.24 µs per set of two terms at 25 frequencies).
+    # casts the moduli to a complex temporary of shape (..., n_terms, n_freq) and is slower:
+    # BENCHMARKS.md, "Measurements behind design choices").
     re, im = phase.real, phase.imag
     out = np.zeros(np.broadcast_shapes(phase.shape[:-1] + (1,),
                                        modulus.shape[:-2] + modulus.shape[-1:]), dtype=complex)
@@ -170,11 +170,9 @@ def _reversed_roots(c: np.ndarray) -> np.ndarray:
 
 
 #: Batches with fewer rows than this take the eigenvalues directly: below it, the fixed cost of
-#: the closed form (~70 array operations, ~170 µs with the eigenvalues of the rows it leaves
-#: open) exceeds that of the eigenvalues of 3×3 companion matrices (~1.4 µs per row). Measured
-#: on the polynomials of a tempered ladder's max-n3m3 constraint checks (``matignon_stable``,
-#: eigenvalues / closed form): 93 / 171 µs at 32 rows, 184 / 209 µs at 96, 227 / 216 µs at 128,
-#: 399 / 269 µs at 256.
+#: the closed form (~70 array operations, with the eigenvalues of the rows it leaves open)
+#: exceeds the per-row cost of the eigenvalues of 3×3 companion matrices (BENCHMARKS.md,
+#: "Measurements behind design choices").
 CLOSED_FORM_MIN_ROWS = 128
 
 #: Relative perturbation of each coefficient (about 4500 machine epsilons) in the error bound
@@ -204,7 +202,8 @@ def cubic_roots(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         the distance to the nearest other root (nearly multiple roots).
     """
     # Common subexpressions are computed once (fixed cost: a call takes ~70 array operations,
-    # 1–2 µs each at the tens to hundreds of rows of a tempered ladder's constraint checks);
+    # whose overhead counts at the tens to hundreds of rows of a tempered ladder's checks:
+    # BENCHMARKS.md, "Measurements behind design choices");
     # every value is the same floating-point expression as written out in the docstring's
     # steps.
     a, b, d = c[:, 0], c[:, 1], c[:, 2]
@@ -295,10 +294,10 @@ def _same_sign_sector(c: np.ndarray, q: np.ndarray) -> np.ndarray:
     sin kθ (k ≤ n) has the sign of θ, so Im A(λ) = Σ c_k r^k sin kθ ≠ 0, and A(r) ≥ 1 on the
     positive axis (a classical exclusion sector, e.g. A. Melman 2021). With qπ/2 < π/n every
     root then lies outside the sector. Exact for the
-    floating-point coefficients (the roots of the other routes are of the same ``c``). Measured
-    on the rows of one tempered-ladder run on the G_spec set-up: it settles 41 % of max-n3m3's
-    and 80 % of max-n2m2's, and takes ``matignon_stable`` over that run's calls from 1.40 to
-    1.18 s and 0.37 to 0.31 s, with the same decisions.
+    floating-point coefficients (the roots of the other routes are of the same ``c``). It
+    settles many rows of a tempered-ladder run without their roots, and so makes
+    ``matignon_stable`` faster with the same decisions (BENCHMARKS.md, "Measurements behind
+    design choices").
     """
     return np.all(c >= 0, axis=1) & (q < 2.0 / c.shape[1])
 

@@ -130,12 +130,10 @@ def oustaloup(alpha, omega_low, omega_high, order=5):
     Splitting towards zero keeps a negative fractional order such as ``-0.5`` free of a pole at
     the origin, which a simulation would turn into an integrator.
 
-    Inside the band the approximation is accurate away from its edges: with ``order >= 5``,
-    measured over ``0.05 <= nu <= 0.95`` and a band of six decades, the magnitude error is below
-    1e-3 (relative) and the phase error below 0.6 degree for
-    ``100 * omega_low <= omega <= omega_high / 100``; within a decade of the edges the phase error
-    reaches about 5 degrees whatever the order, because the phase at one frequency depends on the
-    slope of the magnitude over the whole axis.
+    Inside the band the approximation is accurate away from its edges; within a decade of the
+    edges the phase error stays large whatever the order, because the phase at one frequency
+    depends on the slope of the magnitude over the whole axis (BENCHMARKS.md, "Measurements
+    behind design choices").
 
     Parameters
     ----------
@@ -399,18 +397,15 @@ def rational_approximation(numerator, denominator, omega_low, omega_high, order=
 # --------------------------------------------------------------------------------------------
 # simulation
 # --------------------------------------------------------------------------------------------
-# Default band relative to what the time grid resolves, [2 pi / duration, pi / dt]. Measured on
-# unit step responses of 1/(1 + s**q) (q = 0.2, 0.5, 0.8), a three-term fractional model and a
-# mixed integer/fractional one, each against a numerical Laplace inversion, for grids
-# (duration, dt) = (1 s, 1e-4 s), (10 s, 1e-2 s), (100 s, 0.1 s): the error grows linearly with
-# omega_low (a margin of 1e4 below 2 pi / duration gives up to 9e-5, 1e5 gives up to 2.5e-5) and
-# stops improving once omega_high is 1e3 above pi / dt. A step has the most low-frequency
-# content of the usual validation inputs, so these margins are conservative for sine or chirp
-# records.
+# Default band relative to what the time grid resolves, [2 pi / duration, pi / dt]: the error
+# of a step response grows linearly with omega_low and stops improving once omega_high is far
+# enough above pi / dt (BENCHMARKS.md, "Measurements behind design choices"). A step has the
+# most low-frequency content of the usual validation inputs, so these margins are conservative
+# for sine or chirp records.
 _LOW_MARGIN = 1e5
 _HIGH_MARGIN = 1e3
-# Two zero/pole pairs per decade: a third pair per decade changed the errors above by 1e-5 or
-# less.
+# Two zero/pole pairs per decade: a third pair per decade hardly changed the errors above
+# (BENCHMARKS.md, "Measurements behind design choices").
 _PAIRS_PER_DECADE = 2.0
 _MIN_ORDER = 5
 
@@ -459,10 +454,9 @@ def _realisation(scaled: _Scaled) -> tuple[np.ndarray, np.ndarray, np.ndarray, f
 
     The companion matrix of a wide-band Oustaloup approximation has entries spanning dozens of
     orders of magnitude; diagonal balancing (LAPACK gebal, an exact similarity by powers of two)
-    brings them together. Measured on a three-term fractional model with a 16-decade band (degree
-    100): the unbalanced form overflows inside lsim, the balanced one stays within 2e-5 of a
-    numerical Laplace inversion. Building a cascade from polynomial roots instead was worse
-    (roots of such polynomials are inaccurate).
+    brings them together: on a wide band the unbalanced form overflows inside lsim, the balanced
+    one stays accurate (BENCHMARKS.md, "Measurements behind design choices"). Building a cascade
+    from polynomial roots instead was worse (roots of such polynomials are inaccurate).
     """
     den = scaled.den[::-1] / scaled.den[-1]
     num = np.zeros(den.size)
@@ -514,8 +508,8 @@ def simulate(numerator, denominator, t, u, *, omega_low=None, omega_high=None, o
 
     With the defaults (:func:`default_band`, ``order`` chosen for two zero/pole pairs per
     decade) the unit step responses of ``1/(1 + s**q)`` for ``q`` in 0.2..0.8 and of a
-    three-term fractional model are reproduced to within 2.5e-5 (measured against a numerical
-    Laplace inversion on three grids from 1e4 to 1e3 samples).
+    three-term fractional model agree closely with a numerical Laplace inversion (BENCHMARKS.md,
+    "Measurements behind design choices").
 
     Parameters
     ----------

@@ -1,4 +1,12 @@
-"""Worker processes for the structures of a comparison and the data sets of a batch.
+"""The one executor layer: the processes (or this process) that run the structures of a
+comparison and the data sets of a batch.
+
+:func:`executor` gives a job its executor from the number of processes asked for: this process
+(:class:`InlineExecutor`), a pool of worker processes (:func:`process_pool`), or the automatic
+choice (:class:`LazyPool`, whose processes start only when a task needs them, so that a job of
+quick tasks pays no start-up); every one has ``submit``, and the schedule that drives them is the
+same. :func:`figure_processes` says from the CPU time left idle whether figures can be drawn
+in a second process.
 
 Workers are spawned, or forked where that is safe (a comparison's pools, see :func:`new_pool`
 and :func:`fork_safe`), run one BLAS thread each,
@@ -14,6 +22,7 @@ import os
 import signal
 import sys
 import warnings
+from concurrent.futures import Executor, Future
 from contextlib import contextmanager
 
 from .errors import InputError
@@ -275,3 +284,103 @@ def lazy_process_pool(workers: int = 0):
             raise
         if lazy.started:
             lazy._pool.shutdown(wait=True)
+
+
+class InlineExecutor(Executor):
+    """An executor that runs each task in this process as it is submitted (the serial path of
+    :func:`executor`): the schedule that drives worker processes drives it the same way, so a
+    comparison has one code path whatever the number of processes."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except BaseException as exc:  # handed to whoever reads the future, as a pool does
+            if not isinstance(exc, Exception):
+                raise
+            future.set_exception(exc)
+        return future
+
+
+def runs_here(pool) -> bool:
+    """Whether the tasks of ``pool`` (or some of them) compute in this process: an
+    :class:`InlineExecutor`, or a :class:`LazyPool`, whose schedule keeps the quick steps
+    here. This process then limits its BLAS to one thread (:func:`single_blas_thread`)."""
+    return isinstance(pool, (InlineExecutor, LazyPool))
+
+
+@contextmanager
+def executor(workers: int, n_tasks: int | None = None):
+    """The executor of a job that asks for ``workers`` processes: 0, the automatic choice (a
+    :class:`LazyPool` of one process per CPU, started only when a task needs it); 1 (or a job of
+    one task), this process (:class:`InlineExecutor`); more, a :func:`process_pool` of that many
+    processes, at most one per task.
+
+    Yields
+    ------
+    concurrent.futures.Executor or LazyPool
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    n = min(workers or available_cpus(), n_tasks or available_cpus())
+    if workers == 0:
+        with lazy_process_pool(n) as pool:
+            yield pool
+    elif n <= 1:
+        yield InlineExecutor()
+    else:
+        with process_pool(n) as pool:
+            yield pool
+
+
+def cpu_times() -> tuple[float, float, int] | None:
+    """(idle, total, CPUs) time so far, in clock ticks (``/proc/stat``), of the CPUs this
+    process may run on (its affinity set: under taskset, a cpuset or a batch scheduler, idle
+    CPUs outside it are no use); ``None`` where the system does not tell."""
+    try:
+        allowed = os.sched_getaffinity(0)
+    except (AttributeError, OSError):
+        allowed = None
+    idle = total = 0.0
+    count = 0
+    try:
+        with open("/proc/stat") as f:
+            for line in f:
+                name, _, rest = line.partition(" ")
+                if not name.startswith("cpu") or name == "cpu":
+                    continue
+                if allowed is not None and int(name[3:]) not in allowed:
+                    continue
+                fields = [float(x) for x in rest.split()]
+                if len(fields) < 4:
+                    return None
+                idle += fields[3] + (fields[4] if len(fields) > 4 else 0.0)  # idle + iowait
+                total += sum(fields[:8])
+                count += 1
+    except (OSError, ValueError):
+        return None
+    return (idle, total, count) if count else None
+
+
+def idle_cpus(since) -> float | None:
+    """CPUs of this process's set left idle on average since ``since`` (from
+    :func:`cpu_times`)."""
+    now = cpu_times()
+    if since is None or now is None or now[2] != since[2] or now[1] <= since[1]:
+        return None
+    return now[2] * (now[0] - since[0]) / (now[1] - since[1])
+
+
+#: Idle CPUs during a job from which its figures are drawn in two processes.
+SPARE_CPU_FOR_FIGURES = 0.5
+
+
+def figure_processes(since) -> int:
+    """2 when a second process can draw figures beside this one: two CPUs or more, and at
+    least :data:`SPARE_CPU_FOR_FIGURES` of them idle since ``since`` (:func:`cpu_times`). On a
+    busy machine the two processes would share one core and take longer than one
+    (BENCHMARKS.md, "Measurements behind design choices")."""
+    if available_cpus() < 2:
+        return 1
+    idle = idle_cpus(since)
+    return 2 if idle is not None and idle >= SPARE_CPU_FOR_FIGURES else 1

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import os
 import sys
 from pathlib import Path
 
@@ -43,90 +42,28 @@ def add_parser(subparsers):
     return p
 
 
-def _cpu_times() -> tuple[float, float, int] | None:
-    """(idle, total, CPUs) time so far, in clock ticks (``/proc/stat``), of the CPUs this
-    process may run on (its affinity set: under taskset, a cpuset or a batch scheduler, idle
-    CPUs outside it are no use); ``None`` where the system does not tell."""
-    try:
-        allowed = os.sched_getaffinity(0)
-    except (AttributeError, OSError):
-        allowed = None
-    idle = total = 0.0
-    count = 0
-    try:
-        with open("/proc/stat") as f:
-            for line in f:
-                name, _, rest = line.partition(" ")
-                if not name.startswith("cpu") or name == "cpu":
-                    continue
-                if allowed is not None and int(name[3:]) not in allowed:
-                    continue
-                fields = [float(x) for x in rest.split()]
-                if len(fields) < 4:
-                    return None
-                idle += fields[3] + (fields[4] if len(fields) > 4 else 0.0)  # idle + iowait
-                total += sum(fields[:8])
-                count += 1
-    except (OSError, ValueError):
-        return None
-    return (idle, total, count) if count else None
-
-
-def _idle_cpus(since) -> float | None:
-    """CPUs of this process's set left idle on average since ``since`` (from
-    :func:`_cpu_times`)."""
-    now = _cpu_times()
-    if since is None or now is None or now[2] != since[2] or now[1] <= since[1]:
-        return None
-    return now[2] * (now[0] - since[0]) / (now[1] - since[1])
-
-
-#: Idle CPUs during the comparison from which the figures are drawn in two processes.
-SPARE_CPU_FOR_FIGURES = 0.5
-
-
-def _figure_processes(since) -> int:
-    """2 when a second process can draw figures beside this one: two CPUs or more, and at
-    least :data:`SPARE_CPU_FOR_FIGURES` of them idle during the comparison (measured, two
-    cores: with one core idle, 9 figures in PNG and PDF 5.5 → 3.1 s; with another job keeping
-    one core busy, the two processes shared the other and the command took 0.1-1.5 s longer
-    than in one process)."""
-    from ..parallel import available_cpus
-
-    if available_cpus() < 2:
-        return 1
-    idle = _idle_cpus(since)
-    return 2 if idle is not None and idle >= SPARE_CPU_FOR_FIGURES else 1
-
-
-def _compare(data, structures, out, n_proc, workers, formats, no_figures, options):
-    """The comparison and its outputs, in the processes that ``workers`` asks for."""
+def _compare(data, structures, out, workers, formats, no_figures, options):
+    """The comparison and its outputs, in the processes that ``workers`` asks for
+    (:func:`bayesfo.parallel.executor`). With worker processes, the same pool draws the
+    figures: its processes have the libraries loaded by then (with the automatic choice, only
+    if some structure started them). In this process alone, the figures are drawn here, and in
+    a process forked from this one where the machine had a CPU to spare during the comparison
+    (:func:`bayesfo.parallel.figure_processes`)."""
     from ..comparison import compare
     from ..output import write_outputs
-    from ..parallel import lazy_process_pool, process_pool
+    from ..parallel import InlineExecutor, cpu_times, executor, figure_processes
 
     figures = {} if formats is None else {"formats": formats,
                                           "structure_figures": options.pop("structure_figures")}
     options.pop("structure_figures", None)
-    if workers == 0:
-        # The quick steps here, the long ones in worker processes started only if some
-        # structure needs them; those then draw the figures too. Otherwise the figures are
-        # drawn here, and in a process forked from this one if the machine has a spare CPU.
-        start = _cpu_times()
-        with lazy_process_pool(n_proc) as pool:
-            result = compare(data, structures, pool=pool, **options)
-            write_outputs(result, out, figures=not no_figures, pool=pool,
-                          figure_processes=1 if no_figures else _figure_processes(start),
-                          **figures)
-    elif n_proc > 1:
-        # One pool for the structures and then the figures: its processes have the libraries
-        # loaded by the time they draw.
-        with process_pool(n_proc) as pool:
-            result = compare(data, structures, pool=pool, **options)
-            write_outputs(result, out, figures=not no_figures, pool=pool, **figures)
-    else:
-        result = compare(data, structures, workers=1, **options)
-        write_outputs(result, out, figures=not no_figures, **figures)
+    start = cpu_times()
+    with executor(workers, len(structures)) as pool:
+        result = compare(data, structures, pool=pool, **options)
+        inline = isinstance(pool, InlineExecutor)
+        extra = {} if workers != 0 or no_figures else {"figure_processes":
+                                                        figure_processes(start)}
+        write_outputs(result, out, figures=not no_figures, pool=None if inline else pool,
+                      **extra, **figures)
     return result
 
 
@@ -173,7 +110,6 @@ def _print_undetermined(result) -> None:
 def run(args) -> int:
     from ..comparison.table import ranking_lines
     from ..outdir import check_output_directory
-    from ..parallel import available_cpus
     from ..structures import resolve_structures
     from ._libraries import load_libraries
 
@@ -205,13 +141,12 @@ def run(args) -> int:
                    sampler=args.sampler)
     options.update(sampler_options(settings))
     options["structure_figures"] = None if detail == "all" else int(detail)
-    n_proc = min(args.workers or available_cpus(), len(structures))
     target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
     created = not target.exists()
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(formats or ())
     try:
-        result = _compare(data, structures, out, n_proc, args.workers, formats, args.no_figures,
+        result = _compare(data, structures, out, args.workers, formats, args.no_figures,
                           options)
     except BaseException:
         if created:  # a run that wrote nothing leaves no directory behind

@@ -384,11 +384,12 @@ class Comparison:
                 + (f"; {failed} failed" if failed else "") + ">")
 
     def summary(self) -> str:
-        """The ranking as ``bayesfo compare`` prints it (:func:`~bayesfo.comparison.table.
-        ranking_lines`): per structure ln Z ± error (L: from a tempered ladder), Δln Z, the
-        posterior probability P, elpd by PSIS-LOO, BIC, the fractional orders' means, R-hat,
-        whether the posterior is certified (ok) and whether the structure fits the data
-        (posterior predictive checks); the structures that failed with their reason.
+        """The ranking as ``bayesfo compare`` prints it
+        (:func:`~bayesfo.comparison.table.ranking_lines`): per structure ln Z ± error (L: from
+        a tempered ladder), Δln Z, the posterior probability P, elpd by PSIS-LOO, BIC, the
+        fractional orders' means, R-hat, whether the posterior is certified (ok) and whether
+        the structure fits the data (posterior predictive checks); the structures that failed
+        with their reason.
         ``print(result.summary())``; per structure, :meth:`StructureResult.summary`."""
         d = self.data
         held = "" if self.holdout is None else f", {self.holdout.n_frequencies} held out"

@@ -10,6 +10,7 @@ unless given. The output directory is written by :func:`bayesfo.output.write_out
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import warnings
 
@@ -18,18 +19,12 @@ import numpy as np
 from ..data import MAX_FREQUENCIES, FrequencyResponse
 from ..errors import DataWarning, InputError
 from ..options import EVIDENCE_ROUTES, SAMPLERS, check_sampler_settings
-from ..parallel import (
-    LazyPool,
-    available_cpus,
-    lazy_process_pool,
-    process_pool,
-    single_blas_thread,
-)
+from ..parallel import LazyPool, executor, runs_here, single_blas_thread
 from ..structures import resolve_structures
 from .criteria import _model_probabilities
 from .results import Comparison, data_problems
 from .schedule import run_in_pool
-from .steps import RunOptions, run_structure
+from .steps import RunOptions
 
 
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
@@ -132,30 +127,19 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         warnings.warn(problem, DataWarning, stacklevel=2)
     if progress is None:
         progress = sys.stderr.isatty()
-    n_proc = min(workers or available_cpus(), len(structures))
     options = RunOptions(noise=noise, priors=priors, seed=seed, evidence=evidence,
                          evidence_check=evidence_check, sampler=sampler,
                          sampler_kwargs=sampler_kwargs, holdout=held_out)
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
-    # Each step gets the same seed whatever the worker count or the process that runs it, so
-    # the numbers do not depend on them.
-    if isinstance(pool, LazyPool):
-        with single_blas_thread():
-            outcomes = run_in_pool(pool, structures, data, options, bar, here=True)
-    elif pool is not None:
-        outcomes = run_in_pool(pool, structures, data, options, bar)
-    elif workers == 0:
-        with lazy_process_pool(n_proc) as own, single_blas_thread():
-            outcomes = run_in_pool(own, structures, data, options, bar, here=True)
-    elif n_proc <= 1:
-        outcomes = []
-        with single_blas_thread():
-            for s in structures:
-                outcomes.append(run_structure(s, data, options))
-                bar.update()
-    else:
-        with process_pool(n_proc) as own:
-            outcomes = run_in_pool(own, structures, data, options, bar)
+    # One path whatever the processes (parallel.executor): the steps of every structure as
+    # tasks, each with the same seed wherever it runs, so the numbers do not depend on them.
+    with contextlib.ExitStack() as stack:
+        if pool is None:
+            pool = stack.enter_context(executor(workers, len(structures)))
+        if runs_here(pool):
+            stack.enter_context(single_blas_thread())
+        outcomes = run_in_pool(pool, structures, data, options, bar,
+                               here=isinstance(pool, LazyPool))
     bar.close()
     results = []
     for result, caught in outcomes:

@@ -1,11 +1,13 @@
-"""The steps of a comparison's structures as tasks of a pool of worker processes.
+"""The steps of a comparison's structures as tasks of an executor
+(:func:`bayesfo.parallel.executor`: this process, worker processes, or both).
 
 A structure is run in three steps (:mod:`bayesfo.comparison.steps`): (1) the optimisation and
 the noise screen, :func:`~bayesfo.comparison.steps.fit_and_screen`; (2) one posterior per noise
 model still in the running, :func:`~bayesfo.comparison.steps.sample_held`; (3) the noise model
 chosen by evidence, the evidence and adequacy checks and the result,
-:func:`~bayesfo.comparison.steps.conclude`. The serial path runs them one after the other
-(:func:`~bayesfo.comparison.steps.run_structure`); here the parent submits (1) for every
+:func:`~bayesfo.comparison.steps.conclude`. In one process
+(:class:`~bayesfo.parallel.InlineExecutor`) each task runs as it is submitted, so they run one
+after the other; with worker processes the parent submits (1) for every
 structure, largest first, and as each comes back either has the result (a structure with one
 noise model to sample runs (2) and (3) in the task of (1): nothing to ship) or submits (2) for
 each noise model at once, and (3) when their posteriors are back. A structure whose screen
@@ -28,7 +30,7 @@ sampling will certify the posterior, it runs (2) and (3) as well, and only the o
 structures' (2) and (3) go to the pool, whose processes start with the first of them. A wrong
 promise costs time, never a different number.
 
-Every step uses the seed it uses in the serial path, so the numbers do not depend on the pool
+Every step uses the comparison's seed wherever it runs, so the numbers do not depend on the pool
 or the worker count. A worker process that dies (killed, out of memory) breaks the pool: its
 tasks and every one still waiting are then run in this process, with a warning, so that no
 finished structure is lost and the numbers are those of the serial path. Warnings are recorded in the task that raises them and returned with its
@@ -75,7 +77,7 @@ def _first(s, data, options):
 
 def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> list:
     """Run the structures' steps as tasks of ``pool``; returns (result, warnings) per structure
-    in the order given, as :func:`~bayesfo.comparison.steps.run_structure` does.
+    in the order given.
 
     With ``here``, this process runs every structure's step (1) itself
     (:func:`~bayesfo.comparison.steps.fit_and_probe`) and then steps (2) and (3) of the

@@ -1,4 +1,4 @@
-"""The steps of one structure's run on one data set, shared by the serial path and the pool.
+"""The steps of one structure's run on one data set, run as tasks by :mod:`.schedule`.
 
 (1) :func:`fit_and_screen`: the global optimisation (the modes) and, without σ in the data,
 the quick noise screen (:func:`screen`), which may set aside a noise model that trails far
@@ -7,7 +7,7 @@ behind; :func:`fit_and_probe` does the same and says whether the rest promises t
 (:func:`~bayesfo.inference.certified.certified_posterior`), its warnings held back.
 (3) :func:`conclude`: the noise model chosen by evidence (:func:`choose_noise`), the evidence
 check, the adequacy checks, the held-out points, and the :class:`StructureResult`.
-:func:`run_structure` runs the three in turn; :mod:`.schedule` runs them as tasks of a pool.
+:mod:`.schedule` runs them as tasks of an executor (this process or worker processes).
 Every step takes the comparison's :class:`RunOptions` and uses its seed, so the numbers do not
 depend on where a step runs.
 """
@@ -274,22 +274,6 @@ def choose_noise(name: str, runs: list[NoiseRun],
 #: below, non-overlapping exponent intervals raise a NoiseWarning (the conclusion then hangs on
 #: a choice the data do not make).
 NOISE_DECISIVE = 0.99
-
-
-def run_structure(s: Structure, data: FrequencyResponse, options: RunOptions):
-    """Optimisation, posterior, criteria and evidence of one structure, in three steps:
-    :func:`fit_and_screen`, :func:`sample_held` per noise model still in the running, and
-    :func:`conclude` (a pool runs the steps as separate tasks, :mod:`.schedule`). Returns the
-    result and the warnings raised on the way."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            fit, screened, noises = fit_and_screen(s, data, options)
-            runs = [sample_held(s, data, noise, fit, options) for noise in noises]
-            result = conclude(s, data, fit, screened, runs, options)
-        except InputError as exc:
-            result = StructureResult(s, error=str(exc))
-    return result, kept(s.name, [(w.category, str(w.message)) for w in caught])
 
 
 def fit_and_screen(s: Structure, data: FrequencyResponse, options: RunOptions):

@@ -373,7 +373,7 @@ def draw_forked(comparison, out_dir, formats=("png",), *, seed: int = 0,
 
     Two processes make the command faster on a machine with an idle core, and slower when
     another job keeps a core busy (BENCHMARKS.md, "Measurements behind design choices"), so
-    the command forks only when a CPU is idle (:func:`bayesfo.cli.compare._figure_processes`).
+    the command forks only when a CPU is idle (:func:`bayesfo.parallel.figure_processes`).
     """
     import multiprocessing
 

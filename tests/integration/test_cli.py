@@ -185,12 +185,12 @@ def test_a_compare_that_fails_leaves_no_output_directory(run_cli, tmp_path, monk
 _TWO_PROCESS_CLI = """
 import sys
 from pathlib import Path
-import bayesfo.cli.compare as cli_compare
+import bayesfo.parallel as parallel
 import bayesfo.plotting.output as output
 from bayesfo.cli import main
 
 marker = Path(sys.argv[1])
-cli_compare._figure_processes = lambda since: 2  # as if a CPU were idle
+parallel.figure_processes = lambda since: 2  # as if a CPU were idle
 draw_in_child = output._draw_in_child
 
 def child(*args):
@@ -232,28 +232,27 @@ def test_compare_draws_in_two_processes_the_files_of_one(run_cli, tmp_path):
 def test_figures_in_two_processes_only_with_a_spare_cpu(monkeypatch):
     import time
 
-    import bayesfo.cli.compare as cli_compare
-    import bayesfo.parallel
+    import bayesfo.parallel as parallel
 
-    since = cli_compare._cpu_times()
+    since = parallel.cpu_times()
     assert since is not None and 0 < since[0] <= since[1]  # Linux: /proc/stat
     assert since[2] == len(os.sched_getaffinity(0))  # the CPUs this process may use
     time.sleep(0.2)
-    idle = cli_compare._idle_cpus(since)
+    idle = parallel.idle_cpus(since)
     assert idle is not None and 0.0 <= idle <= since[2]
-    assert cli_compare._idle_cpus(None) is None
+    assert parallel.idle_cpus(None) is None
     # Restricted to one CPU (taskset, a cpuset): only that CPU's idle time counts.
     with monkeypatch.context() as m:
         m.setattr(os, "sched_getaffinity", lambda pid: {0})
-        one = cli_compare._cpu_times()
+        one = parallel.cpu_times()
         assert one[2] == 1 and one[1] <= since[1]
-        assert cli_compare._idle_cpus(since) is None  # another CPU set: no comparison
-    monkeypatch.setattr(bayesfo.parallel, "available_cpus", lambda: 2)
+        assert parallel.idle_cpus(since) is None  # another CPU set: no comparison
+    monkeypatch.setattr(parallel, "available_cpus", lambda: 2)
     for idle, expected in [(0.2, 1), (0.49, 1), (0.5, 2), (1.6, 2), (None, 1)]:
-        monkeypatch.setattr(cli_compare, "_idle_cpus", lambda since, idle=idle: idle)
-        assert cli_compare._figure_processes(since) == expected, idle
-    monkeypatch.setattr(bayesfo.parallel, "available_cpus", lambda: 1)
-    assert cli_compare._figure_processes(since) == 1
+        monkeypatch.setattr(parallel, "idle_cpus", lambda since, idle=idle: idle)
+        assert parallel.figure_processes(since) == expected, idle
+    monkeypatch.setattr(parallel, "available_cpus", lambda: 1)
+    assert parallel.figure_processes(since) == 1
 
 
 def test_writing_the_netcdf_files_does_not_import_dask_distributed(tmp_path):

@@ -318,19 +318,94 @@ def _realign(line: Line, delimiter: str, n: int) -> list[str]:
     return wide if len(wide) == n and len(line.cells) != n else line.cells
 
 
+#: Lines of a sheet read at most: the rows a data set may have (:data:`MAX_ROWS` of the CSV
+#: reader) and room for headers, comments and a few tables beside them.
+EXCEL_MAX_LINES = 110_000
+#: Cells a sheet may span (rows × columns of its declared extent): a workbook with a stray cell
+#: far out (``XFD200000``) is refused before any row is read, instead of being padded to
+#: billions of empty cells.
+EXCEL_MAX_CELLS = 5_000_000
+
+
+def _cell_text(v) -> str:
+    """The text of one cell value (numbers written exactly)."""
+    import math
+
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return ""
+    if isinstance(v, bool):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)
+    return str(v).strip()
+
+
+def _too_large(path: Path, sheet: str, rows: int, cols: int) -> InputError:
+    from openpyxl.utils import get_column_letter
+
+    return InputError(
+        f"file '{path}', sheet '{sheet}': the sheet spans {rows} rows × {cols} columns (to cell "
+        f"{get_column_letter(cols)}{rows}), more than a data set needs (at most "
+        f"{EXCEL_MAX_LINES} rows and {EXCEL_MAX_CELLS} cells); delete the cells beyond the "
+        "data (Ctrl+End shows the last one) or save the table as CSV")
+
+
+def _openpyxl_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
+    """The sheets of an ``.xlsx`` workbook, streamed row by row (openpyxl's read-only mode)
+    within :data:`EXCEL_MAX_LINES` and :data:`EXCEL_MAX_CELLS`."""
+    import openpyxl
+
+    try:
+        book = openpyxl.load_workbook(path, read_only=True, data_only=True)
+    except Exception as exc:  # noqa: BLE001 - any failure of the workbook library is bad input
+        raise InputError(f"file '{path}' cannot be read as an Excel workbook: {exc}") from None
+    try:
+        out = []
+        for ws in book.worksheets:
+            declared = (ws.max_row or 0, ws.max_column or 0)  # the sheet's dimension, if given
+            if declared[0] > EXCEL_MAX_LINES or declared[0] * declared[1] > EXCEL_MAX_CELLS:
+                raise _too_large(path, ws.title, *declared)
+            rows, cells_read = [], 0
+            try:
+                for values in ws.iter_rows(values_only=True):
+                    cells = [_cell_text(v) for v in values]
+                    while cells and not cells[-1]:
+                        cells.pop()
+                    rows.append(cells)
+                    cells_read += len(values)
+                    if len(rows) > EXCEL_MAX_LINES or cells_read > EXCEL_MAX_CELLS:
+                        raise InputError(
+                            f"file '{path}', sheet '{ws.title}': more than "
+                            + (f"{EXCEL_MAX_LINES} rows" if len(rows) > EXCEL_MAX_LINES
+                               else f"{EXCEL_MAX_CELLS} cells")
+                            + f" (row {len(rows)} read), more than a data set needs; delete "
+                            "the rows beyond the data or save the table as CSV")
+            except InputError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a damaged sheet is bad input
+                raise InputError(f"file '{path}', sheet '{ws.title}' cannot be read: "
+                                 f"{exc}") from None
+            while rows and not rows[-1]:
+                rows.pop()
+            out.append((str(ws.title), rows))
+        return out
+    finally:
+        book.close()
+
+
 def excel_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
     """The sheets of an Excel workbook as rows of cell texts (numbers written exactly).
+
+    ``.xlsx`` workbooks are streamed (at most :data:`EXCEL_MAX_LINES` rows and
+    :data:`EXCEL_MAX_CELLS` cells per sheet); ``.xls`` workbooks (at most 65 536 × 256 cells
+    by their format) are read through pandas and xlrd.
 
     Raises
     ------
     InputError
-        If openpyxl (``.xlsx``) or xlrd (``.xls``) is not installed, or the workbook cannot be
-        read.
+        If openpyxl (``.xlsx``) or xlrd (``.xls``) is not installed, the workbook cannot be
+        read, or a sheet spans more cells than a data set needs.
     """
-    import math
-
-    import pandas as pd
-
     engine = "xlrd" if path.suffix.lower() == ".xls" else "openpyxl"
     try:
         __import__(engine)
@@ -339,27 +414,17 @@ def excel_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
                          f"(pip install {engine}"
                          + ("" if engine == "xlrd" else ", or pip install 'bayesfo[excel]'")
                          + "); or save the sheet as CSV or text") from None
+    if engine == "openpyxl":
+        return _openpyxl_sheets(path)
+    import pandas as pd
+
     try:
         book = pd.read_excel(path, sheet_name=None, header=None, dtype=object, engine=engine)
     except Exception as exc:  # noqa: BLE001 - any failure of the workbook library is bad input
         raise InputError(f"file '{path}' cannot be read as an Excel workbook: {exc}") from None
-    out = []
-    for name, frame in book.items():
-        rows = []
-        for values in frame.itertuples(index=False):
-            cells = []
-            for v in values:
-                if v is None or (isinstance(v, float) and math.isnan(v)):
-                    cells.append("")
-                elif isinstance(v, bool):
-                    cells.append(str(v))
-                elif isinstance(v, float):
-                    cells.append(repr(v))
-                else:
-                    cells.append(str(v).strip())
-            rows.append(cells)
-        out.append((str(name), rows))
-    return out
+    return [(str(name), [[_cell_text(v) for v in values]
+                         for values in frame.itertuples(index=False)])
+            for name, frame in book.items()]
 
 
 def classify_rows(rows: list[list[str]]) -> list[Line]:

@@ -661,3 +661,41 @@ def test_batch_expands_a_lab_file_into_isotherms(tmp_path):
     bad.write_text("Time,Torque\n1,2\n2,3\n", encoding="utf-8")
     (only,) = expand_inputs([bad], options={"structures": "voigt"})
     assert only.error.startswith(f"file '{bad}', line 1: no frequency column")
+
+
+def test_an_excel_sheet_with_a_stray_cell_far_out_is_refused_before_it_is_read(tmp_path):
+    """A stray cell at XFD200000 declares 3.3e9 cells: refused from the sheet's dimension,
+    naming the cell, instead of being padded row by row."""
+    openpyxl = pytest.importorskip("openpyxl")
+    path = tmp_path / "far.xlsx"
+    book = openpyxl.Workbook()
+    sheet = book.active
+    sheet.append(["Angular Frequency [rad/s]", "Storage Modulus [Pa]", "Loss Modulus [Pa]"])
+    for w, g in zip(W, G, strict=True):
+        sheet.append([float(w), float(g.real), float(g.imag)])
+    sheet["XFD200000"] = 1.0
+    book.save(path)
+    with pytest.raises(InputError, match=r"spans 200000 rows × 16384 columns \(to cell "
+                                         r"XFD200000\).*delete the cells beyond the data"):
+        read_isotherms(path)
+    del sheet["XFD200000"]  # openpyxl keeps the dimension of the cells left
+    book.save(path)
+    np.testing.assert_allclose(read_isotherms(path)[0].data.response, G, rtol=1e-12)
+
+
+def test_an_excel_sheet_of_too_many_rows_stops_at_the_cap(tmp_path, monkeypatch):
+    """Without a declared dimension (a write-only workbook), the rows are counted as they are
+    read and reading stops at the cap."""
+    openpyxl = pytest.importorskip("openpyxl")
+    from bayesfo.data import tables
+
+    path = tmp_path / "long.xlsx"
+    book = openpyxl.Workbook(write_only=True)
+    sheet = book.create_sheet("sweep")
+    sheet.append(["omega", "G'", "G''"])
+    for i in range(1, 301):
+        sheet.append([float(i), 1.0, 2.0])
+    book.save(path)
+    monkeypatch.setattr(tables, "EXCEL_MAX_LINES", 100)
+    with pytest.raises(InputError, match=r"sheet 'sweep': more than 100 rows \(row 101 read\)"):
+        read_isotherms(path)

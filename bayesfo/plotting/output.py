@@ -31,6 +31,7 @@ def save_figure(fig, path, *, close: bool = False) -> None:
         finally:
             plt.close(fig)
     from .._io import publish
+    from .._signals import cause
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -39,9 +40,14 @@ def save_figure(fig, path, *, close: bool = False) -> None:
     try:
         fig.savefig(tmp, dpi=200)
         publish(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        written = cause(exc, (OSError,)) if not isinstance(exc, OSError) else None
+        if isinstance(exc, Exception) and written is not None:
+            # The file could not be written (no space left, ...): matplotlib's writer fails
+            # again while ending the file (a zlib or attribute error), which hides the cause.
+            raise written from None
         raise
 
 

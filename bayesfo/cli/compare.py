@@ -144,6 +144,11 @@ def run(args) -> int:
     target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
     created = not target.exists()
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
+    # A data set of a batch (its record batch.json, the batch's summary beside it): this run
+    # replaces the record, so the batch redoes the data set when run again; until then the
+    # batch's summary shows its own result. Nothing outside --out is touched.
+    batch_of = (out.parent if (out / "batch.json").is_file()
+                and (out.parent / "batch_summary.csv").is_file() else None)
     load_libraries(formats or ())
     try:
         result = _compare(data, structures, out, args.workers, formats, args.no_figures,
@@ -153,6 +158,11 @@ def run(args) -> int:
             with contextlib.suppress(OSError):
                 out.rmdir()
         raise
+    if batch_of is not None:
+        print(f"bayesfo: warning: '{out}' is a data set of the batch in '{batch_of}': its "
+              f"batch_summary.csv still shows the batch's result for it; run the batch again "
+              f"into '{batch_of}' to redo this data set with the batch's options and update "
+              "the summary", file=sys.stderr)
     if not args.quiet:
         if not data.units:
             print(_units_note(args.data, data.kind), file=sys.stderr)

@@ -519,3 +519,25 @@ def test_batch_table_points_to_the_report_when_the_best_is_not_certified(capsys,
     _print_table(SimpleNamespace(outcomes=[outcome], out_dir=tmp_path))
     line = capsys.readouterr().out.splitlines()[1]
     assert line.endswith("ok, not converged (best certified: voigt); see Tp017p85C/report.html")
+
+
+def test_compare_into_a_data_set_of_a_batch_says_the_batch_summary_is_stale(tmp_path, run_cli):
+    """compare --out BATCH/ID replaces that data set's run and its batch record (so the batch
+    redoes it when run again) and says that BATCH/batch_summary.csv, which it does not touch,
+    still shows the batch's result."""
+    batch = tmp_path / "batch"
+    sub = batch / "Tp150C"
+    sub.mkdir(parents=True)
+    (sub / "batch.json").write_text(json.dumps({"format": 1, "status": "ok"}))
+    (batch / "batch_summary.csv").write_text("data_set,structure\nTp150C,voigt\n")
+    status, _, err = run_cli("compare", ADHESIVE / "Tp150C.csv", "--structures", "voigt",
+                             "--noise", "proportional", "--no-figures", "--quiet", "--out", sub)
+    assert status == 0, err
+    assert (f"bayesfo: warning: '{sub}' is a data set of the batch in '{batch}': its "
+            "batch_summary.csv still shows the batch's result for it") in err
+    assert (batch / "batch_summary.csv").read_text() == "data_set,structure\nTp150C,voigt\n"
+    # Elsewhere (no batch beside it) nothing is said.
+    status, _, err = run_cli("compare", ADHESIVE / "Tp150C.csv", "--structures", "voigt",
+                             "--noise", "proportional", "--no-figures", "--quiet",
+                             "--out", tmp_path / "alone")
+    assert status == 0 and "batch" not in err

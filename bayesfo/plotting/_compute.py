@@ -210,6 +210,78 @@ def sampling_coordinates(result):
     return values, labels, is_log
 
 
+class Coordinates:
+    """The parameters that the figures of one structure draw, and how to get them from the
+    sampled parameters (:func:`natural_coordinates`).
+
+    Attributes
+    ----------
+    names : list of str
+        The parameters drawn, in order.
+    labels : list of str
+        Mathtext labels with units (``log$_{10}$`` where the axis is logarithmic).
+    is_log : ndarray of bool
+        Whether each is drawn as log10.
+    physical : bool
+        Whether they are the structure's physical parameters (else the card's, as sampled).
+    """
+
+    def __init__(self, names, labels, is_log, convert, physical: bool):
+        self.names, self.labels, self.is_log = list(names), list(labels), np.asarray(is_log)
+        self._convert, self.physical = convert, physical
+
+    def values(self, theta) -> np.ndarray:
+        """Rows of sampled parameters (``posterior.param_names`` order; physical units) as
+        rows of the drawn parameters, in their units (not yet log10); NaN where a row has
+        none (e.g. the noise of a least-squares fit)."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            return self._convert(theta)
+
+    def coordinates(self, theta) -> np.ndarray:
+        """:meth:`values` in the drawn coordinates (log10 where :attr:`is_log`)."""
+        return to_coordinates(self.values(theta), self.is_log)
+
+
+def natural_coordinates(result) -> Coordinates:
+    """The parameters that a structure's corner and trace figures draw: in the form natural to
+    the data, as the report's tables and the verdict name them. For modulus data and a
+    structure with a physical picture, its physical parameters (moduli, quasi-properties and
+    orders, e.g. G_e, c_q, q of the fractional Voigt; not the derived times), each positive
+    one on a log10 axis; otherwise the card's parameters as sampled
+    (:func:`sampling_coordinates`). The noise parameters follow, as sampled."""
+    post = result.posterior
+    s = result.structure
+    phys = getattr(result, "physical", None)
+    if phys is None or phys.get("natural_form") != "physical":
+        _, labels, is_log = sampling_coordinates(result)
+        return Coordinates(post.param_names, labels, is_log, lambda theta: theta, False)
+    from ..comparison.table import ORDER_SYMBOLS
+    from ..structures.physical import physical_parameters, physical_units
+
+    kind, unit = result.data_kind, result.data_units
+    units = physical_units(s, kind, unit, derived=False)
+    k = s.n_params
+    noise = [n for n in post.param_names if n not in s.param_names]
+    at = [post.param_names.index(n) for n in s.param_names]
+    at_noise = [post.param_names.index(n) for n in noise]
+
+    def convert(theta):
+        vals = physical_parameters(s, theta[:, at], kind, unit, derived=False)
+        return np.column_stack([vals[n][0] for n in units] + [theta[:, i] for i in at_noise])
+
+    draws = convert(np.asarray(post.samples, float)) if k else np.empty((0, 0))
+    priors = result.criteria.priors or {}
+    is_log = [n not in ORDER_SYMBOLS and bool(np.all(draws[:, i] > 0))
+              for i, n in enumerate(units)]
+    is_log += [priors.get(n, {}).get("prior") == "log-uniform" for n in noise]
+    sampled_units = result_units(result)
+    labels = ([_label(n, log, u) for (n, u), log in zip(units.items(), is_log)]
+              + [_label(n, log, sampled_units.get(n, ""))
+                 for n, log in zip(noise, is_log[len(units):])])
+    return Coordinates([*units, *noise], labels, is_log, convert, True)
+
+
 def result_units(result) -> dict[str, str]:
     """``{parameter: unit}`` of a result's sampled parameters, from the kind and unit of the
     data it was run on (:attr:`bayesfo.comparison.StructureResult.units`); empty when the

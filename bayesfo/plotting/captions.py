@@ -70,10 +70,15 @@ def trace_caption(result) -> str:
 
 def corner_caption(result) -> str:
     """Caption of :func:`~bayesfo.plotting.plot_corner` for ``result``."""
+    from ._compute import natural_coordinates
+
     post = result.posterior
+    coords = natural_coordinates(result)
+    form = ("the physical parameters and the noise; log10 of those that are positive"
+            if coords.physical else "log10 of parameters with a log-uniform prior")
     text = (f"Posterior of {result.name}: marginal and pairwise distributions of "
-            f"{len(post.param_names)} parameters (log10 of parameters with a log-uniform prior; "
-            "contours hold 50 % and 90 %), with the posterior mode"
+            f"{len(coords.names)} parameters ({form}; contours hold 50 % and 90 %), with the "
+            "posterior mode"
             + (" and the least-squares optimum" if result.fit is not None
                and getattr(result.fit, "admissible", False) else "") + ".")
     if not post.converged:

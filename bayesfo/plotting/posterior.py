@@ -14,7 +14,7 @@ from ..errors import InputError
 from ._base import Drawn, new_figure
 from ._compute import (
     decade_exponent,
-    sampling_coordinates,
+    natural_coordinates,
     scaled_label,
     to_coordinates,
 )
@@ -39,13 +39,14 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
     """Corner plot (``corner.corner``) of one structure's posterior, with the posterior mode,
     the least-squares optimum and, when given, the linear methods' fits marked.
 
-    Parameters are shown in the coordinates of the summaries' flags: log10 of parameters with
-    a log-uniform prior (axis labels say so), the parameter itself otherwise, divided by a
-    power of ten when its values are very small or large (the label gives the factor); noise
+    The parameters are those the report's tables name: for modulus data the structure's physical parameters (``G_e``,
+    ``c_q``, ``q`` of the fractional Voigt; positive ones on log10 axes), else the card's
+    parameters as sampled (log10 of those with a log-uniform prior), each divided by a power
+    of ten when its values are very small or large (the label gives the factor); noise
     parameters sampled with the structure are included. Each label carries the parameter's
-    unit, derived from the data's units (``log10 b0 [1/Pa]``, ``a1 [s^q]``; orders have none)
-    when the result knows them (:attr:`~bayesfo.comparison.StructureResult.units`). Contours enclose 50 % and 90 % of the
-    draws. However many parameters, the axis labels clear the tick labels and every label stays
+    unit, derived from the data's units (``log10 G_e [Pa]``, ``a1 [s^q]``; orders have none)
+    when the result knows them (:attr:`~bayesfo.comparison.StructureResult.units`). Contours
+    enclose 50 % and 90 % of the draws. However many parameters, the axis labels clear the tick labels and every label stays
     inside the figure: they are placed, and the margins set, from the drawn tick labels.
 
     Parameters
@@ -87,7 +88,8 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
 
     _check_result(result)
     post = result.posterior
-    samples, labels, is_log = sampling_coordinates(result)
+    coords = natural_coordinates(result)
+    samples, labels = coords.coordinates(post.samples), coords.labels
     ndim = samples.shape[1]
     exponents = np.array([decade_exponent(samples[:, i]) for i in range(ndim)])
     factor = 10.0 ** exponents
@@ -95,17 +97,19 @@ def plot_corner(result, fig=None, *, color: str | None = None, bins: int = 30,
     # The factor on a second line: narrow panels of many parameters keep their labels apart.
     labels = [scaled_label(lab, int(e)).replace(" (×", "\n(×")
               for lab, e in zip(labels, exponents)]
-    mode = to_coordinates(post.map_theta, is_log) / factor
+    mode = coords.coordinates(post.map_theta)[0] / factor
+
+    def card_point(theta):  # the card's coefficients of a fit, without noise parameters
+        row = np.full(len(post.param_names), np.nan)
+        row[[post.param_names.index(n) for n in result.structure.param_names]] = theta
+        return coords.coordinates(row)[0] / factor
+
     fit = np.full(ndim, np.nan)
     if result.fit is not None and result.fit.admissible:
-        k = result.structure.n_params
-        fit[:k] = to_coordinates(result.fit.theta, is_log[:k]) / factor[:k]
+        fit = card_point(result.fit.theta)
     lin_labels = list(linear or {})
-    lin = np.full((len(lin_labels), ndim), np.nan)
-    k = result.structure.n_params
-    for row, label in zip(lin, lin_labels):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            row[:k] = to_coordinates(np.asarray(linear[label], float), is_log[:k]) / factor[:k]
+    lin = np.array([card_point(np.asarray(linear[label], float)) for label in lin_labels]
+                   ).reshape(len(lin_labels), ndim)
     ranges = []
     for i in range(ndim):
         lo, hi = np.quantile(samples[:, i], [0.0005, 0.9995])
@@ -283,8 +287,8 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     """Trace of every walker for each parameter (and the log posterior density).
 
     Uses the stored DataTree (``posterior.idata``: chain = walker), i.e. the draws kept
-    after burn-in and thinning. Parameters with a log-uniform prior are drawn as log10, as in
-    :func:`plot_corner`, and labelled with their units as there.
+    after burn-in and thinning, in the parameters, coordinates and labels of
+    :func:`plot_corner`.
 
     Parameters
     ----------
@@ -297,9 +301,9 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     Returns
     -------
     Drawn
-        ``axes``: one per parameter in the order of ``posterior.param_names``, then the log
-        posterior when stored. ``values``: ``"<param>"`` (n_walkers, n_kept) in physical units
-        (the axes show them as labelled: log10 or divided by a power of ten),
+        ``axes``: one per parameter drawn (those of :func:`plot_corner`), then the log
+        posterior when stored. ``values``: ``"<param>"`` (n_walkers, n_kept) in the
+        parameter's units (the axes show them as labelled: log10 or divided by a power of ten),
         ``"lp"`` and ``"draw"`` (the x values), ``"converged"``. ``artists``: ``"<param>"``
         (list of ``Line2D``, one per walker). ``caption``: what the traces show for this
         structure (:func:`~bayesfo.plotting.captions.trace_caption`: they overlap and show no
@@ -315,24 +319,26 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     if post.idata is None or not hasattr(post.idata, "posterior"):
         raise InputError(f"argument 'result': structure '{result.name}' has no posterior draws")
     ds = post.idata.posterior.dataset
-    _, labels, is_log = sampling_coordinates(result)
+    coords = natural_coordinates(result)
+    chains = _drawn_chains(post, ds, coords)
     lp = None
     if hasattr(post.idata, "sample_stats") and "lp" in post.idata.sample_stats:
         lp = np.asarray(post.idata.sample_stats["lp"].values)
     color = color or "#0072B2"
     if getattr(post, "sampler", "emcee") in ("ladder", "importance"):
-        return _plot_particles(result, fig, ds, lp, labels, is_log)
+        return _plot_particles(result, fig, ds, lp, coords, chains)
     values, artists = {}, {}
     with style():
-        n_rows = len(post.param_names) + (lp is not None)
+        n_rows = len(coords.names) + (lp is not None)
         fig = new_figure(fig, (COLUMN_WIDTH, 0.55 + 0.62 * n_rows))
         axes = np.atleast_1d(fig.subplots(n_rows, 1, sharex=True))
         n_kept = ds.sizes["draw"]
         draw = np.arange(n_kept)
         values["draw"] = draw
         alpha = max(0.15, min(0.6, 8.0 / ds.sizes["chain"]))
-        for ax, name, label, log in zip(axes, post.param_names, labels, is_log):
-            y = np.asarray(ds[name].transpose("chain", "draw").values)
+        for i, (ax, name, label, log) in enumerate(zip(axes, coords.names, coords.labels,
+                                                        coords.is_log)):
+            y = chains[..., i]
             values[name] = y
             shown = to_coordinates(y, log)
             e = decade_exponent(shown)
@@ -354,26 +360,33 @@ def plot_trace(result, fig=None, *, color: str | None = None) -> Drawn:
     return Drawn.build(fig, axes, values, artists, trace_caption(result))
 
 
-def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
+def _drawn_chains(post, ds, coords) -> np.ndarray:
+    """The stored draws (chain, draw) as the parameters drawn: shape (chain, draw, ndim)."""
+    theta = np.stack([np.asarray(ds[n].transpose("chain", "draw").values, float)
+                      for n in post.param_names], axis=-1)
+    c, d, p = theta.shape
+    return coords.values(theta.reshape(c * d, p)).reshape(c, d, -1)
+
+
+def _plot_particles(result, fig, ds, lp, coords, chains) -> Drawn:
     """:func:`plot_trace` for a posterior without a chain to trace: tempered-ladder particles
     (one histogram per run: the runs certify the posterior by agreeing) or draws resampled
     from importance weights (one histogram)."""
     post = result.posterior
     ladder = post.sampler == "ladder"
     if not ladder:  # importance sampling: one set of resampled draws, no runs to compare
-        ds = ds.stack(sample=("chain", "draw")).drop_vars(["chain", "draw", "sample"])
-        ds = ds.expand_dims(chain=1).rename({"sample": "draw"})
+        chains = chains.reshape(1, -1, chains.shape[-1])
         lp = None if lp is None else lp.reshape(1, -1)
-    runs = ds.sizes["chain"]
+    runs, n_draws = chains.shape[:2]
     colors = ("#0072B2", "#E69F00", "#009E73", "#CC79A7")
     values, artists = {}, {}
     with style():
-        n_rows = len(post.param_names) + (lp is not None)
+        n_rows = len(coords.names) + (lp is not None)
         fig = new_figure(fig, (COLUMN_WIDTH, 0.55 + 0.62 * n_rows))
         axes = np.atleast_1d(fig.subplots(n_rows, 1))
-        rows = [(name, label, log) for name, label, log in zip(post.param_names, labels, is_log)]
-        for ax, (name, label, log) in zip(axes, rows):
-            y = np.asarray(ds[name].transpose("chain", "draw").values)
+        rows = list(zip(coords.names, coords.labels, coords.is_log))
+        for i, (ax, (name, label, log)) in enumerate(zip(axes, rows)):
+            y = chains[..., i]
             values[name] = y
             shown = to_coordinates(y, log)
             e = decade_exponent(shown)
@@ -390,14 +403,14 @@ def _plot_particles(result, fig, ds, lp, labels, is_log) -> Drawn:
                              for i in range(runs)]
             axes[-1].set_xlabel("log posterior density", labelpad=1)
             axes[-1].set_yticks([])
-        values["draw"] = np.arange(ds.sizes["draw"])
+        values["draw"] = np.arange(n_draws)
         if ladder:
             axes[0].legend(fontsize=6, frameon=False, loc="upper right")
-            title = (f"{result.name}: {runs} tempered-ladder runs × {ds.sizes['draw']} "
+            title = (f"{result.name}: {runs} tempered-ladder runs × {n_draws} "
                      f"particles\nR-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f} across "
                      "the runs")
         else:
-            title = (f"{result.name}: {ds.sizes['draw']} draws resampled from importance "
+            title = (f"{result.name}: {n_draws} draws resampled from importance "
                      f"weights\n(ESS of the weights {post.ess_min:.0f})")
         if not post.converged:
             title += ": the runs disagree"

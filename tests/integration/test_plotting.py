@@ -656,3 +656,39 @@ def test_only_the_leading_structures_get_corner_and_trace_figures(comparison, tm
     with pytest.raises(InputError, match="'structure_figures' must be a non-negative integer"):
         write_figures(comparison, tmp_path / "bad", structure_figures=-1)
     assert not (tmp_path / "bad").exists() or not list((tmp_path / "bad").iterdir())
+
+
+def test_corner_and_trace_of_modulus_data_draw_the_physical_parameters():
+    """On modulus data the figures name the parameters as the report's tables do (the
+    physical G_e, c_q, q of the fractional Voigt, not the card's a1, b0), with their units, the
+    positive ones on log10 axes; the drawn numbers are those of physical_parameters."""
+    from pathlib import Path
+
+    from bayesfo.data import read
+    from bayesfo.structures.physical import physical_parameters
+
+    data = read(Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+                / "Tp020C.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PredictiveWarning)
+        r = compare(data, "voigt", noise="proportional", seed=0, progress=False)["voigt"]
+    post, s = r.posterior, r.structure
+    phys = physical_parameters(s, post.samples[:, :s.n_params], "modulus", "Pa", derived=False)
+    assert list(phys) == ["G_e", "c_q", "q"]
+    expected = np.column_stack([np.log10(phys["G_e"][0]), np.log10(phys["c_q"][0]),
+                                phys["q"][0], np.log10(post.samples[:, -1])])
+    drawn = plot_corner(r)
+    np.testing.assert_allclose(drawn.values["samples"] * drawn.values["factor"], expected,
+                               rtol=1e-12)
+    bottom = [drawn.axes[12 + j].get_xlabel() for j in range(4)]
+    assert bottom[0].startswith("log$_{10}$ $G_{e}$ [Pa]") and "[Pa s$^{q}$]" in bottom[1]
+    assert bottom[2].startswith("$q$")
+    # The least-squares optimum is marked in the same parameters.
+    fit = physical_parameters(s, r.fit.theta, "modulus", "Pa", derived=False)
+    np.testing.assert_allclose(drawn.values["fit"][:2] * drawn.values["factor"][:2],
+                               np.log10([fit["G_e"][0], fit["c_q"][0]]), rtol=1e-12)
+    trace = plot_trace(r)
+    assert [k for k in trace.values if k not in ("draw", "lp", "converged")] == [
+        "G_e", "c_q", "q", "sigma_rel"]
+    np.testing.assert_allclose(np.ravel(trace.values["G_e"]), phys["G_e"][0], rtol=1e-12)
+    plt.close("all")

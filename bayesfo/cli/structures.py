@@ -20,8 +20,13 @@ def run(args) -> int:
         print(json.dumps([s.describe() for s in lib.values()], indent=2))
         return 0
     width = max(len(n) for n in lib)
+    print(f"{'':<{width}}  J(s): the card in its parameters (the compliance; for generic data "
+          "the transfer function); G*(s) = 1/J(s) in the physical parameters that modulus "
+          "data report")
     for s in lib.values():
         priors = ", ".join(f"{p.name}~{p.prior.describe()}" for p in s.parameters)
-        print(f"{s.name:<{width}}  {s.formula}")
+        print(f"{s.name:<{width}}  J(s) = {s.formula}")
+        if s.modulus_formula is not None:
+            print(f"{'':<{width}}  G*(s) = {s.modulus_formula}")
         print(f"{'':<{width}}  priors: {priors}")
     return 0

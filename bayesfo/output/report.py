@@ -217,7 +217,11 @@ def _priors_section(comparison) -> str:
                      f"g_ref = {sc.g_ref:.4g}"
                      + (" (structure compared with the reciprocal of the data)"
                         if sc.reciprocal else "") + ".")
-        parts.append(f"<h3>{_e(r.name)}</h3><p class='small'>{_e(r.structure.formula)}."
+        formula = f"J(s) = {r.structure.formula}"
+        if comparison.data.kind == "modulus" and r.structure.modulus_formula is not None:
+            formula = (f"G*(s) = {r.structure.modulus_formula}, sampled as the card's "
+                       f"compliance {formula}")
+        parts.append(f"<h3>{_e(r.name)}</h3><p class='small'>{_e(formula)}."
                      f"{_e(scale)}</p><table><tr><th class='text'>parameter</th>"
                      f"<th class='text'>prior</th><th class='text'>range</th></tr>"
                      f"{''.join(rows)}</table>")
@@ -306,7 +310,8 @@ def _picture_text(structure, picture: str) -> str:
     pic = picture_of(structure, picture)
     text = pic.name + (f", {pic.title}" if pic.title else "")
     if pic.network is not None:
-        text += f"; network {pic.network.text}"
+        text += (f"; network {pic.network.text}, G*(s) = "
+                 f"{pic.network.modulus_text(dict(structure.fixed))}")
     if structure.fixed:
         text += " with " + ", ".join(f"{k} = {float(v):g}" for k, v in structure.fixed.items())
     return _e(text)

@@ -132,6 +132,49 @@ class Network:
 
         return show_tree(self.tree, top=True)
 
+    def modulus_text(self, fixed: dict | None = None) -> str:
+        """G*(s) of the network in symbols: moduli add in parallel, compliances in series,
+        e.g. ``G_e + c_q s^q`` or ``G_e + 1/(1/G_m + 1/(c_q s^q))``; an order that ``fixed``
+        (``{name: value}``, e.g. an integer variant's orders at 1) determines is written as
+        its value (``c_q s`` for q = 1, a spring's modulus for order 0).
+
+        Examples
+        --------
+        >>> Network.parse("parallel(spring(G_e), springpot(c_q, q))", "x").modulus_text()
+        'G_e + c_q s^q'
+        >>> Network.parse("series(springpot(c_beta, beta), springpot(c_delta, beta - alpha))",
+        ...               "x").modulus_text()
+        '1/(1/(c_beta s^beta) + 1/(c_delta s^(beta - alpha)))'
+        """
+
+        def power(order) -> str:
+            if fixed and order.names <= set(fixed):
+                value = float(order(fixed))
+                return "" if value == 0 else "s" if value == 1 else f"s^{value:g}"
+            text = str(order)
+            return f"s^{text}" if text.replace("_", "").isalnum() else f"s^({text})"
+
+        def modulus(t) -> str:
+            if isinstance(t, Element):
+                if t.kind == "spring":
+                    return str(t.coefficient)
+                if t.kind == "dashpot":
+                    return f"{t.coefficient} s"
+                return f"{t.coefficient} {power(t.order)}".rstrip()
+            if t[0] == "parallel":
+                return " + ".join(modulus(c) for c in t[1])
+            return "1/(" + " + ".join(compliance(c) for c in t[1]) + ")"
+
+        def compliance(t) -> str:
+            if isinstance(t, Element):
+                inner = modulus(t)
+                return f"1/{inner}" if " " not in inner else f"1/({inner})"
+            if t[0] == "series":
+                return " + ".join(compliance(c) for c in t[1])
+            return f"1/({modulus(t)})"
+
+        return modulus(self.tree)
+
     # ------------------------------------------------------------------ evaluation
     def modulus(self, values, omega) -> np.ndarray:
         """G(jω) of the network, shape (n_sets, n_freq) for ``values`` of shape (n_sets,)."""

@@ -139,7 +139,18 @@ class Structure:
             out["aliases"] = list(self.aliases)
         if self.pictures:
             out["pictures"] = [p.describe() for p in self.pictures]
+            if self.modulus_formula is not None:
+                out["modulus_formula"] = self.modulus_formula
         return out
+
+    @property
+    def modulus_formula(self) -> str | None:
+        """G*(s) in the physical parameters of the default picture (``G_e + c_q s^q`` for the
+        fractional Voigt), with the orders this variant fixes written as their values; None for
+        a structure without a mechanical network (inverted variants, the max-order family).
+        :attr:`formula` is the card's compliance J(s)."""
+        network = self.pictures[0].network if self.pictures else None
+        return None if network is None else network.modulus_text(dict(self.fixed))
 
     def with_picture(self, name: str) -> Structure:
         """A copy whose default picture (the physical parameters it reports) is the one called

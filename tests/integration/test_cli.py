@@ -119,6 +119,15 @@ def test_models_option_before_or_after_the_command(tmp_path, run_cli):
         assert status == 0 and "kv2 " in out and "kv2-int " in out
     status, out, _ = run_cli("structures")
     assert "kv2" not in out
+    # Each structure with a mechanical picture in the modulus form too, its orders as fixed.
+    lines = out.splitlines()
+    at = next(i for i, line in enumerate(lines) if line.startswith("voigt "))
+    assert lines[at].split(None, 1)[1] == "J(s) = b0 / (1 + a1 s^q)"
+    assert lines[at + 1].strip() == "G*(s) = G_e + c_q s^q"
+    at = next(i for i, line in enumerate(lines) if line.startswith("maxwell-int "))
+    assert lines[at + 1].strip() == "G*(s) = 1/(1/(c_beta s) + 1/c_delta)"
+    at = next(i for i, line in enumerate(lines) if line.startswith("voigt-inv "))
+    assert lines[at + 1].strip().startswith("priors:")  # no network: no modulus form
 
 
 ADHESIVE = EXAMPLES / "adhesive_468mp" / "Tp020C.csv"

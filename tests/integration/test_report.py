@@ -166,6 +166,15 @@ def test_parameter_summaries_and_priors_are_listed(comparison):
     assert "log-uniform" in text and "[0, 1]" in text  # the prior of q
     assert "known: the data give sigma per point" in text
     assert "sim/voigt.csv" in text and "1/Pa" in text
+    # Compliance data: the priors under the card's J(s); modulus data also name G*(s) in the
+    # physical parameters, each integer variant with its orders as fixed.
+    assert "<p class='small'>J(s) = b0 / (1 + a1 s^q)." in text
+    modulus = replace(comparison, data=replace(comparison.data, kind="modulus", units="Pa"))
+    text = render_report(modulus)
+    assert ("G*(s) = G_e + c_q s^q, sampled as the card&#x27;s compliance J(s) = b0 / (1 + a1 "
+            "s^q).") in text
+    assert "G*(s) = G_e + c_q s, sampled as the card&#x27;s compliance J(s) = b0 / (1 + a1 s)." \
+        in text
 
 
 def test_figures_are_embedded_and_nothing_is_external(comparison, figures):

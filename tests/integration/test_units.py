@@ -256,14 +256,15 @@ def test_corner_and_trace_labels_carry_units(zener_run):
     ndim = len(r.posterior.param_names)
     labels = [drawn.axes[ndim * (ndim - 1) + j].get_xlabel() for j in range(ndim)]
     plt.close(drawn.figure)
-    assert labels[0].startswith("log$_{10}$ $a_{1}$ [s$^{q}$]")
-    assert labels[1].startswith("log$_{10}$ $b_{0}$ [1/MPa]")
-    assert labels[2].startswith("log$_{10}$ $b_{1}$ [s$^{q}$/MPa]")
+    # Modulus data: the physical parameters, in the data's unit.
+    assert labels[0].startswith("log$_{10}$ $G_{e}$ [MPa]")
+    assert labels[1].startswith("log$_{10}$ $G_{m}$ [MPa]")
+    assert labels[2].startswith("log$_{10}$ $c_{q}$ [MPa s$^{q}$]")
     assert labels[3] == "$q$"  # an order has no unit
     drawn = plot_trace(r)
     texts = [ax.get_xlabel() + ax.get_ylabel() for ax in drawn.axes]
     plt.close(drawn.figure)
-    assert any("[1/MPa]" in t for t in texts) and any("[s$^{q}$/MPa]" in t for t in texts)
+    assert any("$G_{e}$ [MPa]" in t for t in texts) and any("[MPa s$^{q}$]" in t for t in texts)
 
 
 def test_unit_and_symbol_mathtext():

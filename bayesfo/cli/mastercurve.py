@@ -35,6 +35,9 @@ def add_parser(subparsers):
     p.add_argument("--noise", default="proportional", choices=("proportional", "constant",
                                                                "known"),
                    help="noise model (default proportional: isotherms span decades)")
+    p.add_argument("--vertical", default="none", choices=("none", "density", "free"),
+                   help="vertical shift b_T: none (default); density: b_T = T_ref/T in kelvin "
+                        "(constant density); free: one log10 b_T per isotherm")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default bayesfo-mastercurve)")
@@ -89,13 +92,15 @@ def run(args) -> int:
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
-                     noise=args.noise, seed=args.seed)
+                     noise=args.noise, vertical=args.vertical, seed=args.seed)
     summary = {"data": mc.data.to_dict(), **mc.to_dict()}
     master = mc.master_data()
     law = mc.shift_law()
     comments = [f"master curve at {mc.reference_temperature:g} C of {len(mc.temperatures)} "
                 f"isotherms ({min(mc.temperatures):g} to {max(mc.temperatures):g} C), shifted "
-                f"by the posterior mean log10 a_T of bayesfo mastercurve ({mc.structure})",
+                f"by the posterior mean log10 a_T"
+                + ("" if mc.vertical == "none" else f" and log10 b_T ({mc.vertical})")
+                + f" of bayesfo mastercurve ({mc.structure})",
                 f"temperature: {mc.reference_temperature:g} C",
                 f"shift law: {law['name']} "
                 + ", ".join(f"{k} = {v['mean']:.6g} {v['unit']}".rstrip()

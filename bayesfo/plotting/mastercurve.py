@@ -36,13 +36,17 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     cmap = mpl.colormaps["coolwarm"]
     norm = mpl.colors.Normalize(temps.min(), temps.max())
     shifts = mc.log_shift_mean
+    vertical = (np.zeros(len(temps)) if getattr(mc, "vertical_draws", None) is None
+                else mc.vertical_draws.mean(axis=0))
     lo_w, hi_w = np.inf, 0.0
     artists = {}
     for i, (d, t) in enumerate(zip(mc.isotherms, temps, strict=True)):
         w = d.omega * 10.0 ** shifts[i]
         lo_w, hi_w = min(lo_w, w.min()), max(hi_w, w.max())
-        loss = d.response.imag if modulus else -d.response.imag
-        for ax, name, part in zip(axes[:2], ("storage", "loss"), (d.response.real, loss),
+        # b_T G(ω) (a compliance divided by b_T) lies on the master curve.
+        y = d.response * 10.0 ** (vertical[i] if modulus else -vertical[i])
+        loss = y.imag if modulus else -y.imag
+        for ax, name, part in zip(axes[:2], ("storage", "loss"), (y.real, loss),
                                   strict=True):
             artists[f"{t:g}/{name}"] = ax.loglog(w, np.abs(part), "o", ms=3,
                                                  color=cmap(norm(t)), alpha=0.8)[0]
@@ -59,7 +63,8 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
         ax.fill_between(grid, lo, hi, color="0.3", alpha=0.25, lw=0)
         ax.loglog(grid, med, "k-", lw=1.2, label=f"{mc.structure} (median, 94 %)")
         ax.set_xlabel(f"a_T ω [rad/s] (T_ref = {mc.reference_temperature:g} °C)")
-        ax.set_ylabel(f"{sym} [{unit}]")
+        ax.set_ylabel(f"{'b_T ' if vertical.any() and modulus else ''}{sym}"
+                      f"{' / b_T' if vertical.any() and not modulus else ''} [{unit}]")
         values[f"{q.split('_')[0]}_median"] = med
     axes[0].legend(loc="best", fontsize=8)
     fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes[1], label="T [°C]")

@@ -2,10 +2,14 @@
 horizontal shift log10 a_T, on all isotherms' complex data at once.
 
 Isotherm i, measured at temperature T_i, is modelled as the master function at reduced
-frequency: G_i(ω) = G_master(a_T,i · ω), with a_T = 1 at the reference temperature. The
-parameters are the master structure's, one log10 a_T per other isotherm (uniform prior over
-±:data:`SHIFT_RANGE` decades: no bound on the step between neighbours, and a shift the data do
-not fix, over a featureless plateau, comes out wide rather than pinned) and the noise. The
+frequency: G_i(ω) = G_master(a_T,i · ω) / b_T,i, with a_T = b_T = 1 at the reference
+temperature. The parameters are the master structure's, one log10 a_T per other isotherm
+(uniform prior over ±:data:`SHIFT_RANGE` decades: no bound on the step between neighbours, and
+a shift the data do not fix, over a featureless plateau, comes out wide rather than pinned)
+and the noise. The vertical factor b_T is 1 (``vertical="none"``), the density correction of
+entropic elasticity b_T = T_ref/T in kelvin with a constant density (``"density"``), or one
+log10 b_T per other isotherm (``"free"``, uniform over ±:data:`VERTICAL_RANGE` decades);
+compliances scale the other way, J_i(ω) = b_T,i J_master(a_T,i · ω). The
 posterior and ln Z come from :func:`bayesfo.inference.certified_posterior`, as in ``compare``.
 
 Seeds: the shift between neighbouring isotherms that best overlays their log|G*| and phase
@@ -34,6 +38,15 @@ from .laws import _fit_laws
 
 #: Prior of each log10 a_T: uniform over ±SHIFT_RANGE decades around the reference.
 SHIFT_RANGE = 15.0
+#: Prior of each free log10 b_T: uniform over ±VERTICAL_RANGE decades (vertical factors are
+#: density and temperature ratios, a few tens of per cent).
+VERTICAL_RANGE = 1.0
+#: The vertical shifts ``mastercurve`` knows.
+VERTICAL = ("none", "density", "free")
+#: Free vertical shifts beyond this many decades (a factor of 1.26) exceed the density and
+#: temperature ratios they stand for: a note says they likely absorb a misfit of the master.
+VERTICAL_PLAUSIBLE = 0.1
+KELVIN = 273.15
 #: A law whose χ²/dof against the shifts' posterior exceeds this misses them: a note says so
 #: (the 99.9 % point of χ²/dof for 5 degrees of freedom is 4.1).
 LAW_MISS = 4.0
@@ -42,11 +55,12 @@ LAW_MISS = 4.0
 ISOTHERM_MISFIT = 3.0
 
 
-def shift_name(temperature: float) -> str:
+def shift_name(temperature: float, factor: str = "aT") -> str:
     """The parameter name of the shift of the isotherm at ``temperature`` [°C]:
-    ``log10_aT_80C``, ``log10_aT_m40C``, ``log10_aT_12p5C``."""
+    ``log10_aT_80C``, ``log10_aT_m40C``, ``log10_aT_12p5C``; ``factor="bT"`` for the vertical
+    shift (``log10_bT_80C``)."""
     text = f"{temperature:g}".replace("-", "m").replace(".", "p")
-    return f"log10_aT_{text}C"
+    return f"log10_{factor}_{text}C"
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,6 +82,8 @@ class ShiftedStructure:
         The isotherm of each point of the joint data, in its order.
     master_grid : ndarray or None
         The dissipation grid of the master (scaled), spanning the reduced window.
+    vertical : {"none", "density", "free"}
+        The vertical shift b_T (see the module).
     """
 
     master: object
@@ -75,6 +91,7 @@ class ShiftedStructure:
     reference: int
     point_isotherm: np.ndarray
     master_grid: np.ndarray | None = None
+    vertical: str = "none"
 
     @property
     def name(self) -> str:
@@ -89,6 +106,10 @@ class ShiftedStructure:
     def parameters(self) -> tuple:
         shifts = tuple(Parameter(shift_name(self.temperatures[i]), "shift",
                                  Uniform(-SHIFT_RANGE, SHIFT_RANGE)) for i in self.shifted)
+        if self.vertical == "free":
+            shifts += tuple(Parameter(shift_name(self.temperatures[i], "bT"), "shift",
+                                      Uniform(-VERTICAL_RANGE, VERTICAL_RANGE))
+                            for i in self.shifted)
         return tuple(self.master.parameters) + shifts
 
     @property
@@ -132,17 +153,31 @@ class ShiftedStructure:
         out[:, list(self.shifted)] = theta[:, k:k + len(self.shifted)]
         return out
 
+    def log_vertical(self, theta) -> np.ndarray:
+        """log10 b_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        out = np.zeros((theta.shape[0], len(self.temperatures)))
+        if self.vertical == "density":
+            t = np.asarray(self.temperatures) + KELVIN
+            out[:] = np.log10(t[self.reference] / t)
+        elif self.vertical == "free":
+            start = self.master.n_params + len(self.shifted)
+            out[:, list(self.shifted)] = theta[:, start:start + len(self.shifted)]
+        return out
+
     def response(self, theta, omega, kind: str = "compliance") -> np.ndarray:
-        """The master's response at each point's reduced frequency a_T·ω (``omega`` are the
-        joint data's points, in their order)."""
+        """The master's response at each point's reduced frequency a_T·ω, divided by b_T
+        (a compliance multiplied by it); ``omega`` are the joint data's points, in their
+        order."""
         theta2 = np.atleast_2d(np.asarray(theta, float))
         omega = np.asarray(omega, float)
         if omega.shape != self.point_isotherm.shape:
             raise InputError("a master curve is evaluated on its own data's points only")
         a = 10.0 ** self.log_shifts(theta2)[:, self.point_isotherm]
+        b = 10.0 ** self.log_vertical(theta2)[:, self.point_isotherm]
         with np.errstate(all="ignore"):
-            c = self.master.laplace(theta2[:, :self.master.n_params], 1j * omega * a,
-                                    per_set=True)
+            c = b * self.master.laplace(theta2[:, :self.master.n_params], 1j * omega * a,
+                                        per_set=True)
             out = 1.0 / c if kind == "modulus" else c
         return out[0] if np.ndim(theta) == 1 else out
 
@@ -150,7 +185,9 @@ class ShiftedStructure:
         theta2 = np.atleast_2d(np.asarray(theta, float))
         k = self.master.n_params
         ok = np.atleast_1d(self.master.in_support(theta2[:, :k])).copy()
-        ok &= np.all(np.abs(theta2[:, k:]) <= SHIFT_RANGE, axis=1)
+        n = len(self.shifted)
+        ok &= np.all(np.abs(theta2[:, k:k + n]) <= SHIFT_RANGE, axis=1)
+        ok &= np.all(np.abs(theta2[:, k + n:]) <= VERTICAL_RANGE, axis=1)
         return ok if np.ndim(theta) == 2 else ok[0]
 
     def constraints_hold(self, theta, kind: str, omega_grid=None, where=None) -> np.ndarray:
@@ -291,13 +328,16 @@ def _seed_shifts(iso: _Isotherms) -> np.ndarray:
     return shifts
 
 
-def _reduced(iso: _Isotherms, log_shifts) -> FrequencyResponse:
-    """The isotherms on one reduced frequency axis (a_T ω), sorted; points that land on the
-    same frequency averaged."""
+def _reduced(iso: _Isotherms, log_shifts, log_vertical=None) -> FrequencyResponse:
+    """The isotherms on one reduced frequency axis (a_T ω), each multiplied by b_T (a
+    compliance divided by it), sorted; points that land on the same frequency averaged."""
     j = iso.joint
     omega = j.omega * 10.0 ** np.asarray(log_shifts)[iso.point_isotherm]
+    b = np.ones_like(omega) if log_vertical is None else \
+        10.0 ** np.asarray(log_vertical)[iso.point_isotherm]
+    scale = b if j.kind == "modulus" else 1.0 / b
     order = np.argsort(omega)
-    omega, response = omega[order], j.response[order]
+    omega, response = omega[order], (j.response * scale)[order]
     keep = np.r_[True, np.diff(omega) > 1e-12 * omega[1:]]
     groups = np.cumsum(keep) - 1
     n = groups[-1] + 1
@@ -307,7 +347,7 @@ def _reduced(iso: _Isotherms, log_shifts) -> FrequencyResponse:
     sigma = None
     if j.sigma is not None:
         s2 = np.zeros(n)
-        np.add.at(s2, groups, j.sigma[order] ** 2)
+        np.add.at(s2, groups, (j.sigma * scale)[order] ** 2)
         sigma = np.sqrt(s2) / np.bincount(groups)
     return FrequencyResponse(omega[keep], r, sigma, kind=j.kind, units=j.units,
                              name=f"master curve of {j.label}", source=j.source)
@@ -340,6 +380,10 @@ class MasterCurve:
     ranking : tuple of dict
         Every master structure fitted, best first: ``structure``, ``log_evidence``,
         ``log_evidence_err``, ``probability`` (equal prior odds), ``certified``, ``sampler``.
+    vertical : {"none", "density", "free"}
+        The vertical shift of the model (see the module).
+    vertical_draws : ndarray, shape (n_draws, n_isotherms), or None
+        Posterior draws of log10 b_T (0 at the reference; None without vertical shifts).
     """
 
     structure: str
@@ -356,6 +400,8 @@ class MasterCurve:
     notes: tuple[str, ...] = ()
     ranking: tuple = ()
     tts_checks: dict = field(default_factory=dict)
+    vertical: str = "none"
+    vertical_draws: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def tts_valid(self) -> bool | None:
@@ -375,22 +421,25 @@ class MasterCurve:
         the data give σ)."""
         return _reduced(_Isotherms(self.isotherms, self.temperatures,
                                    self.temperatures.index(self.reference_temperature)),
-                        self.log_shift_mean)
+                        self.log_shift_mean,
+                        None if self.vertical_draws is None else self.vertical_draws.mean(0))
 
     def shift_factors(self) -> list[dict]:
         """``[{"temperature", "log10_aT": {mean, sd, hdi_low, hdi_high}, "log10_bT": ...}]``
-        as ``summary.json`` holds them (b_T = 1: no vertical shift)."""
+        as ``summary.json`` holds them (log10 b_T = 0 without vertical shifts; a fixed one,
+        the density correction, has sd 0)."""
         from ..inference._arviz import hdi
 
-        out = []
-        for i, t in enumerate(self.temperatures):
-            x = self.shift_draws[:, i]
-            lo, hi = (0.0, 0.0) if not x.any() else hdi(x, 0.94)
-            out.append({"temperature": t,
-                        "log10_aT": {"mean": float(x.mean()), "sd": float(x.std(ddof=1)),
-                                     "hdi_low": lo, "hdi_high": hi},
-                        "log10_bT": {"mean": 0.0, "sd": 0.0, "hdi_low": 0.0, "hdi_high": 0.0}})
-        return out
+        def summary(x):
+            lo, hi = (float(x[0]), float(x[0])) if np.ptp(x) == 0 else hdi(x, 0.94)
+            return {"mean": float(x.mean()), "sd": float(x.std(ddof=1)), "hdi_low": lo,
+                    "hdi_high": hi}
+
+        vertical = (np.zeros_like(self.shift_draws) if self.vertical_draws is None
+                    else self.vertical_draws)
+        return [{"temperature": t, "log10_aT": summary(self.shift_draws[:, i]),
+                 "log10_bT": summary(vertical[:, i])}
+                for i, t in enumerate(self.temperatures)]
 
     def shift_law(self) -> dict:
         """``{"name", "reference_temperature", "parameters", "probabilities", "method"}``:
@@ -412,7 +461,8 @@ class MasterCurve:
                 "parameters": {n: {k: _num(getattr(v, k)) for k in
                                    ("mean", "sd", "hdi_low", "hdi_high")}
                                for n, v in self.posterior.summary.items()
-                               if not n.startswith("log10_aT_")},
+                               if not n.startswith(("log10_aT_", "log10_bT_"))},
+                "vertical": self.vertical,
                 "structures": list(self.ranking),
                 "shift_factors": self.shift_factors(), "shift_law": self.shift_law(),
                 "laws": self.laws, "tts_valid": self.tts_valid, "tts_checks": self.tts_checks,
@@ -426,7 +476,8 @@ def _num(x):
 
 # ---------------------------------------------------------------------------- the fit
 def mastercurve(isotherms, structures="zener", *, reference_temperature: float | None = None,
-                noise: str = "proportional", seed: int = 0) -> MasterCurve:
+                noise: str = "proportional", vertical: str = "none",
+                seed: int = 0) -> MasterCurve:
     """One joint posterior of a master structure and the isotherms' shifts; with several
     structures, each is fitted and the one of highest ln Z is returned, with the ranking.
 
@@ -442,6 +493,9 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         [°C]; an isotherm's temperature (default: the middle isotherm).
     noise : {"proportional", "constant", "known"}
         ``proportional`` suits data spanning decades (as isotherms do).
+    vertical : {"none", "density", "free"}
+        The vertical shift b_T: none; the density correction b_T = T_ref/T [K] (constant
+        density); or one free log10 b_T per isotherm (see the module).
     seed : int
 
     Returns
@@ -456,10 +510,12 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     """
     from ..structures import resolve_structures
 
+    if vertical not in VERTICAL:
+        raise InputError(f"vertical must be one of {', '.join(VERTICAL)}, got {vertical!r}")
     names = resolve_structures(structures) if isinstance(structures, str) else (
         [structures] if not isinstance(structures, (list, tuple)) else list(structures))
     iso = _isotherms(isotherms, reference_temperature)
-    fits = [_fit_one(iso, s, noise, seed) for s in names]
+    fits = [_fit_one(iso, s, noise, seed, vertical) for s in names]
     z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
     best = int(np.argmax(z))
     p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
@@ -488,7 +544,8 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes))
 
 
-def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
+def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
+             vertical: str = "none") -> MasterCurve:
     """The joint posterior with one master structure."""
     from scipy.optimize import least_squares
 
@@ -506,7 +563,7 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
     reduced0 = _reduced(iso, shifts0)
     w = reduced0.omega / scaling.omega_ref
     shifted = ShiftedStructure(master, iso.temperatures, iso.reference, iso.point_isotherm,
-                               dissipation_grid(w.min(), w.max()))
+                               dissipation_grid(w.min(), w.max()), vertical)
     lik = Likelihood(shifted, joint, noise=noise, scaling=scaling)
     # Master seeds on the reduced data, then everything jointly (least squares on relative
     # residuals, in the sampling coordinates: logs of the log-uniform parameters).
@@ -515,6 +572,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
                                                               else fit.theta_scaled),
                                                 fit.scaling), scaling)
     shift_cols = np.delete(shifts0, iso.reference)
+    if vertical == "free":
+        shift_cols = np.r_[shift_cols, np.zeros(len(shifted.shifted))]
     tr = _Transform(lik)
     k_all = shifted.n_params
     log, lo, hi = tr.log[:k_all], tr.lo_u[:k_all], tr.hi_u[:k_all]
@@ -569,10 +628,22 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int) -> MasterCurve:
                      f"{law['chi2_per_dof']:.3g}; most at {law['worst_temperature']:g} °C, by "
                      f"{law['worst_deviation']:+.2f} decades): neither law holds over the whole "
                      "range (e.g. WLF above the glass transition only)")
+    vertical_draws = None if vertical == "none" else shifted.log_vertical(physical[:, :k_all])
+    if vertical == "free":
+        mean_b = vertical_draws.mean(axis=0)
+        worst = int(np.argmax(np.abs(mean_b)))
+        if abs(mean_b[worst]) > VERTICAL_PLAUSIBLE:
+            notes.append(
+                f"{master.name}: the free vertical shifts reach {mean_b[worst]:+.2f} decades "
+                f"(b_T = {10.0 ** mean_b[worst]:.2g} at {iso.temperatures[worst]:g} °C), beyond "
+                f"the density and temperature ratios they stand for (±{VERTICAL_PLAUSIBLE:g}): "
+                "they likely absorb a misfit of the master structure; compare the ln Z with "
+                "vertical='none' or 'density', and other structures")
     return MasterCurve(
         structure=master.name, temperatures=iso.temperatures,
         reference_temperature=iso.temperatures[iso.reference], shift_draws=shift_draws,
         master_draws=physical[:, :k], posterior=post,
         log_evidence=math.nan if ev is None else ev.log_z,
         log_evidence_err=math.nan if ev is None else ev.log_z_err, laws=laws, data=joint,
-        isotherms=iso.data, notes=tuple(notes), tts_checks={"isotherm_fit": isotherm_fit})
+        isotherms=iso.data, notes=tuple(notes), tts_checks={"isotherm_fit": isotherm_fit},
+        vertical=vertical, vertical_draws=vertical_draws)

@@ -24,13 +24,15 @@ TEMPS = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0]
 ADHESIVE = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
 
 
-def isotherms(log_aT, seed=0, rel=0.01):
-    """Isotherms of the Zener at the reduced frequencies a_T·ω, with 1 % complex noise."""
+def isotherms(log_aT, seed=0, rel=0.01, log_bT=None):
+    """Isotherms of the Zener at the reduced frequencies a_T·ω, divided by b_T, with 1 %
+    complex noise."""
     z = get_structure("zener")
     rng = np.random.default_rng(seed)
     out = []
-    for t, la in zip(TEMPS, log_aT, strict=True):
-        g = z.response([ZENER], W * 10.0**la, "modulus")[0]
+    log_bT = np.zeros(len(TEMPS)) if log_bT is None else log_bT
+    for t, la, lb in zip(TEMPS, log_aT, log_bT, strict=True):
+        g = z.response([ZENER], W * 10.0**la, "modulus")[0] / 10.0**lb
         sd = rel * np.abs(g)
         y = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
         out.append((FrequencyResponse(W, y, kind="modulus", units="Pa", name=f"syn {t:g} °C"), t))
@@ -167,3 +169,49 @@ def test_batch_over_isotherms_points_to_mastercurve(tmp_path, run_cli):
     assert out.strip().splitlines()[-1] == (
         "note: 2 temperatures: each isotherm was compared on its own; for one master structure "
         "and the shift factors of all of them, run 'bayesfo mastercurve' on the same files")
+
+
+def test_vertical_shifts_are_recovered_and_the_density_factor_is_exact():
+    """Isotherms divided by known vertical factors (up to 25 %, as density and temperature
+    ratios give): with free vertical shifts the 94 % HDIs of log10 b_T and a_T cover the truth,
+    the joint evidence is far above that of horizontal shifts alone, and the master curve puts
+    the isotherms back on the reference's scale. The density correction is T_ref/T in kelvin."""
+    truth_a = wlf(np.array(TEMPS), 20.0, 8.0, 80.0)
+    truth_b = np.array([0.08, -0.05, 0.0, 0.06, -0.1, 0.04])  # 0 at the reference, 20 °C
+    data = isotherms(truth_a, log_bT=truth_b)
+    free = _fit(data, vertical="free")
+    assert free.posterior.converged and free.vertical == "free"
+    factors = free.shift_factors()
+    assert factors[2]["log10_bT"] == {"mean": 0.0, "sd": 0.0, "hdi_low": 0.0, "hdi_high": 0.0}
+    for f, a, b in zip(factors, truth_a, truth_b, strict=True):
+        if f["temperature"] == 20.0:
+            continue
+        assert f["log10_bT"]["hdi_low"] <= b <= f["log10_bT"]["hdi_high"], f
+        assert f["log10_bT"]["sd"] < 0.02  # 1 % noise on 12 points: well determined
+        assert f["log10_aT"]["hdi_low"] - 0.02 <= a <= f["log10_aT"]["hdi_high"] + 0.02, f
+    none = _fit(data)
+    assert free.log_evidence > none.log_evidence + 50
+    assert "log10_bT_0C" in free.posterior.param_names
+    assert not any(n.startswith("log10_bT") for n in free.to_dict()["parameters"])
+    # The reduced data lie on the reference's curve: b_T G_i(ω) = G_master(a_T ω).
+    master = free.master_data()
+    expected = get_structure("zener").response([ZENER], master.omega, "modulus")[0]
+    assert np.median(np.abs(master.response / expected - 1)) < 0.02
+    with pytest.raises(InputError, match="vertical must be one of none, density, free"):
+        _fit(data, vertical="yes")
+    # Factors beyond density and temperature ratios are fitted, and a note says so.
+    assert not any("free vertical shifts reach" in n for n in free.notes)
+    large = _fit(isotherms(truth_a, log_bT=3 * truth_b), vertical="free")
+    assert any("the free vertical shifts reach -0.29 decades (b_T = 0.51 at 40 °C)" in n
+               for n in large.notes), large.notes
+
+
+def test_the_density_correction_is_the_ratio_of_absolute_temperatures():
+    from bayesfo.tts.joint import ShiftedStructure
+
+    shifted = ShiftedStructure(get_structure("zener"), tuple(TEMPS), 2, np.zeros(1, int),
+                               vertical="density")
+    expected = np.log10((20.0 + 273.15) / (np.array(TEMPS) + 273.15))
+    np.testing.assert_allclose(shifted.log_vertical(np.zeros((3, shifted.n_params)))[1],
+                               expected, rtol=1e-14)
+    assert shifted.n_params == 4 + 5  # no vertical parameters: the factor is fixed

@@ -395,6 +395,7 @@ def staged_run(out_dir):
         replace a directory that no bayesfo run recorded; the earlier outputs stay.
     """
     out_dir = Path(out_dir)
+    created = not os.path.lexists(out_dir)  # a first run that fails leaves no directory
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         staging = out_dir / f"{STAGING_PREFIX}{secrets.token_hex(6)}"
@@ -402,6 +403,8 @@ def staged_run(out_dir):
         owner = _claim(staging)
         (staging / "new").mkdir()
     except OSError as exc:
+        if created:
+            shutil.rmtree(out_dir, ignore_errors=True)  # what this call made, nothing else
         raise OutputError(_describe_os_error(exc, out_dir)) from None
     swapping = False  # from the journal on, the staging directory holds both runs' files
     try:
@@ -444,6 +447,9 @@ def staged_run(out_dir):
                                   "the move") from None
             raise
         shutil.rmtree(staging, ignore_errors=True)
+        if created:
+            with contextlib.suppress(OSError):
+                out_dir.rmdir()  # only if empty
         if isinstance(exc, OSError) and not isinstance(exc, OutputError):
             raise OutputError(_describe_os_error(exc, out_dir)) from None
         raise

@@ -8,7 +8,7 @@ import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, wait
 
-from ..errors import InputError
+from ..errors import InputError, OutputError
 from ..outdir import check_output_directory
 from .store import BatchResult, Outcome, _lost, _store, _stored_rows, write_batch_outputs
 from .task import INPUT_ERROR, OK, run_task
@@ -206,6 +206,21 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
             else:
                 executor = f"processes ({n})"
                 _run_processes(todo, n, on_result)
+    except OutputError as exc:
+        # The output directory cannot take more (no space left, ...): the batch stops, the
+        # data sets finished so far stay, and the summary lists them if it can be written.
+        done = [outcomes[ds.id] for ds in datasets if ds.id in outcomes]
+        listed = ""
+        if write_combined and done:
+            order = list(dict.fromkeys(n for ds in datasets for n in ds.options["structures"]))
+            try:
+                write_batch_outputs([r for o in done for r in o.rows], out_dir, order)
+                listed = ", listed in batch_summary.csv"
+            except OSError:
+                pass
+        raise OutputError(f"{exc}; the batch stopped after {len(done)} of {len(datasets)} data "
+                          f"sets, whose outputs are kept{listed}; free space and run the same "
+                          "command again: it resumes") from None
     finally:
         bar.close()
 

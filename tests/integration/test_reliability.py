@@ -288,6 +288,37 @@ def fake_compare(monkeypatch):
     monkeypatch.setattr(bayesfo.output, "write_outputs", fake_outputs)
 
 
+def test_a_full_output_directory_stops_a_batch_keeping_and_listing_what_finished(
+        tmp_path, fake_compare, monkeypatch):
+    """The device fills while the second of three data sets is stored: the batch stops with
+    one OutputError naming it, the first data set's outputs stay and batch_summary.csv lists
+    it, and no empty directory of the second is left behind; run again with room, it resumes."""
+    for name in ("a", "b", "c"):
+        shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / f"{name}.csv")
+    out = tmp_path / "out"
+    real_write = Path.write_bytes
+
+    def full_disk(self, data):
+        if self.parent.name == "new" and f"{os.sep}b{os.sep}" in str(self):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(self, data)
+
+    monkeypatch.setattr(Path, "write_bytes", full_disk)
+    inputs = expand_inputs([tmp_path / f"{n}.csv" for n in "abc"],
+                           options={"structures": "voigt", "figures": False})
+    with pytest.raises(OutputError, match=r"no space left on the device of .*b'.*the batch "
+                                          r"stopped after 1 of 3 data sets, whose outputs are "
+                                          r"kept, listed in batch_summary.csv"):
+        run_batch(inputs, out, workers=1, progress=False)
+    assert (out / "a" / "summary.json").is_file() and not (out / "b").exists()
+    header, *rows = (out / "batch_summary.csv").read_text().splitlines()
+    ids = [dict(zip(header.split(","), r.split(","), strict=False))["dataset"] for r in rows]
+    assert set(ids) == {"a"}
+    monkeypatch.setattr(Path, "write_bytes", real_write)
+    res = run_batch(inputs, out, workers=1, progress=False)
+    assert [o.reused for o in res.outcomes] == [True, False, False]
+
+
 def _victims(tmp_path) -> dict:
     """Files outside the output directory that a hostile output directory names."""
     v = tmp_path / "victims"

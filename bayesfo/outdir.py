@@ -396,15 +396,18 @@ def staged_run(out_dir):
     """
     out_dir = Path(out_dir)
     created = not os.path.lexists(out_dir)  # a first run that fails leaves no directory
+    token = secrets.token_hex(6)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
-        staging = out_dir / f"{STAGING_PREFIX}{secrets.token_hex(6)}"
+        staging = out_dir / f"{STAGING_PREFIX}{token}"
         staging.mkdir()
         owner = _claim(staging)
         (staging / "new").mkdir()
     except OSError as exc:
-        if created:
-            shutil.rmtree(out_dir, ignore_errors=True)  # what this call made, nothing else
+        if created:  # what this call made, and only if nothing else came into it
+            shutil.rmtree(out_dir / f"{STAGING_PREFIX}{token}", ignore_errors=True)
+            with contextlib.suppress(OSError):
+                out_dir.rmdir()
         raise OutputError(_describe_os_error(exc, out_dir)) from None
     swapping = False  # from the journal on, the staging directory holds both runs' files
     try:

@@ -1,12 +1,13 @@
-"""The one executor layer: the processes (or this process) that run the structures of a
-comparison and the data sets of a batch.
+"""Worker processes, and the one executor of a comparison's structures.
 
-:func:`executor` gives a job its executor from the number of processes asked for: this process
+:func:`executor` gives a comparison its executor from the number of processes asked for: this process
 (:class:`InlineExecutor`), a pool of worker processes (:func:`process_pool`), or the automatic
 choice (:class:`LazyPool`, whose processes start only when a task needs them, so that a job of
 quick tasks pays no start-up); every one has ``submit``, and the schedule that drives them is the
 same. :func:`figure_processes` says from the CPU time left idle whether figures can be drawn
-in a second process.
+in a second process. A batch runs its data sets on the same worker processes
+(:func:`new_pool`) through its own schedule (:mod:`bayesfo.batch.executors`: one data set per
+task, resumable, or a Dask cluster).
 
 Workers are spawned, or forked where that is safe (a comparison's pools, see :func:`new_pool`
 and :func:`fork_safe`), run one BLAS thread each,

@@ -1,7 +1,10 @@
 """Moved to :mod:`bayesfo.output.report`; the old name stays an alias for one release."""
 
-from .output import report as _moved
+import importlib
+
 from .output.report import *  # noqa: F401,F403
+
+_moved = importlib.import_module("bayesfo.output.report")
 
 
 def __getattr__(name):

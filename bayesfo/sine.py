@@ -1,7 +1,10 @@
 """Moved to :mod:`bayesfo.timeseries.sine`; the old name stays an alias for one release."""
 
-from .timeseries import sine as _moved
+import importlib
+
 from .timeseries.sine import *  # noqa: F401,F403
+
+_moved = importlib.import_module("bayesfo.timeseries.sine")
 
 
 def __getattr__(name):

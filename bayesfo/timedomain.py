@@ -1,7 +1,10 @@
 """Moved to :mod:`bayesfo.timeseries.timedomain`; the old name stays an alias for one release."""
 
-from .timeseries import timedomain as _moved
+import importlib
+
 from .timeseries.timedomain import *  # noqa: F401,F403
+
+_moved = importlib.import_module("bayesfo.timeseries.timedomain")
 
 
 def __getattr__(name):

@@ -153,7 +153,7 @@ def print_holdout(comp) -> None:
 
 
 def save(comp, out_dir, *, figures: bool = True, quick: bool = False) -> Path:
-    """Write the outputs with :func:`bayesfo.comparison.write_outputs` and say where they are.
+    """Write the outputs with :func:`bayesfo.output.write_outputs` and say where they are.
 
     The quick forms draw PNG figures only.
     """

@@ -136,11 +136,17 @@ def _print(mc, out) -> None:
         print(f"   {r['structure']:<22} ln Z {z:>20}  P {p:>6}  "
               f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")
     print(f"shift factors of {mc.structure}, T_ref = {mc.reference_temperature:g} °C:")
-    print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}")
+    vertical = mc.vertical != "none"
+    print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}"
+          + (f" {'log10 b_T':>10} {'sd':>7} {'94 % HDI':>20} ({mc.vertical})" if vertical
+             else ""))
     for f in mc.shift_factors():
-        a = f["log10_aT"]
-        hdi = f"[{a['hdi_low']:.3f}, {a['hdi_high']:.3f}]"
-        print(f"{f['temperature']:8g} {a['mean']:10.3f} {a['sd']:7.3f} {hdi:>20}")
+        line = f"{f['temperature']:8g}"
+        for key in ("log10_aT", "log10_bT") if vertical else ("log10_aT",):
+            a = f[key]
+            hdi = f"[{a['hdi_low']:.3f}, {a['hdi_high']:.3f}]"
+            line += f" {a['mean']:10.3f} {a['sd']:7.3f} {hdi:>20}"
+        print(line)
     for name, law in mc.laws.items():
         text = ", ".join(f"{k} = {v['mean']:.4g} ± {v['sd']:.2g} {v['unit']}".rstrip()
                          for k, v in law["parameters"].items())

@@ -28,9 +28,9 @@ class Criteria:
     Every field is optional: a structure that could not be run has none (``Criteria()``), and
     some exist only for some runs (``importance`` for an importance-sampled posterior, the
     ``holdout_*`` entries with held-out frequencies, ``posterior_probability`` with an
-    evidence). As a mapping, a field whose value is None is absent (``in``, iteration,
-    ``get``), while ``criteria[name]`` returns it whatever its value; a name that is not a field
-    raises ``KeyError``, in both ``criteria[name]`` and ``criteria.get(name)``.
+    evidence). Read the fields as attributes (``criteria.loo``); :meth:`to_dict` gives those
+    that are not None. The mapping interface of earlier releases (``criteria[name]``,
+    ``get``, ``in``, iteration) is deprecated and warns.
 
     Attributes
     ----------
@@ -136,12 +136,13 @@ class Criteria:
 
     # ---- the read side of a mapping, deprecated: attribute access replaces it
     @staticmethod
-    def _deprecated(instead: str) -> None:
+    def _deprecated(instead: str, stacklevel: int = 3) -> None:
         warnings.warn("reading Criteria as a mapping is deprecated and goes in the next "
-                      f"release; use {instead}", DeprecationWarning, stacklevel=3)
+                      f"release; use {instead}", DeprecationWarning, stacklevel=stacklevel)
 
     def _check(self, key) -> None:
-        self._deprecated(f"criteria.{key}" if isinstance(key, str) else "its attributes")
+        # The warning points at the caller of __getitem__ or get.
+        self._deprecated(f"criteria.{key}" if isinstance(key, str) else "its attributes", 4)
         if key not in _NAMES:
             raise KeyError(f"{key!r} is not a criteria key; the keys are " + ", ".join(_NAMES))
 

@@ -42,7 +42,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         ``auto``: ``known`` when the data carry σ; else every structure runs under
         ``constant`` and ``proportional`` noise and keeps the one with the larger ln Z
         (:data:`~bayesfo.comparison.steps.SCREEN_MARGIN` lets a quick estimate set aside a model that trails far behind);
-        both are stated in the result (``criteria["noise_models"]``). Any other value forces
+        both are stated in the result (``criteria.noise_models``). Any other value forces
         that model; ``relative_parts`` (relative errors σ_rel·|Re G| and σ_rel·|Im G| of each
         part, pyRheo's cost) is only used when forced, never by ``auto``.
     seed : int

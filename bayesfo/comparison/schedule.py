@@ -164,7 +164,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
 
     def collect(future):
         i, what, args = live.pop(future)
-        if future.cancelled():
+        if future.cancelled() or outcomes[i] is not None:  # its structure has ended
             return
         try:
             value = future.result()

@@ -352,45 +352,71 @@ def _too_large(path: Path, sheet: str, rows: int, cols: int) -> InputError:
 
 def _openpyxl_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
     """The sheets of an ``.xlsx`` workbook, streamed row by row (openpyxl's read-only mode)
-    within :data:`EXCEL_MAX_LINES` and :data:`EXCEL_MAX_CELLS`."""
+    within :data:`EXCEL_MAX_LINES` and :data:`EXCEL_MAX_CELLS`. A sheet beyond them is left
+    out with a :class:`~bayesfo.errors.DataWarning` (an instrument's log beside the data), and
+    refused only when no other sheet is left; error cells (``#N/A``) read as empty."""
+    import warnings
+
     import openpyxl
+
+    from ..errors import DataWarning
 
     try:
         book = openpyxl.load_workbook(path, read_only=True, data_only=True)
     except Exception as exc:  # noqa: BLE001 - any failure of the workbook library is bad input
         raise InputError(f"file '{path}' cannot be read as an Excel workbook: {exc}") from None
+    out, refused = [], []
     try:
-        out = []
         for ws in book.worksheets:
-            declared = (ws.max_row or 0, ws.max_column or 0)  # the sheet's dimension, if given
-            if declared[0] > EXCEL_MAX_LINES or declared[0] * declared[1] > EXCEL_MAX_CELLS:
-                raise _too_large(path, ws.title, *declared)
-            rows, cells_read = [], 0
             try:
-                for values in ws.iter_rows(values_only=True):
-                    cells = [_cell_text(v) for v in values]
-                    while cells and not cells[-1]:
-                        cells.pop()
-                    rows.append(cells)
-                    cells_read += len(values)
-                    if len(rows) > EXCEL_MAX_LINES or cells_read > EXCEL_MAX_CELLS:
-                        raise InputError(
-                            f"file '{path}', sheet '{ws.title}': more than "
-                            + (f"{EXCEL_MAX_LINES} rows" if len(rows) > EXCEL_MAX_LINES
-                               else f"{EXCEL_MAX_CELLS} cells")
-                            + f" (row {len(rows)} read), more than a data set needs; delete "
-                            "the rows beyond the data or save the table as CSV")
-            except InputError:
-                raise
-            except Exception as exc:  # noqa: BLE001 - a damaged sheet is bad input
-                raise InputError(f"file '{path}', sheet '{ws.title}' cannot be read: "
-                                 f"{exc}") from None
-            while rows and not rows[-1]:
-                rows.pop()
-            out.append((str(ws.title), rows))
-        return out
+                out.append((str(ws.title), _sheet_rows(path, ws)))
+            except _TooLarge as exc:
+                refused.append(str(exc))
     finally:
         book.close()
+    if refused and not out:
+        raise InputError(refused[0])
+    for why in refused:
+        warnings.warn(f"{why}; the sheet is left out", DataWarning, stacklevel=3)
+    return out
+
+
+class _TooLarge(InputError):
+    """A sheet beyond the caps of :func:`_openpyxl_sheets`."""
+
+
+_EXCEL_ERRORS = {"#N/A", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#NULL!"}
+
+
+def _sheet_rows(path: Path, ws) -> list[list[str]]:
+    declared = (ws.max_row or 0, ws.max_column or 0)  # the sheet's dimension, if given
+    if declared[0] > EXCEL_MAX_LINES or declared[0] * declared[1] > EXCEL_MAX_CELLS:
+        raise _TooLarge(str(_too_large(path, ws.title, *declared)))
+    # Some writers declare a wrong dimension (A1:A1); within the caps, read every row there is.
+    ws.reset_dimensions()
+    rows, cells_read = [], 0
+    try:
+        for values in ws.iter_rows(values_only=True):
+            cells = ["" if isinstance(v, str) and v in _EXCEL_ERRORS else _cell_text(v)
+                     for v in values]
+            while cells and not cells[-1]:
+                cells.pop()
+            rows.append(cells)
+            cells_read += len(values)
+            if len(rows) > EXCEL_MAX_LINES or cells_read > EXCEL_MAX_CELLS:
+                raise _TooLarge(
+                    f"file '{path}', sheet '{ws.title}': more than "
+                    + (f"{EXCEL_MAX_LINES} rows" if len(rows) > EXCEL_MAX_LINES
+                       else f"{EXCEL_MAX_CELLS} cells")
+                    + f" (row {len(rows)} read), more than a data set needs; delete the rows "
+                    "beyond the data or save the table as CSV")
+    except InputError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged sheet is bad input
+        raise InputError(f"file '{path}', sheet '{ws.title}' cannot be read: {exc}") from None
+    while rows and not rows[-1]:
+        rows.pop()
+    return rows
 
 
 def excel_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:

@@ -239,8 +239,12 @@ class Coordinates:
             return self._convert(theta)
 
     def coordinates(self, theta) -> np.ndarray:
-        """:meth:`values` in the drawn coordinates (log10 where :attr:`is_log`)."""
-        return to_coordinates(self.values(theta), self.is_log)
+        """:meth:`values` in the drawn coordinates (log10 where :attr:`is_log`; NaN, not
+        drawn, for a value that is not positive there, e.g. an inadmissible linear fit)."""
+        values = self.values(theta)
+        if self.physical:
+            values = np.where(self.is_log & ~(values > 0), np.nan, values)
+        return to_coordinates(values, self.is_log)
 
 
 def natural_coordinates(result) -> Coordinates:
@@ -272,8 +276,8 @@ def natural_coordinates(result) -> Coordinates:
 
     draws = convert(np.asarray(post.samples, float)) if k else np.empty((0, 0))
     priors = result.criteria.priors or {}
-    is_log = [n not in ORDER_SYMBOLS and bool(np.all(draws[:, i] > 0))
-              for i, n in enumerate(units)]
+    orders = set(s.exponent_params) | set(ORDER_SYMBOLS)
+    is_log = [n not in orders and bool(np.all(draws[:, i] > 0)) for i, n in enumerate(units)]
     is_log += [priors.get(n, {}).get("prior") == "log-uniform" for n in noise]
     sampled_units = result_units(result)
     labels = ([_label(n, log, u) for (n, u), log in zip(units.items(), is_log)]

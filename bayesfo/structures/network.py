@@ -148,11 +148,12 @@ class Network:
         """
 
         def power(order) -> str:
-            if fixed and order.names <= set(fixed):
-                value = float(order(fixed))
-                return "" if value == 0 else "s" if value == 1 else f"s^{value:g}"
-            text = str(order)
-            return f"s^{text}" if text.replace("_", "").isalnum() else f"s^({text})"
+            text = order.substitute(fixed or {})
+            try:
+                value = float(text)
+            except ValueError:  # an order left free
+                return f"s^{text}" if text.replace("_", "").isalnum() else f"s^({text})"
+            return "" if value == 0 else "s" if value == 1 else f"s^{value:g}"
 
         def modulus(t) -> str:
             if isinstance(t, Element):

@@ -699,3 +699,25 @@ def test_an_excel_sheet_of_too_many_rows_stops_at_the_cap(tmp_path, monkeypatch)
     monkeypatch.setattr(tables, "EXCEL_MAX_LINES", 100)
     with pytest.raises(InputError, match=r"sheet 'sweep': more than 100 rows \(row 101 read\)"):
         read_isotherms(path)
+
+
+def test_an_oversized_sheet_beside_the_data_is_left_out_with_a_warning(tmp_path):
+    """An instrument's log sheet with a stray far cell does not stop the data sheet from being
+    read; a warning names what was left out."""
+    openpyxl = pytest.importorskip("openpyxl")
+    from bayesfo.errors import DataWarning
+
+    path = tmp_path / "two.xlsx"
+    book = openpyxl.Workbook()
+    sheet = book.active
+    sheet.title = "sweep"
+    sheet.append(["Angular Frequency [rad/s]", "Storage Modulus [Pa]", "Loss Modulus [Pa]"])
+    for w, g in zip(W, G, strict=True):
+        sheet.append([float(w), float(g.real), float(g.imag)])
+    log = book.create_sheet("log")
+    log["XFD200000"] = "end"
+    book.save(path)
+    with pytest.warns(DataWarning, match=r"sheet 'log': the sheet spans 200000 rows .* left out"):
+        iso = read_isotherms(path)
+    assert iso[0].reading.format == "Excel workbook (sheet 'sweep')"
+    np.testing.assert_allclose(iso[0].data.response, G, rtol=1e-12)

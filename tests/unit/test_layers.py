@@ -148,3 +148,16 @@ def test_an_old_module_name_is_the_new_module(alias):
     new = importlib.import_module(target)
     public = [n for n in dir(new) if not n.startswith("_")]
     assert public and all(getattr(old, n) is getattr(new, n) for n in public)
+    private = [n for n in vars(new) if n.startswith("_") and not n.startswith("__")]
+    assert all(getattr(old, n) is getattr(new, n) for n in private)  # e.g. verdict._strength
+
+
+def test_the_moved_modules_of_subpackages_keep_their_names():
+    from bayesfo.batch.temperature import parse_temperature
+    from bayesfo.comparison.output import ranking_csv, write_outputs
+    from bayesfo.data.temperature import parse_temperature as moved_parse
+    from bayesfo.output.write import ranking_csv as moved_csv
+    from bayesfo.output.write import write_outputs as moved_write
+
+    assert parse_temperature is moved_parse
+    assert write_outputs is moved_write and ranking_csv is moved_csv

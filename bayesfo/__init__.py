@@ -1,19 +1,19 @@
 """bayesfo: uncertainty-aware model choice for fractional-order transfer functions.
 
 From a measured complex frequency response G(jω) to the answer "which model structure do these
-data support, and how sure can I be?". The data flow, module by module:
-
-``data`` (FrequencyResponse, CSV reader) → ``structures`` (model cards in ``models/*.toml``,
-evaluated by ``response``) → ``identify`` (methods 1–5, q grid, global optimisation: the seeds)
-→ ``inference`` (likelihood, certified posteriors, diagnostics, evidence) → ``comparison`` (run,
-criteria, results, output files) and ``tts`` (master curves: one posterior of a master
-structure and the isotherms' shift factors) → ``predictions`` (material functions with credible
-bands) and ``planning`` (the frequencies to measure next) → ``report`` and ``plotting``. ``options`` checks the options
-of a comparison before any work; ``outdir`` keeps each output directory the output of one run;
-``parallel`` runs worker processes; ``batch`` runs comparisons over many data sets; ``cli`` is
-the command line, one module per command. ``sine`` analyses one sine record and ``records``
-turns many record files into a frequency response; ``timedomain`` simulates fitted models in
-the time domain for validation; ``studies`` reruns the thesis' Monte Carlo studies.
+data support, and how sure can I be?". The data flow, package by package (the layers and the
+words: ``docs/architecture.md``):
+``data`` (FrequencyResponse, readers, temperatures) → ``structures`` (cards in
+``bayesfo/models/*.toml``, evaluated by ``structures.response``) → ``identify`` (methods 1–5,
+q grid, global optimisation: the seeds) → ``inference`` (likelihood, ``certified_posterior``,
+diagnostics, evidence) → ``predictions`` (material functions with credible bands) →
+``comparison`` (steps, schedule, criteria, results, ``load``) and ``tts`` (master curves) →
+``planning`` (the frequencies to measure next) → ``plotting`` → ``output`` (``write_outputs``,
+report, verdict) → ``batch`` (many data sets) and ``cli`` (the command line). ``options``
+checks the options of a comparison before any work; ``outdir`` keeps each output directory the
+output of one run; ``parallel`` is the executor; ``timeseries`` turns sine records into a
+frequency response and simulates fitted models in time; ``studies`` reruns the thesis' Monte
+Carlo studies.
 
 Example
 -------
@@ -49,7 +49,8 @@ _LAZY = {"compare": "comparison", "write_outputs": "output", "load": "comparison
 
 #: Subpackages reachable as attributes without an import of their own (``bf.plotting``), loaded
 #: on first use: matplotlib is imported only by a program that draws.
-_LAZY_MODULES = ("plotting", "inference", "identify", "batch", "predictions", "tts")
+_LAZY_MODULES = ("plotting", "inference", "identify", "batch", "predictions", "tts", "output",
+                 "timeseries", "planning")
 
 
 def __getattr__(name):

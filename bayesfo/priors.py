@@ -5,7 +5,7 @@ interval (:meth:`ppf`, the prior transform of nested samplers) and states its su
 (:attr:`bounds`), so an MCMC sampler and a nested sampler use the very same prior. All priors are
 proper: the evidence depends on them.
 
-Priors are declared in the structure cards (``models/*.toml``) as tables such as
+Priors are declared in the structure cards (``bayesfo/models/*.toml``) as tables such as
 ``{ prior = "log-uniform", low = 1e-4, high = 1e4 }`` and apply to parameters on the scaled data
 (ω/ω_ref, G/g_ref; see :mod:`bayesfo.structures`).
 """

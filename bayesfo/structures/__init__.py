@@ -1,4 +1,4 @@
-"""Model structures, declared as cards in ``models/*.toml`` and evaluated vectorised.
+"""Model structures, declared as cards in ``bayesfo/models/*.toml`` and evaluated vectorised.
 
 A :class:`Structure` is a transfer function written as a ratio of power terms,
 ``Σ c_i s^{e_i} / Σ d_j s^{f_j}``, whose coefficients and exponents are parameters or constants,

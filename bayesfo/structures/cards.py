@@ -1,4 +1,4 @@
-"""Structure cards (``models/*.toml``) and the library they make: reading and checking cards,
+"""Structure cards (``bayesfo/models/*.toml``) and the library they make: reading and checking cards,
 expanding max-order families and variants, and resolving names and shortcuts."""
 
 from __future__ import annotations

@@ -150,7 +150,10 @@ def summary_rows(summary: dict) -> list[dict]:
         q = params.get(q_name, {}) if q_name else {}
         row.update(best=name == best, q_parameter=q_name, q_hdi_low=q.get("hdi_low"),
                    q_hdi_high=q.get("hdi_high"), q_map=q.get("map"), noise=s.get("noise"),
-                   warnings="; ".join(s.get("warnings", [])))
+                   warnings="; ".join(s.get("warnings", [])),
+                   # For the terminal table (not columns of batch_summary.csv): whether the
+                   # structure describes the data, and every order by its symbol.
+                   fits=table_row.get("fits"), orders=table_row.get("orders") or "")
         rows.append(row)
     return rows
 

@@ -98,21 +98,34 @@ def run(args) -> int:
 
 
 def _print_table(result: BatchResult) -> None:
+    """A line per data set: its best structure by ln Z, P, every order's mean, whether the
+    structure describes the data (fits: the posterior predictive checks, as ``compare``
+    prints), and the status; then how many data sets no structure describes."""
+    from ..comparison.table import order_means
+
     width = max([7] + [len(o.dataset.id) for o in result.outcomes])
-    print(f"{'dataset':<{width}} {'T [°C]':>7}  {'best':<14} {'P':>6}  {'q (94% HDI)':<26} status")
+    means = {o.dataset.id: order_means(next((r for r in o.rows if r.get("best")), {}))
+             for o in result.outcomes if o.status == OK}
+    o_width = max([13] + [len(v) for v in means.values()])
+    b_width = max([14] + [len(r["structure"]) for o in result.outcomes for r in o.rows
+                          if r.get("best")])
+    print(f"{'dataset':<{width}} {'T [°C]':>7}  {'best':<{b_width}} {'P':>6}  "
+          f"{'orders (mean)':<{o_width}} {'fits':>6}  status")
+    misfit = []
     for o in result.outcomes:
         t = "" if o.dataset.temperature is None else f"{o.dataset.temperature:g}"
         if o.status != OK:
-            print(f"{o.dataset.id:<{width}} {t:>7}  {'-':<14} {'-':>6}  {'-':<26} "
-                  f"{o.status.replace('_', ' ')}")
+            print(f"{o.dataset.id:<{width}} {t:>7}  {'-':<{b_width}} {'-':>6}  {'-':<{o_width}} "
+                  f"{'-':>6}  {o.status.replace('_', ' ')}")
             continue
         best = next((r for r in o.rows if r.get("best")), None)
         if best is None:
             print(f"{o.dataset.id:<{width}} {t:>7}  no ranked structure")
             continue
         p = best.get("posterior_probability")
-        q = "" if best.get("q_mean") is None else (
-            f"{best['q_mean']:.3f} [{best['q_hdi_low']:.3f}, {best['q_hdi_high']:.3f}]")
+        fits = best.get("fits")
+        if fits == "no":
+            misfit.append(o.dataset.id)
         flags = "reused" if o.reused else "ok"
         if not best.get("converged"):
             # The report says what to do (more steps, another prior); name it, and the best
@@ -124,7 +137,10 @@ def _print_table(result: BatchResult) -> None:
                                        / "report.html").exists() else "summary.json"
             flags += (", not converged" + (f" (best certified: {certified})" if certified else "")
                       + f"; see {o.dataset.id}/{report}")
-        print(f"{o.dataset.id:<{width}} {t:>7}  {best['structure']:<14} "
-              f"{'-' if p is None else f'{p:.3f}':>6}  {q:<26} {flags}")
-
-
+        print(f"{o.dataset.id:<{width}} {t:>7}  {best['structure']:<{b_width}} "
+              f"{'-' if p is None else f'{p:.3f}':>6}  {means[o.dataset.id]:<{o_width}} "
+              f"{(fits or '-').replace('no', 'NO'):>6}  {flags}")
+    if misfit:
+        print(f"fits NO: on {len(misfit)} of {len(result.outcomes)} data sets the best structure "
+              "fails the posterior predictive checks (none of the candidates describes those "
+              "data; see each report's verdict): " + ", ".join(misfit))

@@ -521,6 +521,31 @@ def test_batch_table_points_to_the_report_when_the_best_is_not_certified(capsys,
     assert line.endswith("ok, not converged (best certified: voigt); see Tp017p85C/report.html")
 
 
+
+def test_batch_table_shows_every_order_and_whether_the_best_fits(capsys, tmp_path):
+    from types import SimpleNamespace
+
+    from bayesfo.batch.task import OK
+    from bayesfo.cli.batch import _print_table
+
+    def outcome(name, t, orders, fits):
+        rows = [{"structure": "fractional_kelvin_voigt", "rank": 1, "best": True,
+                 "converged": True, "posterior_probability": 1.0, "orders": orders,
+                 "fits": fits}]
+        return SimpleNamespace(dataset=SimpleNamespace(id=name, temperature=t), status=OK,
+                               rows=rows, reused=False)
+
+    outcomes = [outcome("Tm040C", -40.0, "α 0.901 [0.88–0.92]; β 0.120 [0.11–0.13]", "no"),
+                outcome("Tp020C", 20.0, "α 0.589 [0.586–0.592]; β 0.138 [0.13–0.14]", "yes")]
+    _print_table(SimpleNamespace(outcomes=outcomes, out_dir=tmp_path))
+    header, cold, warm, summary = capsys.readouterr().out.splitlines()
+    assert "orders (mean)" in header and header.split()[-2:] == ["fits", "status"]
+    assert "α 0.901 β 0.120" in cold and cold.split()[-2:] == ["NO", "ok"]
+    assert "α 0.589 β 0.138" in warm and warm.split()[-2:] == ["yes", "ok"]
+    assert summary.startswith("fits NO: on 1 of 2 data sets the best structure fails")
+    assert summary.endswith(": Tm040C")
+
+
 def test_compare_into_a_data_set_of_a_batch_says_the_batch_summary_is_stale(tmp_path, run_cli):
     """compare --out BATCH/ID replaces that data set's run and its batch record (so the batch
     redoes it when run again) and says that BATCH/batch_summary.csv, which it does not touch,

@@ -340,10 +340,14 @@ def _cell_text(v) -> str:
     return str(v).strip()
 
 
-def _too_large(path: Path, sheet: str, rows: int, cols: int) -> InputError:
+class _TooLarge(InputError):
+    """A sheet beyond the caps of :func:`_openpyxl_sheets`."""
+
+
+def _too_large(path: Path, sheet: str, rows: int, cols: int) -> _TooLarge:
     from openpyxl.utils import get_column_letter
 
-    return InputError(
+    return _TooLarge(
         f"file '{path}', sheet '{sheet}': the sheet spans {rows} rows × {cols} columns (to cell "
         f"{get_column_letter(cols)}{rows}), more than a data set needs (at most "
         f"{EXCEL_MAX_LINES} rows and {EXCEL_MAX_CELLS} cells); delete the cells beyond the "
@@ -381,17 +385,13 @@ def _openpyxl_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
     return out
 
 
-class _TooLarge(InputError):
-    """A sheet beyond the caps of :func:`_openpyxl_sheets`."""
-
-
 _EXCEL_ERRORS = {"#N/A", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#NULL!"}
 
 
 def _sheet_rows(path: Path, ws) -> list[list[str]]:
     declared = (ws.max_row or 0, ws.max_column or 0)  # the sheet's dimension, if given
     if declared[0] > EXCEL_MAX_LINES or declared[0] * declared[1] > EXCEL_MAX_CELLS:
-        raise _TooLarge(str(_too_large(path, ws.title, *declared)))
+        raise _too_large(path, ws.title, *declared)
     # Some writers declare a wrong dimension (A1:A1); within the caps, read every row there is.
     ws.reset_dimensions()
     rows, cells_read = [], 0

@@ -1,7 +1,8 @@
 """Time–temperature superposition (master curves) as one joint posterior of a master structure
 and the isotherms' shift factors, with the WLF and Arrhenius laws fitted to the shifts."""
 
-from .joint import MasterCurve, ShiftedStructure, mastercurve
+from .joint import MasterCurve, mastercurve
 from .laws import arrhenius, wlf
+from .model import ShiftedStructure
 
 __all__ = ["MasterCurve", "ShiftedStructure", "arrhenius", "mastercurve", "wlf"]

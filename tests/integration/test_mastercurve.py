@@ -15,8 +15,8 @@ from bayesfo.data import FrequencyResponse
 from bayesfo.errors import InputError
 from bayesfo.structures import get_structure
 from bayesfo.tts import arrhenius, wlf
-from bayesfo.tts.joint import shift_name
 from bayesfo.tts.laws import _fit_laws
+from bayesfo.tts.model import shift_name
 
 ZENER = [10.0, 1.0, 0.1, 0.6]  # a1, b0, b1, q (compliance form)
 W = np.logspace(-1, 2, 12)
@@ -207,7 +207,7 @@ def test_vertical_shifts_are_recovered_and_the_density_factor_is_exact():
 
 
 def test_the_density_correction_is_the_ratio_of_absolute_temperatures():
-    from bayesfo.tts.joint import ShiftedStructure
+    from bayesfo.tts.model import ShiftedStructure
 
     shifted = ShiftedStructure(get_structure("zener"), tuple(TEMPS), 2, np.zeros(1, int),
                                vertical="density")

@@ -15,7 +15,9 @@ def add_parser(subparsers):
                     "0) to the posterior median G', G'' of a structure or an average, and "
                     "write it with its largest relative error over the data window beside the "
                     "width of the model's credible band.")
-    p.add_argument("directory", metavar="DIR", help="output directory of bayesfo compare")
+    p.add_argument("directory", metavar="DIR",
+                   help="output directory of bayesfo compare, or of bayesfo mastercurve (the "
+                        "series at the reference temperature, with the shift law)")
     p.add_argument("--format", required=True, choices=FORMATS,
                    help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY) or ansys "
                         "(TB,PRONY with TBDATA)")
@@ -58,6 +60,17 @@ def run(args) -> int:
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
           f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
+    law = prony.shift_law
+    if law is not None:
+        from ..tts.joint import LAW_MISS
+
+        print(f"with the {'WLF' if law['name'] == 'wlf' else 'Arrhenius'} shift law at "
+              f"T_ref = {law['reference_temperature']:g} °C (" + ", ".join(
+                  f"{k} = {v:.6g}" for k, v in law["parameters"].items()) + ")")
+        if law["chi2_per_dof"] > LAW_MISS:
+            print(f"note: the shift law misses the master curve's shifts beyond their "
+                  f"uncertainty (chi2/dof {law['chi2_per_dof']:.3g}): the finite-element model "
+                  "will be off at some temperatures; see the master curve's notes")
     if error > prony.band_rel_halfwidth:
         more = (f"--terms {min(100, 2 * args.terms)}" if args.terms is not None
                 else f"--per-decade {min(10, 2 * args.per_decade)}")

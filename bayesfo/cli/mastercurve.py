@@ -20,7 +20,8 @@ def add_parser(subparsers):
                     "(a certified posterior, as compare computes it), fit the WLF and "
                     "Arrhenius laws to the shifts, test whether superposition holds (van "
                     "Gurp–Palmen), and write summary.json, master.csv (the reduced data, which "
-                    "'bayesfo compare' reads), figures/mastercurve.png and "
+                    "'bayesfo compare' reads), the joint posterior (STRUCTURE.nc, which "
+                    "'bayesfo predict' and 'bayesfo export' read), figures/mastercurve.png and "
                     "figures/van_gurp_palmen.png.")
     p.add_argument("data", nargs="+", metavar="DATA",
                    help="files of isotherms: a lab export with several (TRIOS steps, a "
@@ -93,7 +94,9 @@ def run(args) -> int:
     load_libraries(() if args.no_figures else ("png",))
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
                      noise=args.noise, vertical=args.vertical, seed=args.seed)
-    summary = {"data": mc.data.to_dict(), **mc.to_dict()}
+    from ..tts.stored import summary_fields
+
+    summary = {"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)}
     master = mc.master_data()
     law = mc.shift_law()
     comments = [f"master curve at {mc.reference_temperature:g} C of {len(mc.temperatures)} "
@@ -109,6 +112,12 @@ def run(args) -> int:
         (stage / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False)
                                             + "\n")
         (stage / "master.csv").write_text(master.to_csv_text(comments))
+        from ..inference import save_netcdf
+        from ..output.write import _without_distributed
+        from ..tts.stored import netcdf_of
+
+        with _without_distributed():
+            save_netcdf(netcdf_of(mc), stage / f"{mc.structure}.nc")
         if not args.no_figures:
             from ..plotting.mastercurve import plot_mastercurve
             from ..plotting.output import save_figure
@@ -158,6 +167,6 @@ def _print(mc, out) -> None:
         print(describe(vgp))  # a failing or untested test is among the notes
     for n in mc.notes:
         print(f"note: {n}")
-    print(f"wrote {out}/summary.json, master.csv" + (
+    print(f"wrote {out}/summary.json, master.csv, {mc.structure}.nc" + (
         "" if not (out / "figures").exists()
         else " and figures/mastercurve.png, figures/van_gurp_palmen.png"))

@@ -19,7 +19,8 @@ def add_parser(subparsers):
     p = subparsers.add_parser(
         "predict", help="a material function (G(t), J(t), G', G'', spectra) with its credible "
                         "band, from the output directory of a comparison")
-    p.add_argument("directory", metavar="DIR", help="output directory of bayesfo compare")
+    p.add_argument("directory", metavar="DIR",
+                   help="output directory of bayesfo compare or bayesfo mastercurve")
     p.add_argument("--quantity", required=True, choices=tuple(QUANTITIES), metavar="Q",
                    help="one of " + ", ".join(QUANTITIES))
     x = p.add_mutually_exclusive_group(required=True)
@@ -36,6 +37,10 @@ def add_parser(subparsers):
     out = p.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print the prediction as JSON")
     out.add_argument("--out", metavar="FILE.csv", help="write the prediction as CSV")
+    p.add_argument("--temperature", type=float, default=None, metavar="T",
+                   help="[°C] of a master curve: the function at T (within the isotherms' "
+                        "temperatures) instead of the reference temperature, each draw with its "
+                        "own shift factors")
     p.add_argument("--seed", type=int, default=0, help="seed of the draws used (default 0)")
     return p
 
@@ -76,10 +81,11 @@ def run(args) -> int:
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     try:
         p = predict(result, args.quantity, x, structure=args.structure, average=args.average,
-                    seed=args.seed)
+                    seed=args.seed, temperature=args.temperature)
     except InputError as exc:  # the API's words, in the command line's
         text = str(exc).replace("predict: ", "", 1)
-        raise InputError(text.replace("average must be", "--average must be")) from None
+        text = text.replace("average must be", "--average must be")
+        raise InputError(f"--{text}" if text.startswith("temperature ") else text) from None
     if args.json:
         print(json.dumps(p.to_dict(), indent=1))
         return 0

@@ -82,10 +82,12 @@ def netcdf_for(comparison: Comparison, result: StructureResult):
 
 
 # ---------------------------------------------------------------------- reading
-def load(directory, *, models=()) -> Comparison:
+def load(directory, *, models=()):
     """The :class:`Comparison` that wrote ``directory`` (``bf.write_outputs`` or
     ``bayesfo compare --out DIR``), read from its ``summary.json`` and NetCDF files without
-    running anything.
+    running anything; or the :class:`~bayesfo.tts.MasterCurve` of a directory that
+    ``bayesfo mastercurve`` wrote (its shifts, laws, checks and joint posterior, from which
+    :func:`bayesfo.predict` and :func:`bayesfo.predictions.prony_series` follow).
 
     Everything comes from those files: the data (frequencies, response, σ, held-out points,
     kind, units, name, source and notes), each structure's posterior (the draws, the
@@ -147,6 +149,8 @@ def _load(d: Path, models) -> Comparison:
         raise InputError(f"'{path}': cannot be read ({exc.strerror or exc})") from None
     library = load_library(extra=list(models)) if models else default_library()
     try:
+        if isinstance(summary, dict) and "shift_factors" in summary:
+            return _mastercurve(summary, d, library)
         return _comparison(summary, d, library)
     except InputError:
         raise
@@ -217,18 +221,21 @@ def _data(summary: dict, idata, path: Path) -> tuple[FrequencyResponse, Frequenc
     return data, holdout
 
 
+def _check_name(name, d: Path) -> None:
+    """A structure name is a file stem in this directory: one that reaches elsewhere ("../x",
+    "a/b") was not written by a run, and no file outside the directory is opened for it."""
+    if not isinstance(name, str) or not name or name in (".", "..") \
+            or any(c in name for c in "/\\\0") or Path(name).name != name:
+        raise InputError(f"'{d / 'summary.json'}': structure name {name!r} is not a file "
+                         "name in the directory; the file was not written by a run")
+
+
 def _comparison(summary: dict, d: Path, library) -> Comparison:
     from ..structures import get_structure
 
     entries = summary["structures"]
     for s in entries:
-        # A name is a file stem in this directory: one that reaches elsewhere ("../x", "a/b")
-        # was not written by a run, and no file outside the directory is opened for it.
-        name = s.get("name")
-        if not isinstance(name, str) or not name or name in (".", "..") \
-                or any(c in name for c in "/\\\0") or Path(name).name != name:
-            raise InputError(f"'{d / 'summary.json'}': structure name {name!r} is not a file "
-                             "name in the directory; the file was not written by a run")
+        _check_name(s.get("name"), d)
     files = {}
     for s in entries:
         if "error" not in s:
@@ -266,6 +273,69 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
                                        _criteria(s, idata)))
     return Comparison(data, tuple(results), int(summary["seed"]),
                       ranked_by=summary.get("ranked_by", "log_evidence"), holdout=holdout)
+
+
+def _mastercurve(summary: dict, d: Path, library):
+    """The :class:`~bayesfo.tts.MasterCurve` that ``bayesfo mastercurve`` wrote into ``d``
+    (what it stores: :mod:`bayesfo.tts.stored`)."""
+    from ..structures import get_structure
+    from ..tts import MasterCurve
+    from ..tts.model import ShiftedStructure
+
+    where = d / "summary.json"
+    if "posterior" not in summary or "isotherms" not in summary:
+        raise InputError(f"'{where}': a master curve written by an earlier version of bayesfo, "
+                         "without its posterior; run bayesfo mastercurve again")
+    name = summary["structure"]
+    _check_name(name, d)
+    path = d / f"{name}.nc"
+    idata = _read_netcdf(path, name)
+    try:
+        master = get_structure(name, library)
+    except InputError as exc:
+        raise InputError(f"'{where}': structure '{name}' is not in the library ({exc}); give "
+                         "its card with models=") from None
+    meta, iso = summary["data"], summary["isotherms"]
+    obs = idata.observed_data
+    omega = np.asarray(obs["omega"].values, dtype=float)
+    response = np.asarray(obs["G_real"].values, dtype=float) \
+        + 1j * np.asarray(obs["G_imag"].values, dtype=float)
+    point = np.atleast_1d(np.asarray(obs.attrs.get("point_isotherm", []), dtype=int))
+    counts = [int(m["n_frequencies"]) for m in iso]
+    if point.shape != omega.shape or point.size != sum(counts) \
+            or np.bincount(point, minlength=len(iso)).tolist() != counts:
+        raise InputError(f"'{path}': its points do not match the isotherms summary.json lists")
+    sigma = obs.attrs.get("sigma")
+    sigma = None if sigma is None else np.atleast_1d(np.asarray(sigma, dtype=float))
+    common = dict(kind=meta["kind"], units=meta.get("units") or "",
+                  source=meta.get("path") or "")
+    isotherms = tuple(
+        FrequencyResponse(omega[point == i], response[point == i],
+                          None if sigma is None else sigma[point == i], name=m["name"],
+                          **common)
+        for i, m in enumerate(iso))
+    joint = FrequencyResponse(omega, response, sigma, name=meta["name"],
+                              notes=tuple(meta["notes"]), distinct_frequencies=False, **common)
+    temperatures = tuple(float(m["temperature"]) for m in iso)
+    vertical = summary.get("vertical", "none")
+    shifted = ShiftedStructure(master, temperatures,
+                               temperatures.index(float(summary["reference_temperature"])),
+                               point, None, vertical)
+    post = _posterior(summary["posterior"], idata, joint, path)
+    if post.param_names[:shifted.n_params] != shifted.param_names:
+        raise InputError(f"'{path}': its parameters are not those of the master curve of "
+                         f"{name} over the isotherms summary.json lists")
+    theta = post.samples[:, :shifted.n_params]
+    return MasterCurve(
+        structure=name, temperatures=temperatures,
+        reference_temperature=float(summary["reference_temperature"]),
+        shift_draws=shifted.log_shifts(theta), master_draws=theta[:, :master.n_params],
+        posterior=post, log_evidence=_num(summary["log_evidence"]),
+        log_evidence_err=_num(summary["log_evidence_err"]), laws=summary["laws"], data=joint,
+        isotherms=isotherms, notes=tuple(summary["notes"]), ranking=tuple(summary["structures"]),
+        tts_checks=summary["tts_checks"], vertical=vertical,
+        vertical_draws=None if vertical == "none" else shifted.log_vertical(theta),
+        master=master)
 
 
 def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> PosteriorResult:

@@ -119,13 +119,16 @@ class Prediction:
 
 
 def predict(result, quantity: str, x, *, structure: str | None = None,
-            average: str | None = None, seed: int = 0) -> Prediction:
-    """A material function of a comparison's structure, or of an average, with its band.
+            average: str | None = None, seed: int = 0,
+            temperature: float | None = None) -> Prediction:
+    """A material function of a comparison's structure, or of an average, or of a master
+    curve, with its band.
 
     Parameters
     ----------
-    result : Comparison
-        From :func:`bayesfo.compare` or :func:`bayesfo.load`, on modulus or compliance data.
+    result : Comparison or MasterCurve
+        From :func:`bayesfo.compare`, :func:`bayesfo.mastercurve` or :func:`bayesfo.load`, on
+        modulus or compliance data.
     quantity : str
         One of :data:`QUANTITIES`: ``storage``, ``loss``, ``tan_delta``,
         ``storage_compliance``, ``loss_compliance``, ``complex_viscosity`` (at angular
@@ -141,6 +144,11 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
     seed : int
         Seeds the choice of draws where a posterior has more than :data:`MAX_DRAWS`, and the
         mixing of an average.
+    temperature : float, optional
+        [°C] For a master curve: the material function at this temperature instead of the
+        reference temperature, G(ω; T) = G_ref(a_T ω)/b_T and G(t; T) = G_ref(t/a_T)/b_T with
+        each draw's own shifts (:meth:`~bayesfo.tts.MasterCurve.shifts_at`), so the band
+        carries the shifts' uncertainty; within the isotherms' temperatures.
 
     Returns
     -------
@@ -150,7 +158,8 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
     ------
     InputError
         An unknown quantity or structure, x not positive and finite, data that are not a
-        modulus or a compliance, or an average with nothing to average.
+        modulus or a compliance, an average with nothing to average, or a temperature outside
+        a master curve's isotherms (or given for a comparison).
 
     Examples
     --------
@@ -169,6 +178,11 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
     if structure is not None and average is not None:
         raise InputError("predict: give a structure or an average, not both")
     rng = np.random.default_rng(seed)
+    if hasattr(result, "shift_draws"):
+        return _predict_master(result, quantity, x, structure, average, temperature, rng)
+    if temperature is not None:
+        raise InputError("predict: a temperature applies to a master curve only (bayesfo "
+                         "mastercurve); a comparison describes the data at their own")
     notes = []
     if average is None:
         name = structure if structure is not None else _best(result)
@@ -203,6 +217,47 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
         structure=next(iter(weights)) if average is None else None,
         weights=dict(weights) if average is not None else None, average=average,
         notes=tuple(notes), values=values)
+
+
+#: How each kind of quantity scales with the vertical shift b_T and the horizontal a_T
+#: (G(ω; T) = G_ref(a_T ω)/b_T): powers of (a_T, b_T).
+_SCALING = {"modulus": (0, -1), "compliance": (0, 1), "viscosity": (1, -1), "none": (0, 0)}
+
+
+def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) -> Prediction:
+    """:func:`predict` of a master curve: its master structure's draws, each with its own
+    shifts at ``temperature`` (the reference temperature by default)."""
+    if average is not None:
+        raise InputError("predict: a master curve holds the posterior of one master "
+                          f"structure ({mc.structure}), so there is nothing to average")
+    if structure is not None and structure != mc.structure:
+        raise InputError(f"predict: the master curve's structure is {mc.structure!r}, not "
+                          f"{structure!r}")
+    domain = QUANTITIES[quantity][0]
+    n = mc.master_draws.shape[0]
+    rows = (np.sort(rng.choice(n, size=MAX_DRAWS, replace=False)) if n >= MAX_DRAWS
+            else rng.choice(n, size=MAX_DRAWS, replace=True))
+    theta = np.asarray(mc.master_draws, float)[rows]
+    t = mc.reference_temperature if temperature is None else temperature
+    log_a, log_b = mc.shifts_at(t)
+    log_a, log_b = log_a[rows], log_b[rows]
+    a = 10.0 ** log_a[:, None]
+    x_ref = x[None, :] * a if domain == "omega" else x[None, :] / a
+    values = _evaluate(mc.master, theta, quantity, x_ref)
+    pa, pb = _SCALING[QUANTITIES[quantity][2]]
+    if pa or pb:
+        values = values * 10.0 ** (pa * log_a + pb * log_b)[:, None]
+    notes = [] if temperature is None else [
+        f"at {float(t):g} °C from the master curve at {mc.reference_temperature:g} °C with each "
+        f"draw's shifts (log10 a_T median {np.median(log_a):.3g}"
+        + ("" if mc.vertical == "none" else f", log10 b_T median {np.median(log_b):.3g}")
+        + ")"]
+    median, lo, hi = _band(values)
+    window = mc.reduced_omega() / 10.0 ** float(np.median(log_a))
+    return Prediction(
+        quantity=quantity, unit=_unit(quantity, mc.data), x=x, x_unit=X_UNITS[domain],
+        median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, window),
+        structure=mc.structure, notes=tuple(notes), values=values)
 
 
 # ---------------------------------------------------------------------------- checks
@@ -340,25 +395,33 @@ def evaluate(structure, theta, quantity: str, x) -> np.ndarray:
 
 
 def _evaluate(structure, theta, quantity: str, x) -> np.ndarray:
+    """``quantity`` for each parameter set at ``x``: shared by all sets (shape (n_x,)) or each
+    set's own (shape (n_sets, n_x), e.g. frequencies shifted by each draw's a_T)."""
     domain = QUANTITIES[quantity][0]
+    own = np.ndim(x) == 2
     with np.errstate(all="ignore"):
         if domain == "omega":
-            c = structure.laplace(theta, 1j * x)  # the compliance C(iω)
+            c = structure.laplace(theta, 1j * x, per_set=own)  # the compliance C(iω)
             g = 1.0 / c
             return {"storage": lambda: g.real, "loss": lambda: g.imag,
                     "tan_delta": lambda: g.imag / g.real,
                     "storage_compliance": lambda: c.real, "loss_compliance": lambda: -c.imag,
                     "complex_viscosity": lambda: np.abs(g) / x}[quantity]()
         if domain == "tau":
-            c = structure.laplace(theta, -1.0 / x + 0j)  # on the upper side of the cut
+            c = structure.laplace(theta, -1.0 / x + 0j, per_set=own)  # upper side of the cut
             # s^α at s = e^{iπ}/τ: np.log of a negative real with +0 imaginary part is ln|s|+iπ.
             if quantity == "relaxation_spectrum":
                 return (1.0 / c).imag / np.pi
             return -c.imag / np.pi
-        out = np.empty((theta.shape[0], x.size))
+        out = np.empty((theta.shape[0], np.shape(x)[-1]))
         for i in range(0, theta.shape[0], _CHUNK):
             part = theta[i:i + _CHUNK]
-            if quantity == "relaxation_modulus":
+            if own:
+                f = ((lambda s: 1.0 / (structure.laplace(part, s, per_set=True) * s))
+                     if quantity == "relaxation_modulus"
+                     else (lambda s: structure.laplace(part, s, per_set=True) / s))
+                out[i:i + _CHUNK] = laplace.invert_per_set(f, x[i:i + _CHUNK])
+            elif quantity == "relaxation_modulus":
                 out[i:i + _CHUNK] = laplace.invert(lambda s: 1.0 / (structure.laplace(part, s) * s), x)
             else:
                 out[i:i + _CHUNK] = laplace.invert(lambda s: structure.laplace(part, s) / s, x)

@@ -56,3 +56,26 @@ def invert(transform, t, n: int = NODES) -> np.ndarray:
     with np.errstate(over="ignore", invalid="ignore"):
         values = transform(s)
         return np.real(np.sum(w * np.exp(t[:, None] * s) * values, axis=-1))
+
+
+def invert_per_set(transform, t) -> np.ndarray:
+    """f(t) from its Laplace transform where each parameter set has its own times.
+
+    Parameters
+    ----------
+    transform : callable
+        F(s) for complex s of shape (n_sets, n_t, n), row i belonging to parameter set i
+        alone: returns an array of the same shape.
+    t : array_like, shape (n_sets, n_t)
+        Times > 0 of each set.
+
+    Returns
+    -------
+    ndarray, shape (n_sets, n_t)
+    """
+    t = np.asarray(t, dtype=float)
+    s, w = talbot_nodes(t.ravel(), NODES)
+    s, w = s.reshape(*t.shape, -1), w.reshape(*t.shape, -1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        values = transform(s)
+        return np.real(np.sum(w * np.exp(t[..., None] * s) * values, axis=-1))

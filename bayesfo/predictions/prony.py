@@ -14,6 +14,14 @@ Formats: ``csv`` (``tau_s,g_i`` with ``#`` lines for G∞, G0, the unit and the 
 (``*VISCOELASTIC, TIME=PRONY``: g_i/G0, k_i = 0, τ_i; G0 in a comment, for ``*ELASTIC,
 MODULI=INSTANTANEOUS``) and ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` pairs of α_i = g_i/G0
 and τ_i).
+
+A series fitted to a master curve is the material at the reference temperature, and its shift
+law goes with it (the law of larger support, posterior means): Abaqus ``*TRS`` (``WLF``:
+θ0, C1, C2; ``ARRHENIUS``: θ0, E0, R, θZ = −273.15 for temperatures in °C), ANSYS
+``TB,SHIFT`` (``WLF``: T_r, C1, C2, whose log10 A = C1 (T − T_r)/(C2 + T − T_r) is the
+inverse of a_T; Arrhenius as the two-constant Tool–Narayanaswamy form ``TN``: T_r and
+E_a/R, in kelvin), and the csv's comment lines; the law's fit to the shifts and its
+temperature range are stated beside it.
 """
 
 from __future__ import annotations
@@ -24,6 +32,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+
+#: Gas constant [J/(mol K)] and the kelvin of 0 °C, for the Arrhenius shift law.
+GAS_CONSTANT = 8.314462618
+KELVIN = 273.15
 
 FORMATS = ("csv", "abaqus", "ansys")
 #: Decades of relaxation times beyond the data window on each side.
@@ -51,6 +63,10 @@ class Prony:
         medians over the window.
     band_rel_halfwidth : float
         The smallest relative half-width of the model's 94 % band of G(t) over the window.
+    shift_law : dict or None
+        For a master curve: ``{"name": "wlf" | "arrhenius", "reference_temperature",
+        "parameters": {NAME: value}, "temperatures": (min, max), "chi2_per_dof"}`` (values
+        in °C and J/mol, posterior means), written with the series.
     """
 
     tau: np.ndarray
@@ -62,6 +78,7 @@ class Prony:
     max_rel_error_modulus: float
     max_rel_error_relaxation: float
     band_rel_halfwidth: float
+    shift_law: dict | None = None
 
     @property
     def g_0(self) -> float:
@@ -88,6 +105,9 @@ class Prony:
                 f" (G', G'': {self.max_rel_error_modulus:.3g}; G(t): "
                 f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of G(t) is at least "
                 f"+-{self.band_rel_halfwidth:.3g} (relative) there"]
+        law = self.shift_law
+        if law is not None:
+            head.append(self._law_text())
         if fmt == "csv":
             lines = [f"# {h}" for h in head] + ["tau_s,g_i"]
             lines += [f"{t:.10g},{g:.10g}" for t, g in zip(self.tau, self.g, strict=True)]
@@ -98,6 +118,14 @@ class Prony:
             lines.append("*VISCOELASTIC, TIME=PRONY")
             lines += [f"{g / self.g_0:.10g}, 0., {t:.10g}"
                       for t, g in zip(self.tau, self.g, strict=True)]
+            if law is not None:
+                p, t_ref = law["parameters"], law["reference_temperature"]
+                if law["name"] == "wlf":
+                    lines += ["*TRS, DEFINITION=WLF", f"{t_ref:.10g}, {p['C1']:.10g}, "
+                                                      f"{p['C2']:.10g}"]
+                else:
+                    lines += ["*TRS, DEFINITION=ARRHENIUS",
+                              f"{t_ref:.10g}, {p['Ea']:.10g}, {GAS_CONSTANT:.10g}, {-KELVIN:.10g}"]
         else:  # ansys
             lines = [f"! {h}" for h in head]
             lines.append(f"! instantaneous modulus G0 = {self.g_0:.10g}")
@@ -107,7 +135,30 @@ class Prony:
             for start in range(0, len(pairs), 6):  # TBDATA takes six values per command
                 chunk = ",".join(f"{v:.10g}" for v in pairs[start:start + 6])
                 lines.append(f"TBDATA,{start + 1},{chunk}")
+            if law is not None:
+                p, t_ref = law["parameters"], law["reference_temperature"]
+                if law["name"] == "wlf":
+                    lines += ["TB,SHIFT,1,,3,WLF",
+                              f"TBDATA,1,{t_ref:.10g},{p['C1']:.10g},{p['C2']:.10g}"]
+                else:
+                    lines += ["! Arrhenius as Tool-Narayanaswamy: ln A = (Ea/R) (1/T_r - 1/T), "
+                              "T in kelvin", "TB,SHIFT,1,,2,TN",
+                              f"TBDATA,1,{t_ref + KELVIN:.10g},{p['Ea'] / GAS_CONSTANT:.10g}"]
         return "\n".join(lines) + "\n"
+
+    def _law_text(self) -> str:
+        law = self.shift_law
+        p = law["parameters"]
+        lo, hi = law["temperatures"]
+        if law["name"] == "wlf":
+            form = (f"WLF log10 a_T = -C1 (T - T_ref)/(C2 + T - T_ref), T_ref = "
+                    f"{law['reference_temperature']:.10g} C, C1 = {p['C1']:.10g}, "
+                    f"C2 = {p['C2']:.10g} C")
+        else:
+            form = (f"Arrhenius log10 a_T = Ea/(R ln 10) (1/T - 1/T_ref) in kelvin, T_ref = "
+                    f"{law['reference_temperature']:.10g} C, Ea = {p['Ea']:.10g} J/mol")
+        return (f"shift law: {form}; fitted to the shifts of isotherms at {lo:g} to {hi:g} C "
+                f"(chi2/dof {law['chi2_per_dof']:.3g})")
 
 
 def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
@@ -117,7 +168,8 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
 
     Parameters
     ----------
-    result : Comparison
+    result : Comparison or MasterCurve
+        A master curve gives the series at its reference temperature, with its shift law.
     per_decade : int
         Relaxation times per decade (1 to 10).
     liquid : bool
@@ -148,7 +200,9 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
                               or not 2 <= terms <= 100):
         raise InputError(f"export: the number of terms must be an integer from 2 to 100, got "
                          f"{terms!r}")
-    w_lo, w_hi = float(np.min(result.data.omega)), float(np.max(result.data.omega))
+    master = hasattr(result, "shift_draws")
+    window_omega = result.reduced_omega() if master else result.data.omega
+    w_lo, w_hi = float(np.min(window_omega)), float(np.max(window_omega))
     omega = np.logspace(math.log10(w_lo) - 1, math.log10(w_hi) + 1,
                         int(20 * (math.log10(w_hi / w_lo) + 2)) + 1)
     kw = dict(structure=structure, average=average, seed=seed)
@@ -174,7 +228,10 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     keep = terms > 0
     window = (1.0 / w_hi, 1.0 / w_lo)
     fitted = Prony(tau=tau[keep], g=terms[keep], g_inf=g_inf, unit=storage.unit,
-                   source=storage.structure or f"{storage.average} average", window=window,
+                   source=(f"the master curve of {result.structure} at "
+                           f"{result.reference_temperature:g} C" if master
+                           else storage.structure or f"{storage.average} average"),
+                   window=window,
                    max_rel_error_modulus=math.nan, max_rel_error_relaxation=math.nan,
                    band_rel_halfwidth=math.nan)
     inside = (omega >= w_lo) & (omega <= w_hi)
@@ -188,4 +245,13 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     from dataclasses import replace
 
     return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
-                   band_rel_halfwidth=half)
+                   band_rel_halfwidth=half, shift_law=_shift_law(result) if master else None)
+
+
+def _shift_law(mc) -> dict:
+    """The master curve's preferred shift law, as :class:`Prony` carries it."""
+    law = mc.shift_law()
+    return {"name": law["name"], "reference_temperature": float(law["reference_temperature"]),
+            "parameters": {k: float(v["mean"]) for k, v in law["parameters"].items()},
+            "temperatures": (float(min(mc.temperatures)), float(max(mc.temperatures))),
+            "chi2_per_dof": float(mc.laws[law["name"]]["chi2_per_dof"])}

@@ -217,6 +217,8 @@ class MasterCurve:
         The vertical shift of the model (see the module).
     vertical_draws : ndarray, shape (n_draws, n_isotherms), or None
         Posterior draws of log10 b_T (0 at the reference; None without vertical shifts).
+    master : Structure
+        The master structure itself (its card), which predictions evaluate.
     """
 
     structure: str
@@ -235,6 +237,7 @@ class MasterCurve:
     tts_checks: dict = field(default_factory=dict)
     vertical: str = "none"
     vertical_draws: np.ndarray | None = field(default=None, repr=False)
+    master: object = field(default=None, repr=False)
 
     @property
     def tts_valid(self) -> bool | None:
@@ -283,6 +286,63 @@ class MasterCurve:
                 "parameters": self.laws[best]["parameters"], "probabilities": probs,
                 "method": "BIC of each law fitted to the posterior mean and covariance of the "
                           "shifts; parameters over the posterior draws"}
+
+    def reduced_omega(self) -> np.ndarray:
+        """The reduced angular frequencies a_T·ω [rad/s] of every point at the posterior mean
+        shifts: the window at the reference temperature that the data cover."""
+        return np.concatenate([d.omega * 10.0 ** m for d, m in
+                               zip(self.isotherms, self.log_shift_mean, strict=True)])
+
+    def shifts_at(self, temperature: float) -> tuple[np.ndarray, np.ndarray]:
+        """Posterior draws of log10 a_T and log10 b_T at ``temperature`` [°C], paired with
+        :attr:`master_draws` row by row.
+
+        At an isotherm's temperature they are that isotherm's draws. Between two isotherms,
+        each draw's log10 a_T is the preferred shift law (:meth:`shift_law`, posterior means)
+        plus that draw's departure from the law, interpolated linearly in 1/T (kelvin)
+        between the two isotherms: exact where the law holds, and following the shifts
+        where it does not. Free vertical shifts are interpolated the same way (without a law);
+        the density correction is exact at any temperature.
+
+        Raises
+        ------
+        InputError
+            A temperature outside the isotherms' range (a shift law extrapolated beyond the
+            measured temperatures is a guess this does not make).
+        """
+        from .laws import arrhenius, wlf
+        from .model import KELVIN
+
+        try:
+            t = float(temperature)
+        except (TypeError, ValueError):
+            raise InputError(f"temperature must be a number in °C, got {temperature!r}") from None
+        temps = np.asarray(self.temperatures, float)
+        if not (np.isfinite(t) and temps[0] - 1e-9 <= t <= temps[-1] + 1e-9):
+            raise InputError(f"temperature {t:g} °C is outside the isotherms "
+                             f"({temps[0]:g} to {temps[-1]:g} °C): the master curve says "
+                             "nothing measured there")
+        vertical = (np.zeros_like(self.shift_draws) if self.vertical_draws is None
+                    else self.vertical_draws)
+        hi = int(np.clip(np.searchsorted(temps, t), 1, temps.size - 1))
+        lo = hi - 1
+        inv = 1.0 / (temps + KELVIN)
+        f = (1.0 / (t + KELVIN) - inv[lo]) / (inv[hi] - inv[lo])
+        law = self.shift_law()
+        p = {k: v["mean"] for k, v in law["parameters"].items()}
+        ref = self.reference_temperature
+
+        def base(x):
+            return (wlf(x, ref, p["C1"], p["C2"]) if law["name"] == "wlf"
+                    else arrhenius(x, ref, p["Ea"]))
+
+        off = self.shift_draws[:, [lo, hi]] - base(temps[[lo, hi]])
+        a = base(t) + (1 - f) * off[:, 0] + f * off[:, 1]
+        if self.vertical == "density":
+            b = np.full(a.shape, np.log10((ref + KELVIN) / (t + KELVIN)))
+        else:
+            b = (1 - f) * vertical[:, lo] + f * vertical[:, hi]
+        return a, b
 
     def to_dict(self) -> dict:
         return {"structure": self.structure, "reference_temperature": self.reference_temperature,
@@ -479,4 +539,4 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
         log_evidence=math.nan if ev is None else ev.log_z,
         log_evidence_err=math.nan if ev is None else ev.log_z_err, laws=laws, data=joint,
         isotherms=iso.data, notes=tuple(notes), tts_checks={"isotherm_fit": isotherm_fit},
-        vertical=vertical, vertical_draws=vertical_draws)
+        vertical=vertical, vertical_draws=vertical_draws, master=master)

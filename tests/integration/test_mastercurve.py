@@ -159,6 +159,43 @@ def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
     assert all(p["tested"] and p["passes"] for p in pairs)
     status, _, err = run_cli("mastercurve", files[0], "--out", tmp_path / "one")
     assert status == 2 and "two or more isotherms, got 1" in err
+    # The directory loads back as the master curve it wrote: the same shifts (recomputed from
+    # the stored draws), parameters, laws and checks.
+    mc = bf.load(tmp_path / "mc")
+    assert isinstance(mc, bf.MasterCurve) and mc.structure == summary["structure"]
+    assert mc.temperatures == (0.0, 10.0, 20.0, 30.0, 40.0) and len(mc.isotherms) == 5
+    for got, wrote in zip(mc.shift_factors(), summary["shift_factors"], strict=True):
+        assert got["temperature"] == wrote["temperature"]
+        assert got["log10_aT"] == pytest.approx(wrote["log10_aT"], rel=1e-12, abs=1e-15)
+    again = mc.to_dict()
+    for key in ("parameters", "laws", "shift_law", "tts_checks", "log_evidence", "notes"):
+        assert again[key] == summary[key], key
+    assert [d.n_frequencies for d in mc.isotherms] == [bf.read(f).n_frequencies for f in files]
+    # What follows from it: a material function at another temperature, a Prony series with
+    # the shift law.
+    status, out, err = run_cli("predict", tmp_path / "mc", "--quantity", "storage", "--omega",
+                               "1,10", "--temperature", "10", "--json")
+    assert status == 0, err
+    at_10 = json.loads(out)
+    assert at_10["structure"] == summary["structure"] and at_10["unit"] == "Pa"
+    measured = bf.read(files[1])  # the 10 °C isotherm: the prediction lies on its data
+    for w, g in zip(at_10["x"], at_10["median"], strict=True):
+        assert g == pytest.approx(np.interp(np.log(w), np.log(measured.omega),
+                                            measured.response.real), rel=0.1)
+    status, _, err = run_cli("predict", tmp_path / "mc", "--quantity", "storage", "--omega",
+                             "1", "--temperature", "80")
+    assert status == 2 and "--temperature 80 °C is outside the isotherms (0 to 40 °C)" in err
+    status, out, err = run_cli("export", tmp_path / "mc", "--format", "abaqus", "--out",
+                               tmp_path / "mc.inp")
+    assert status == 0, err
+    text = (tmp_path / "mc.inp").read_text()
+    law = summary["shift_law"]
+    keyword = "*TRS, DEFINITION=" + ("WLF" if law["name"] == "wlf" else "ARRHENIUS")
+    assert keyword in text and "shift law at T_ref = 20 °C" in out
+    values = [float(v) for v in text.splitlines()[text.splitlines().index(keyword) + 1]
+              .split(",")]
+    assert values[0] == 20.0 and values[1] == pytest.approx(
+        next(iter(law["parameters"].values()))["mean"], rel=1e-9)
 
 
 def test_batch_over_isotherms_points_to_mastercurve(tmp_path, run_cli):
@@ -215,3 +252,69 @@ def test_the_density_correction_is_the_ratio_of_absolute_temperatures():
     np.testing.assert_allclose(shifted.log_vertical(np.zeros((3, shifted.n_params)))[1],
                                expected, rtol=1e-14)
     assert shifted.n_params == 4 + 5  # no vertical parameters: the factor is fixed
+
+
+# ---------------------------------------------------------------------- what follows from it
+def test_material_functions_at_a_temperature_follow_each_draws_shifts(wlf_case):
+    """G′ and G(t) at an isotherm's temperature and between two are the true master function
+    seen through the true shift (WLF, C1 8, C2 80): within the band and a few per cent."""
+    from bayesfo.predictions.functions import evaluate
+
+    truth, mc = wlf_case
+    z = get_structure("zener")
+    at_40 = bf.predict(mc, "storage", W, temperature=40.0)
+    expected = z.response([ZENER], W * 10.0 ** truth[4], "modulus")[0].real
+    assert np.max(np.abs(at_40.median / expected - 1)) < 0.02  # 1 % noise, 72 points
+    assert np.mean((at_40.hdi_low <= expected) & (expected <= at_40.hdi_high)) >= 0.8
+    assert "at 40 °C from the master curve at 20 °C" in at_40.notes[0]
+    # Between isotherms each draw follows the fitted law plus its own departure from it: on
+    # WLF data the shift at 35 °C is WLF's (linear interpolation in 1/T alone would be 0.013
+    # decades off here).
+    t = 35.0
+    exact = wlf(t, 20.0, 8.0, 80.0)
+    log_a, log_b = mc.shifts_at(t)
+    assert abs(np.mean(log_a) - exact) < 0.03 and not log_b.any()
+    np.testing.assert_array_equal(mc.shifts_at(40.0)[0], mc.shift_draws[:, 4])
+    at_35 = bf.predict(mc, "storage", W, temperature=t)
+    expected = z.response([ZENER], W * 10.0 ** exact, "modulus")[0].real
+    assert np.max(np.abs(at_35.median / expected - 1)) < 0.03
+    # G(t; T) = G_ref(t / a_T): the relaxation at 40 °C, against the card's own inversion at
+    # the truly shifted times.
+    times = np.logspace(-1.5, 0.5, 5)
+    g_t = bf.predict(mc, "relaxation_modulus", times, temperature=40.0)
+    reference = evaluate(z, ZENER, "relaxation_modulus", times / 10.0 ** truth[4])[0]
+    assert np.max(np.abs(g_t.median / reference - 1)) < 0.03
+    # The reference temperature is the default; nothing is extrapolated inside the window.
+    plain = bf.predict(mc, "storage", W)
+    np.testing.assert_allclose(plain.median, bf.predict(mc, "storage", W, temperature=20.0).median)
+    assert not plain.extrapolated.any() and not plain.notes
+    with pytest.raises(InputError, match="temperature 60 °C is outside the isotherms"):
+        bf.predict(mc, "storage", W, temperature=60.0)
+    with pytest.raises(InputError, match="nothing to average"):
+        bf.predict(mc, "storage", W, average="bma")
+    with pytest.raises(InputError, match="the master curve's structure is 'zener'"):
+        bf.predict(mc, "storage", W, structure="voigt")
+
+
+def test_a_prony_series_of_a_master_curve_carries_its_shift_law(wlf_case):
+    from bayesfo.predictions import prony_series
+
+    _, mc = wlf_case
+    prony = prony_series(mc)
+    law = prony.shift_law
+    assert law["name"] == "wlf" and law["reference_temperature"] == 20.0
+    assert law["temperatures"] == (0.0, 50.0)
+    c1, c2 = (mc.laws["wlf"]["parameters"][k]["mean"] for k in ("C1", "C2"))
+    assert law["parameters"] == {"C1": c1, "C2": c2}
+    # The series stands for the master function at the reference temperature.
+    g = get_structure("zener").response([ZENER], W, "modulus")[0]
+    assert np.max(np.abs(prony.modulus(W) / g - 1)) < 0.02
+    abaqus = prony.text("abaqus").splitlines()
+    i = abaqus.index("*TRS, DEFINITION=WLF")
+    assert [float(v) for v in abaqus[i + 1].split(",")] == pytest.approx([20.0, c1, c2],
+                                                                          rel=1e-9)
+    ansys = prony.text("ansys").splitlines()
+    i = ansys.index("TB,SHIFT,1,,3,WLF")
+    assert [float(v) for v in ansys[i + 1].split(",")[2:]] == pytest.approx([20.0, c1, c2],
+                                                                             rel=1e-9)
+    assert any(line.startswith("# shift law: WLF") for line in prony.text("csv").splitlines())

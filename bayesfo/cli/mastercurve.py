@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 from ..errors import InputError
@@ -39,6 +40,11 @@ def add_parser(subparsers):
     p.add_argument("--vertical", default="none", choices=("none", "density", "free"),
                    help="vertical shift b_T: none (default); density: b_T = T_ref/T in kelvin "
                         "(constant density); free: one log10 b_T per isotherm")
+    p.add_argument("--law", default="auto", choices=("auto", "free", "wlf", "arrhenius"),
+                   help="horizontal shifts: auto (default: free shifts, then the best master "
+                        "structure with the WLF and the Arrhenius law inside the joint "
+                        "posterior, the highest ln Z kept), free (one log10 a_T per isotherm), "
+                        "wlf or arrhenius (the law's parameters sampled)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default bayesfo-mastercurve)")
@@ -93,7 +99,7 @@ def run(args) -> int:
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
-                     noise=args.noise, vertical=args.vertical, seed=args.seed)
+                     noise=args.noise, vertical=args.vertical, law=args.law, seed=args.seed)
     from ..tts.stored import summary_fields
 
     summary = {"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)}
@@ -144,7 +150,16 @@ def _print(mc, out) -> None:
         p = "-" if r["probability"] is None else f"{r['probability']:.3f}"
         print(f"   {r['structure']:<22} ln Z {z:>20}  P {p:>6}  "
               f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")
-    print(f"shift factors of {mc.structure}, T_ref = {mc.reference_temperature:g} °C:")
+    if mc.law_evidence:
+        print(f"shifts of {mc.structure} ranked by ln Z (free, or by a law inside the posterior)")
+        for how, r in sorted(mc.law_evidence.items(),
+                             key=lambda kv: -(kv[1]["log_evidence"] or -math.inf)):
+            z = "-" if r["log_evidence"] is None else (f"{r['log_evidence']:.2f} ± "
+                                                        f"{r['log_evidence_err']:.2f}")
+            print(f"   {how:<22} ln Z {z:>20}  P {r['probability']:6.3f}  "
+                  f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")
+    shifts = {"free": "", "wlf": " (WLF)", "arrhenius": " (Arrhenius)"}[mc.law]
+    print(f"shift factors{shifts} of {mc.structure}, T_ref = {mc.reference_temperature:g} °C:")
     vertical = mc.vertical != "none"
     print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}"
           + (f" {'log10 b_T':>10} {'sd':>7} {'94 % HDI':>20} ({mc.vertical})" if vertical

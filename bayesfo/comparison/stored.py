@@ -317,10 +317,10 @@ def _mastercurve(summary: dict, d: Path, library):
     joint = FrequencyResponse(omega, response, sigma, name=meta["name"],
                               notes=tuple(meta["notes"]), distinct_frequencies=False, **common)
     temperatures = tuple(float(m["temperature"]) for m in iso)
-    vertical = summary.get("vertical", "none")
+    vertical, law = summary.get("vertical", "none"), summary.get("law", "free")
     shifted = ShiftedStructure(master, temperatures,
                                temperatures.index(float(summary["reference_temperature"])),
-                               point, None, vertical)
+                               point, None, vertical, law)
     post = _posterior(summary["posterior"], idata, joint, path)
     if post.param_names[:shifted.n_params] != shifted.param_names:
         raise InputError(f"'{path}': its parameters are not those of the master curve of "
@@ -335,7 +335,7 @@ def _mastercurve(summary: dict, d: Path, library):
         isotherms=isotherms, notes=tuple(summary["notes"]), ranking=tuple(summary["structures"]),
         tts_checks=summary["tts_checks"], vertical=vertical,
         vertical_draws=None if vertical == "none" else shifted.log_vertical(theta),
-        master=master)
+        master=master, law=law, law_evidence=summary.get("law_evidence") or {})
 
 
 def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> PosteriorResult:

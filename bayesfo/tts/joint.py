@@ -34,7 +34,7 @@ import numpy as np
 from ..data import FrequencyResponse
 from ..errors import InputError
 from .laws import _fit_laws
-from .model import ShiftedStructure
+from .model import LAWS, ShiftedStructure
 
 #: The vertical shifts ``mastercurve`` knows.
 VERTICAL = ("none", "density", "free")
@@ -219,6 +219,12 @@ class MasterCurve:
         Posterior draws of log10 b_T (0 at the reference; None without vertical shifts).
     master : Structure
         The master structure itself (its card), which predictions evaluate.
+    law : {"free", "wlf", "arrhenius"}
+        How the shifts were modelled (see :func:`mastercurve`).
+    law_evidence : dict
+        With ``law="auto"``: ``{"free" | "wlf" | "arrhenius": {"log_evidence",
+        "log_evidence_err", "probability", "certified", "sampler"}}`` of the best master
+        structure under each (probabilities from the ln Z of the certified ones).
     """
 
     structure: str
@@ -238,6 +244,8 @@ class MasterCurve:
     vertical: str = "none"
     vertical_draws: np.ndarray | None = field(default=None, repr=False)
     master: object = field(default=None, repr=False)
+    law: str = "free"
+    law_evidence: dict = field(default_factory=dict)
 
     @property
     def tts_valid(self) -> bool | None:
@@ -281,6 +289,11 @@ class MasterCurve:
         """``{"name", "reference_temperature", "parameters", "probabilities", "method"}``:
         the law with the larger support and its parameters."""
         probs = {k: v["probability"] for k, v in self.laws.items()}
+        if self.law != "free":  # the law the joint posterior sampled
+            return {"name": self.law, "reference_temperature": self.reference_temperature,
+                    "parameters": self.laws[self.law]["parameters"], "probabilities": probs,
+                    "method": f"the {self.law} law's parameters sampled with the master "
+                              "structure (summarised over the posterior draws)"}
         best = max(probs, key=probs.get)
         return {"name": best, "reference_temperature": self.reference_temperature,
                 "parameters": self.laws[best]["parameters"], "probabilities": probs,
@@ -355,7 +368,8 @@ class MasterCurve:
                                    ("mean", "sd", "hdi_low", "hdi_high")}
                                for n, v in self.posterior.summary.items()
                                if not n.startswith(("log10_aT_", "log10_bT_"))},
-                "vertical": self.vertical,
+                "vertical": self.vertical, "law": self.law,
+                "law_evidence": self.law_evidence,
                 "structures": list(self.ranking),
                 "shift_factors": self.shift_factors(), "shift_law": self.shift_law(),
                 "laws": self.laws, "tts_valid": self.tts_valid, "tts_checks": self.tts_checks,
@@ -369,7 +383,7 @@ def _num(x):
 
 # ---------------------------------------------------------------------------- the fit
 def mastercurve(isotherms, structures="zener", *, reference_temperature: float | None = None,
-                noise: str = "proportional", vertical: str = "none",
+                noise: str = "proportional", vertical: str = "none", law: str = "auto",
                 seed: int = 0) -> MasterCurve:
     """One joint posterior of a master structure and the isotherms' shifts; with several
     structures, each is fitted and the one of highest ln Z is returned, with the ranking.
@@ -389,6 +403,13 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     vertical : {"none", "density", "free"}
         The vertical shift b_T: none; the density correction b_T = T_ref/T [K] (constant
         density); or one free log10 b_T per isotherm (see the module).
+    law : {"auto", "free", "wlf", "arrhenius"}
+        The horizontal shifts: one free log10 a_T per isotherm (``"free"``), or those of the
+        WLF or Arrhenius law with its parameters sampled jointly (``"wlf"``,
+        ``"arrhenius"``). ``"auto"`` ranks the master structures with free shifts, then fits
+        the best one with each law too and keeps the model of highest ln Z among the three
+        (a law is kept only where its posterior is certified); ``law_evidence`` says how
+        the three compare.
     seed : int
 
     Returns
@@ -405,10 +426,13 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
 
     if vertical not in VERTICAL:
         raise InputError(f"vertical must be one of {', '.join(VERTICAL)}, got {vertical!r}")
+    if law not in ("auto", *LAWS):
+        raise InputError(f"law must be one of auto, {', '.join(LAWS)}, got {law!r}")
     names = resolve_structures(structures) if isinstance(structures, str) else (
         [structures] if not isinstance(structures, (list, tuple)) else list(structures))
     iso = _isotherms(isotherms, reference_temperature)
-    fits = [_fit_one(iso, s, noise, seed, vertical) for s in names]
+    first = "free" if law == "auto" else law
+    fits = [_fit_one(iso, s, noise, seed, vertical, first) for s in names]
     z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
     best = int(np.argmax(z))
     p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
@@ -424,9 +448,14 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     from .validity import describe, van_gurp_palmen
 
     chosen = fits[best]
+    law_evidence, law_notes = {}, []
+    if law == "auto":
+        chosen, law_evidence, law_notes = _choose_law(
+            iso, names[best], chosen, lambda how: _fit_one(iso, names[best], noise, seed,
+                                                           vertical, how))
     vgp = van_gurp_palmen(iso.data, iso.temperatures)
     checks = {"van_gurp_palmen": vgp, "isotherm_fit": chosen.tts_checks["isotherm_fit"]}
-    notes = list(chosen.notes)
+    notes = list(chosen.notes) + law_notes
     if vgp["valid"] is not True:
         notes.append(describe(vgp))
     misfit = checks["isotherm_fit"]["misfit"]
@@ -434,11 +463,43 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         notes.append(f"the joint fit of {chosen.structure} misses the isotherm(s) at "
                      f"{', '.join(f'{t:g}' for t in misfit)} °C: their relative residuals are "
                      f"over {ISOTHERM_MISFIT:g} times the median isotherm's")
-    return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes))
+    return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes),
+                   law_evidence=law_evidence)
+
+
+def _choose_law(iso: _Isotherms, structure, free: MasterCurve, fit) -> tuple:
+    """The model of highest ln Z among free shifts (``free``, fitted) and the WLF and
+    Arrhenius laws (``fit(law)``), a law only where its posterior is certified; with
+    ``law_evidence`` and a note."""
+    fits = {"free": free, **{how: fit(how) for how in ("wlf", "arrhenius")}}
+    z = {k: f.log_evidence if math.isfinite(f.log_evidence) and f.posterior.converged
+         else -np.inf for k, f in fits.items()}
+    z["free"] = free.log_evidence if math.isfinite(free.log_evidence) else -np.inf
+    top = max(z, key=z.get)
+    if not np.isfinite(z[top]):
+        return free, {}, []
+    p = {k: math.exp(v - z[top]) for k, v in z.items()}
+    total = sum(p.values())
+    evidence = {k: {"log_evidence": _num(fits[k].log_evidence),
+                    "log_evidence_err": _num(fits[k].log_evidence_err),
+                    "probability": p[k] / total, "certified": bool(fits[k].posterior.converged),
+                    "sampler": fits[k].posterior.sampler} for k in fits}
+    name = {"free": "free shifts", "wlf": "the WLF law", "arrhenius": "the Arrhenius law"}
+    runner = max((k for k in z if k != top), key=z.get)
+    gap = z[top] - z[runner]
+    how = f"ln Z {gap:.1f} above {name[runner]}" if np.isfinite(gap) else \
+        f"{name[runner]} gave no certified ln Z"
+    if top == "free":
+        note = (f"the shifts follow neither shift law over all isotherms: free shifts are "
+                f"supported ({how}); the shift factors are each isotherm's own")
+    else:
+        note = (f"the shifts follow {name[top]} ({how}): the shift factors are the law's, "
+                "sampled with the master structure")
+    return fits[top], evidence, [note]
 
 
 def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
-             vertical: str = "none") -> MasterCurve:
+             vertical: str = "none", law: str = "free") -> MasterCurve:
     """The joint posterior with one master structure."""
     from scipy.optimize import least_squares
 
@@ -456,7 +517,7 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
     reduced0 = _reduced(iso, shifts0)
     w = reduced0.omega / scaling.omega_ref
     shifted = ShiftedStructure(master, iso.temperatures, iso.reference, iso.point_isotherm,
-                               dissipation_grid(w.min(), w.max()), vertical)
+                               dissipation_grid(w.min(), w.max()), vertical, law)
     lik = Likelihood(shifted, joint, noise=noise, scaling=scaling)
     # Master seeds on the reduced data, then everything jointly (least squares on relative
     # residuals, in the sampling coordinates: logs of the log-uniform parameters).
@@ -464,7 +525,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
     modes = master.to_scaled(master.to_physical(np.atleast_2d(fit.optima if fit.optima.size
                                                               else fit.theta_scaled),
                                                 fit.scaling), scaling)
-    shift_cols = np.delete(shifts0, iso.reference)
+    shift_cols = _law_start(iso, shifts0, shifted) if law != "free" else \
+        np.delete(shifts0, iso.reference)
     if vertical == "free":
         shift_cols = np.r_[shift_cols, np.zeros(len(shifted.shifted))]
     tr = _Transform(lik)
@@ -539,4 +601,24 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
         log_evidence=math.nan if ev is None else ev.log_z,
         log_evidence_err=math.nan if ev is None else ev.log_z_err, laws=laws, data=joint,
         isotherms=iso.data, notes=tuple(notes), tts_checks={"isotherm_fit": isotherm_fit},
-        vertical=vertical, vertical_draws=vertical_draws, master=master)
+        vertical=vertical, vertical_draws=vertical_draws, master=master, law=shifted.law)
+
+
+def _law_start(iso: _Isotherms, shifts0, shifted: ShiftedStructure) -> np.ndarray:
+    """The shift law's parameters fitted to the seed shifts, inside their priors."""
+    from scipy.optimize import least_squares
+
+    from .laws import arrhenius, wlf
+
+    temps = np.asarray(iso.temperatures, float)
+    t_ref = temps[iso.reference]
+    bounds = np.array([p.prior.bounds for p in shifted.horizontal], float)
+    if shifted.law == "arrhenius":
+        basis = arrhenius(temps, t_ref, 1.0)
+        start = np.array([float(basis @ shifts0 / (basis @ basis))])
+    else:
+        c2 = min(max(51.6, bounds[1, 0] + 10.0), bounds[1, 1])
+        sol = least_squares(lambda q: wlf(temps, t_ref, q[0], q[1]) - shifts0, [10.0, c2],
+                            bounds=(bounds[:, 0] + 1e-9, bounds[:, 1] - 1e-9))
+        start = sol.x
+    return np.clip(start, bounds[:, 0] * (1 + 1e-9) + 1e-12, bounds[:, 1] * (1 - 1e-9))

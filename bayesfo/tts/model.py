@@ -13,8 +13,9 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import InputError
-from ..priors import Uniform
+from ..priors import LogUniform, Uniform
 from ..structures.structure import Parameter
+from .laws import arrhenius, wlf
 
 #: Prior of each log10 a_T: uniform over ±SHIFT_RANGE decades around the reference.
 SHIFT_RANGE = 15.0
@@ -22,6 +23,15 @@ SHIFT_RANGE = 15.0
 #: density and temperature ratios, a few tens of per cent).
 VERTICAL_RANGE = 1.0
 KELVIN = 273.15
+#: How the shifts are modelled: one free log10 a_T per isotherm, or a shift law whose
+#: parameters are sampled with the master's.
+LAWS = ("free", "wlf", "arrhenius")
+#: Priors of a shift law inside the joint model: WLF's C1 uniform on (0, WLF_C1_MAX], C2
+#: uniform from just above T_ref − T_min (C2 + T − T_ref > 0 at every isotherm) to
+#: WLF_C2_MAX °C; Arrhenius' E_a log-uniform on [EA_MIN, EA_MAX] J/mol.
+WLF_C1_MAX = 100.0
+WLF_C2_MAX = 2000.0
+EA_MIN, EA_MAX = 1e3, 1e7
 
 
 def shift_name(temperature: float, factor: str = "aT") -> str:
@@ -53,6 +63,10 @@ class ShiftedStructure:
         The dissipation grid of the master (scaled), spanning the reduced window.
     vertical : {"none", "density", "free"}
         The vertical shift b_T (see the module).
+    law : {"free", "wlf", "arrhenius"}
+        One free log10 a_T per isotherm other than the reference, or the shifts of a law
+        whose parameters (``wlf_C1``, ``wlf_C2`` [°C]; ``Ea`` [J/mol]) are sampled instead
+        (:data:`LAWS`).
     """
 
     master: object
@@ -61,6 +75,7 @@ class ShiftedStructure:
     point_isotherm: np.ndarray
     master_grid: np.ndarray | None = None
     vertical: str = "none"
+    law: str = "free"
 
     @property
     def name(self) -> str:
@@ -72,9 +87,24 @@ class ShiftedStructure:
         return tuple(i for i in range(len(self.temperatures)) if i != self.reference)
 
     @cached_property
+    def horizontal(self) -> tuple:
+        """The parameters of the horizontal shifts: one per shifted isotherm, or the law's."""
+        temps = np.asarray(self.temperatures, float)
+        t_ref = temps[self.reference]
+        if self.law == "wlf":
+            c2_min = max(t_ref - temps.min(), 0.0) + 1.0
+            return (Parameter("wlf_C1", "shift", Uniform(0.0, WLF_C1_MAX)),
+                    Parameter("wlf_C2", "shift", Uniform(c2_min, WLF_C2_MAX)))
+        if self.law == "arrhenius":
+            return (Parameter("Ea", "shift", LogUniform(EA_MIN, EA_MAX)),)
+        if self.law != "free":
+            raise InputError(f"law must be one of {', '.join(LAWS)}, got {self.law!r}")
+        return tuple(Parameter(shift_name(self.temperatures[i]), "shift",
+                               Uniform(-SHIFT_RANGE, SHIFT_RANGE)) for i in self.shifted)
+
+    @cached_property
     def parameters(self) -> tuple:
-        shifts = tuple(Parameter(shift_name(self.temperatures[i]), "shift",
-                                 Uniform(-SHIFT_RANGE, SHIFT_RANGE)) for i in self.shifted)
+        shifts = self.horizontal
         if self.vertical == "free":
             shifts += tuple(Parameter(shift_name(self.temperatures[i], "bT"), "shift",
                                       Uniform(-VERTICAL_RANGE, VERTICAL_RANGE))
@@ -118,6 +148,13 @@ class ShiftedStructure:
         """log10 a_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
         theta = np.atleast_2d(np.asarray(theta, float))
         k = self.master.n_params
+        temps = np.asarray(self.temperatures, float)[None, :]
+        t_ref = self.temperatures[self.reference]
+        if self.law == "wlf":
+            with np.errstate(all="ignore"):
+                return wlf(temps, t_ref, theta[:, k:k + 1], theta[:, k + 1:k + 2])
+        if self.law == "arrhenius":
+            return arrhenius(temps, t_ref, theta[:, k:k + 1])
         out = np.zeros((theta.shape[0], len(self.temperatures)))
         out[:, list(self.shifted)] = theta[:, k:k + len(self.shifted)]
         return out
@@ -130,7 +167,7 @@ class ShiftedStructure:
             t = np.asarray(self.temperatures) + KELVIN
             out[:] = np.log10(t[self.reference] / t)
         elif self.vertical == "free":
-            start = self.master.n_params + len(self.shifted)
+            start = self.master.n_params + len(self.horizontal)
             out[:, list(self.shifted)] = theta[:, start:start + len(self.shifted)]
         return out
 
@@ -155,9 +192,8 @@ class ShiftedStructure:
         theta2 = np.atleast_2d(np.asarray(theta, float))
         k = self.master.n_params
         ok = np.atleast_1d(self.master.in_support(theta2[:, :k])).copy()
-        n = len(self.shifted)
-        ok &= np.all(np.abs(theta2[:, k:k + n]) <= SHIFT_RANGE, axis=1)
-        ok &= np.all(np.abs(theta2[:, k + n:]) <= VERTICAL_RANGE, axis=1)
+        for j, p in enumerate(self.parameters[k:], start=k):
+            ok &= p.prior.contains(theta2[:, j])
         return ok if np.ndim(theta) == 2 else ok[0]
 
     def constraints_hold(self, theta, kind: str, omega_grid=None, where=None) -> np.ndarray:

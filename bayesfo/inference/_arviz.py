@@ -135,8 +135,20 @@ def open_tree(path: Path):
 
 
 def write_tree(tree, path) -> None:
-    """Write a DataTree to NetCDF (HDF5, one group per ArviZ group)."""
-    tree.to_netcdf(path, engine="h5netcdf")
+    """Write a DataTree to NetCDF (HDF5, one group per ArviZ group).
+
+    The file is built in memory and then written with plain file writes: HDF5 writing to a
+    file system that fills up under it (another process took the space after the free-space
+    check of :func:`~bayesfo.inference.results.save_netcdf`) crashes the process
+    (segmentation fault) instead of raising, while a plain write raises ``OSError``
+    (``ENOSPC``) that the command reports.
+    """
+    import io
+
+    buffer = io.BytesIO()
+    tree.to_netcdf(buffer, engine="h5netcdf")
+    with open(path, "wb") as f:
+        f.write(buffer.getbuffer())
 
 
 def preload() -> None:

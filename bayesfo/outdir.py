@@ -114,7 +114,8 @@ def one_run(out_dir, checked=lambda name: True):
         if path is not None:
             raise InputError(f"'{path}' is not the file that the run which wrote "
                              f"'{out_dir}' left there (changed, truncated or copied in "
-                             "from another run); run compare again into the directory")
+                             "from another run); run the command that wrote it again into "
+                             "the directory")
         yield
 
 

@@ -100,9 +100,11 @@ def run(args) -> int:
     load_libraries(() if args.no_figures else ("png",))
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
                      noise=args.noise, vertical=args.vertical, law=args.law, seed=args.seed)
+    from ..output.write import _finite
     from ..tts.stored import summary_fields
 
-    summary = {"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)}
+    # Not-finite numbers (a posterior's undefined diagnostic) are null, as in compare's.
+    summary = _finite({"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)})
     master = mc.master_data()
     law = mc.shift_law()
     comments = [f"master curve at {mc.reference_temperature:g} C of {len(mc.temperatures)} "
@@ -115,8 +117,8 @@ def run(args) -> int:
                 + ", ".join(f"{k} = {v['mean']:.6g} {v['unit']}".rstrip()
                             for k, v in law["parameters"].items())]
     with staged_run(out) as stage:
-        (stage / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False)
-                                            + "\n")
+        (stage / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False,
+                                                       allow_nan=False) + "\n")
         (stage / "master.csv").write_text(master.to_csv_text(comments))
         from ..inference import save_netcdf
         from ..output.write import _without_distributed

@@ -359,3 +359,23 @@ def test_a_shift_law_inside_the_posterior_is_stored_and_loaded(tmp_path, run_cli
         assert p["hdi_low"] <= value <= p["hdi_high"], (name, p)
     status, _, err = run_cli("mastercurve", *files, "--law", "vft", "--out", tmp_path / "x")
     assert status == 2 and "invalid choice: 'vft'" in err
+    # summary.json is strict JSON (no NaN), and a directory without the posterior, as an
+    # earlier version wrote it, or without its NetCDF, is refused with what to do.
+    text = (tmp_path / "mc" / "summary.json").read_text()
+
+    def refuse(name):
+        raise ValueError(f"{name} in summary.json")
+
+    summary = json.loads(text, parse_constant=refuse)
+    old = {k: v for k, v in summary.items() if k not in ("posterior", "isotherms")}
+    (tmp_path / "mc" / "summary.json").write_text(json.dumps(old))
+    record = (tmp_path / "mc" / ".bayesfo-run.json").read_text()
+    (tmp_path / "mc" / ".bayesfo-run.json").unlink()  # as an earlier version left it
+    with pytest.raises(InputError, match="an earlier version of bayesfo, without its posterior; "
+                                         "run bayesfo mastercurve again"):
+        bf.load(tmp_path / "mc")
+    (tmp_path / "mc" / "summary.json").write_text(text)
+    (tmp_path / "mc" / ".bayesfo-run.json").write_text(record)
+    (tmp_path / "mc" / "zener.nc").unlink()
+    status, _, err = run_cli("predict", tmp_path / "mc", "--quantity", "storage", "--omega", "1")
+    assert status == 2 and "zener.nc': missing" in err

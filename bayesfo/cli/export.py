@@ -9,8 +9,8 @@ def add_parser(subparsers):
     from ..predictions.prony import FORMATS
 
     p = subparsers.add_parser(
-        "export", help="a Prony series of the model (csv, Abaqus, ANSYS) from the output "
-                       "directory of a comparison",
+        "export", help="a Prony series of the model (csv, Abaqus, ANSYS, LS-DYNA) from the "
+                       "output directory of a comparison or a master curve",
         description="Fit G(t) = G_inf + sum g_i exp(-t/tau_i) (tau_i fixed per decade, g_i >= "
                     "0) to the posterior median G', G'' of a structure or an average, and "
                     "write it with its largest relative error over the data window beside the "
@@ -19,8 +19,9 @@ def add_parser(subparsers):
                    help="output directory of bayesfo compare, or of bayesfo mastercurve (the "
                         "series at the reference temperature, with the shift law)")
     p.add_argument("--format", required=True, choices=FORMATS,
-                   help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY) or ansys "
-                        "(TB,PRONY with TBDATA)")
+                   help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY), ansys "
+                        "(TB,PRONY with TBDATA) or lsdyna (*MAT_GENERAL_VISCOELASTIC, at most "
+                        "18 terms)")
     p.add_argument("--out", required=True, metavar="FILE", help="the file to write")
     many = p.add_mutually_exclusive_group()
     many.add_argument("--per-decade", type=int, default=2, metavar="K",
@@ -52,7 +53,12 @@ def run(args) -> int:
                          .replace("terms per decade", "--per-decade")
                          .replace("the number of terms", "--terms")) from None
     try:
-        atomic_write_text(args.out, prony.text(args.format))
+        text = prony.text(args.format)
+    except InputError as exc:
+        raise InputError(str(exc).replace("export: ", "", 1).replace(
+            "terms 17 or 1 per decade", "--terms 17 or --per-decade 1")) from None
+    try:
+        atomic_write_text(args.out, text)
     except OSError as exc:
         raise InputError(f"--out '{args.out}': cannot be written ({exc.strerror or exc})") \
             from None

@@ -12,8 +12,10 @@ the data could tell).
 
 Formats: ``csv`` (``tau_s,g_i`` with ``#`` lines for G∞, G0, the unit and the errors), ``abaqus``
 (``*VISCOELASTIC, TIME=PRONY``: g_i/G0, k_i = 0, τ_i; G0 in a comment, for ``*ELASTIC,
-MODULI=INSTANTANEOUS``) and ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` pairs of α_i = g_i/G0
-and τ_i).
+MODULI=INSTANTANEOUS``), ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` pairs of α_i = g_i/G0
+and τ_i) and ``lsdyna`` (``*MAT_GENERAL_VISCOELASTIC``, fixed 10-character fields: rows of G_i
+and the decay constant β_i = 1/τ_i, G∞ as a row with β = 0, at most :data:`LSDYNA_MAX_TERMS`
+rows; RO and BULK, which a shear measurement does not give, are left for the user).
 
 A series fitted to a master curve is the material at the reference temperature, and its shift
 law goes with it (the law of larger support, posterior means): Abaqus ``*TRS`` (``WLF``:
@@ -37,7 +39,9 @@ from ..errors import InputError
 GAS_CONSTANT = 8.314462618
 KELVIN = 273.15
 
-FORMATS = ("csv", "abaqus", "ansys")
+FORMATS = ("csv", "abaqus", "ansys", "lsdyna")
+#: Terms *MAT_GENERAL_VISCOELASTIC takes (the long-term modulus is one of them, with β = 0).
+LSDYNA_MAX_TERMS = 18
 #: Decades of relaxation times beyond the data window on each side.
 TAU_MARGIN = 2
 
@@ -126,6 +130,8 @@ class Prony:
                 else:
                     lines += ["*TRS, DEFINITION=ARRHENIUS",
                               f"{t_ref:.10g}, {p['Ea']:.10g}, {GAS_CONSTANT:.10g}, {-KELVIN:.10g}"]
+        elif fmt == "lsdyna":
+            lines = self._lsdyna(head)
         else:  # ansys
             lines = [f"! {h}" for h in head]
             lines.append(f"! instantaneous modulus G0 = {self.g_0:.10g}")
@@ -145,6 +151,40 @@ class Prony:
                               "T in kelvin", "TB,SHIFT,1,,2,TN",
                               f"TBDATA,1,{t_ref + KELVIN:.10g},{p['Ea'] / GAS_CONSTANT:.10g}"]
         return "\n".join(lines) + "\n"
+
+    def _lsdyna(self, head: list[str]) -> list[str]:
+        """*MAT_GENERAL_VISCOELASTIC in LS-DYNA's fixed 10-character fields."""
+        rows = [(g, 1.0 / t) for t, g in zip(self.tau, self.g, strict=True)]
+        if self.g_inf > 0:
+            rows.append((self.g_inf, 0.0))
+        if len(rows) > LSDYNA_MAX_TERMS:
+            raise InputError(f"export: LS-DYNA's *MAT_GENERAL_VISCOELASTIC takes at most "
+                             f"{LSDYNA_MAX_TERMS} terms (G_inf counts as one), this series has "
+                             f"{len(rows)}; ask for fewer (terms {LSDYNA_MAX_TERMS - 1} or 1 per "
+                             "decade)")
+
+        def field(v: float) -> str:  # 4 significant digits: a blank keeps the fields apart
+            return f"{v:10.3E}" if v != 0 else f"{0.0:10.1f}"
+
+        lines = [f"$ {h}" for h in head]
+        lines += ["$ GI: shear moduli in the data's unit (a tensile E series: divide each by "
+                  "2(1+nu)); BETAI = 1/tau_i [1/s]; the row with BETAI = 0 is G_inf",
+                  "$ RO (density) and BULK (bulk modulus) are not measured in shear: give them "
+                  "in the units of your model"]
+        if self.shift_law is not None:
+            lines.append("$ TREF, A, B (the shift function) are left 0: enter the shift law "
+                         "above in the convention of your LS-DYNA version")
+        lines += ["*KEYWORD", "*MAT_GENERAL_VISCOELASTIC",
+                  "$      MID        RO      BULK       PCF        EF      TREF         A"
+                  "         B",
+                  f"{1:>10d}" + " " * 20 + field(0.0) * 5,
+                  "$     LCID        NT    BSTART     TRAMP     LCIDK       NTK   BSTARTK"
+                  "    TRAMPK",
+                  f"{0:>10d}{0:>10d}" + field(0.0) * 2 + f"{0:>10d}{0:>10d}" + field(0.0) * 2,
+                  "$       GI     BETAI        KI    BETAKI"]
+        lines += [field(g) + field(b) + field(0.0) * 2 for g, b in rows]
+        lines.append("*END")
+        return lines
 
     def _law_text(self) -> str:
         law = self.shift_law

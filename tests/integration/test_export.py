@@ -123,3 +123,42 @@ def test_bad_requests(written, tmp_path, run_cli):
     assert status == 2 and err.startswith("bayesfo: error: no structure 'nope'")
     status, _, err = run_cli("export", out, "--format", "nastran", "--out", tmp_path / "x")
     assert status == 2 and "invalid choice" in err
+
+
+def parse_lsdyna(text: str) -> tuple[np.ndarray, np.ndarray, float]:
+    """(tau, g, g_inf) from the fixed 10-character fields of *MAT_GENERAL_VISCOELASTIC."""
+    lines = [x for x in text.splitlines() if not x.startswith("$")]
+    start = lines.index("*MAT_GENERAL_VISCOELASTIC")
+    card1, card2 = lines[start + 1], lines[start + 2]
+    assert card1[:10].strip() == "1" and card1[10:30].strip() == ""  # MID; RO, BULK the user's
+    assert all(float(card2[i:i + 10]) == 0.0 for i in range(0, 80, 10))  # no curve fit asked
+    rows = []
+    for x in lines[start + 3:lines.index("*END")]:
+        assert len(x) == 40
+        rows.append([float(x[i:i + 10]) for i in range(0, 40, 10)])
+    rows = np.array(rows)
+    assert np.all(rows[:, 2:] == 0.0)  # no bulk relaxation
+    g_inf = float(np.sum(rows[rows[:, 1] == 0, 0]))
+    terms = rows[rows[:, 1] > 0]
+    return 1.0 / terms[:, 1], terms[:, 0], g_inf
+
+
+def test_lsdyna_cards_read_back_as_the_series(written, tmp_path, run_cli):
+    result, out = written
+    status, text, err = run_cli("export", out, "--format", "lsdyna", "--terms", "12", "--out",
+                                tmp_path / "p.k")
+    assert status == 0, err
+    prony = prony_series(result, terms=12)
+    tau, g, g_inf = parse_lsdyna((tmp_path / "p.k").read_text())
+    # Four significant digits in ten characters.
+    np.testing.assert_allclose(tau, prony.tau, rtol=5e-4)
+    np.testing.assert_allclose(g, prony.g, rtol=5e-4)
+    assert g_inf == pytest.approx(prony.g_inf, rel=5e-4)
+    t = np.logspace(-3, 1, 9)
+    relaxation = g_inf + np.sum(g * np.exp(-t[:, None] / tau), axis=1)
+    np.testing.assert_allclose(relaxation, prony.relaxation(t), rtol=1e-3)
+    # More terms than the card takes: refused with the way out.
+    status, _, err = run_cli("export", out, "--format", "lsdyna", "--per-decade", "10",
+                             "--out", tmp_path / "many.k")
+    assert status == 2 and "at most 18 terms" in err and "--terms 17" in err
+    assert not (tmp_path / "many.k").exists()

@@ -51,7 +51,7 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
             artists[f"{t:g}/{name}"] = ax.loglog(w, np.abs(part), "o", ms=3,
                                                  color=cmap(norm(t)), alpha=0.8)[0]
     grid = np.logspace(np.log10(lo_w), np.log10(hi_w), n_grid)
-    structure = get_structure(mc.structure)
+    structure = mc.master if mc.master is not None else get_structure(mc.structure)
     rng = np.random.default_rng(0)
     rows = rng.choice(mc.master_draws.shape[0], size=min(500, mc.master_draws.shape[0]),
                       replace=False)
@@ -73,8 +73,11 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     low = np.array([f["log10_aT"]["hdi_low"] for f in factors])
     high = np.array([f["log10_aT"]["hdi_high"] for f in factors])
     ax = axes[2]
+    shifts = {"free": "", "wlf": ", WLF sampled", "arrhenius": ", Arrhenius sampled"}[mc.law]
+    if mc.law == "free" and mc.law_evidence:
+        shifts = f"; free shifts P {mc.law_evidence['free']['probability']:.2f}"
     ax.errorbar(temps, mean, yerr=[mean - low, high - mean], fmt="o", color="k", ms=3,
-                capsize=2, label="posterior (94 % HDI)")
+                capsize=2, label=f"posterior (94 % HDI{shifts})")
     tt = np.linspace(temps.min(), temps.max(), 200)
     from ..tts import arrhenius, wlf
 
@@ -82,10 +85,14 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     c1, c2 = (laws["wlf"]["parameters"][k]["mean"] for k in ("C1", "C2"))
     ea = laws["arrhenius"]["parameters"]["Ea"]["mean"]
     t_ref = mc.reference_temperature
+    # The laws' probabilities: from ln Z where the laws were fitted inside the posterior
+    # (law="auto", against free shifts too), else from BIC on the shifts.
+    p = ({k: v["probability"] for k, v in mc.law_evidence.items()} if mc.law_evidence
+         else {k: v["probability"] for k, v in laws.items()})
     ax.plot(tt, wlf(tt, t_ref, c1, c2), "-", color="#0072B2",
-            label=f"WLF C1 {c1:.3g}, C2 {c2:.3g} °C (P {laws['wlf']['probability']:.2f})")
+            label=f"WLF C1 {c1:.3g}, C2 {c2:.3g} °C (P {p['wlf']:.2f})")
     ax.plot(tt, arrhenius(tt, t_ref, ea), "--", color="#D55E00",
-            label=f"Arrhenius Ea {ea / 1e3:.3g} kJ/mol (P {laws['arrhenius']['probability']:.2f})")
+            label=f"Arrhenius Ea {ea / 1e3:.3g} kJ/mol (P {p['arrhenius']:.2f})")
     ax.set_xlabel("T [°C]")
     ax.set_ylabel("log10 a_T")
     ax.legend(loc="best", fontsize=7)

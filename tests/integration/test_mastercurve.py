@@ -379,3 +379,24 @@ def test_a_shift_law_inside_the_posterior_is_stored_and_loaded(tmp_path, run_cli
     (tmp_path / "mc" / "zener.nc").unlink()
     status, _, err = run_cli("predict", tmp_path / "mc", "--quantity", "storage", "--omega", "1")
     assert status == 2 and "zener.nc': missing" in err
+
+
+def test_the_master_curve_figure_shows_the_shifts_and_the_laws_evidence(wlf_case):
+    import matplotlib.pyplot as plt
+
+    from bayesfo.plotting.mastercurve import plot_mastercurve
+
+    _, mc = wlf_case
+    drawn = plot_mastercurve(mc)
+    try:
+        means = [f["log10_aT"]["mean"] for f in mc.shift_factors()]
+        np.testing.assert_allclose(drawn.values["log10_aT_mean"], means)
+        labels = [t.get_text() for t in drawn.axes[2].get_legend().get_texts()]
+        p = mc.law_evidence["wlf"]["probability"]
+        assert labels[0].startswith("WLF C1 ") and labels[0].endswith(f"(P {p:.2f})")
+        assert labels[2] == "posterior (94 % HDI, WLF sampled)"
+        # The master's median lies on the reference isotherm's truth.
+        z = get_structure("zener").response([ZENER], drawn.values["omega_reduced"], "modulus")[0]
+        assert np.max(np.abs(drawn.values["storage_median"] / z.real - 1)) < 0.03
+    finally:
+        plt.close(drawn.figure)

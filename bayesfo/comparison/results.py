@@ -55,6 +55,9 @@ class StructureResult:
     #: they give the parameters their units.
     data_kind: str | None = None
     data_units: str = ""
+    #: The letter of the data's measured quantity (:attr:`FrequencyResponse.symbol`, set by
+    #: :class:`Comparison`): figures name the moduli by it (E_e for tensile data); names only.
+    data_symbol: str = "G"
 
     def __post_init__(self):
         if not isinstance(self.criteria, Criteria):
@@ -311,7 +314,8 @@ def data_problems(data: FrequencyResponse) -> list[str]:
     out = []
     bad = data.omega[data.dissipation_violations()]
     if bad.size:
-        loss = "Im J > 0" if data.kind == "compliance" else "Im G < 0"
+        letter = getattr(data, "response_symbol", "J" if data.kind == "compliance" else "G")
+        loss = f"Im {letter} > 0" if data.kind == "compliance" else f"Im {letter} < 0"
         shown = ", ".join(f"{w:.4g}" for w in bad[:6]) + (f" and {bad.size - 6} more"
                                                            if bad.size > 6 else "")
         out.append(f"{data.label}: {bad.size} of {data.n_frequencies} points have negative loss "
@@ -331,11 +335,14 @@ class Comparison:
     holdout: FrequencyResponse | None = None
 
     def __post_init__(self):
-        # Each result learns the kind and unit of the data, which give its parameters units.
+        # Each result learns the kind and unit of the data, which give its parameters units,
+        # and the data's symbol, which names them.
+        symbol = getattr(self.data, "symbol", "G")
         results = tuple(
-            dataclasses.replace(r, data_kind=self.data.kind, data_units=self.data.units or "")
-            if isinstance(r, StructureResult) and (r.data_kind, r.data_units)
-            != (self.data.kind, self.data.units or "") else r
+            dataclasses.replace(r, data_kind=self.data.kind, data_units=self.data.units or "",
+                                data_symbol=symbol)
+            if isinstance(r, StructureResult) and (r.data_kind, r.data_units, r.data_symbol)
+            != (self.data.kind, self.data.units or "", symbol) else r
             for r in self.results)
         object.__setattr__(self, "results", results)
 
@@ -424,7 +431,8 @@ class Comparison:
         summary = {
             "data": {"path": self.data.source, "name": self.data.label,
                      "n_frequencies": self.data.n_frequencies, "kind": self.data.kind,
-                     "units": self.data.units, "omega_min": float(self.data.omega.min()),
+                     "units": self.data.units, "symbol": self.data.symbol,
+                     "omega_min": float(self.data.omega.min()),
                      "omega_max": float(self.data.omega.max()),
                      "warnings": self.data_warnings, "notes": list(self.data.notes),
                      "dissipation_violations_omega":

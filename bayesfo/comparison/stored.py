@@ -201,8 +201,9 @@ def _data(summary: dict, idata, path: Path) -> tuple[FrequencyResponse, Frequenc
     # NetCDF gives an attribute of one element back as a scalar.
     attrs = {k: np.atleast_1d(v) if k == "sigma" or k.startswith("holdout_") else v
              for k, v in obs.attrs.items()}
+    # "symbol" came with the tensile labels (issue 33): an older summary.json means shear, G.
     common = dict(kind=meta["kind"], units=meta.get("units") or "", name=meta["name"],
-                  source=meta.get("path") or "")
+                  source=meta.get("path") or "", symbol=meta.get("symbol") or "G")
     data = FrequencyResponse(omega, response, attrs.get("sigma"), notes=tuple(meta["notes"]),
                              **common)
     if data.n_frequencies != meta["n_frequencies"]:

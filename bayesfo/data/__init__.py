@@ -13,8 +13,10 @@ CSV contract (see DESIGN.md) is:
 * optionally ``sigma`` (standard deviation of the complex value) and ``series`` (an identifier of
   a replicate series: replicates are averaged per frequency, and σ is estimated from their spread).
 
-Comment lines of the form ``# kind: modulus``, ``# units: MPa`` or ``# name: PP sample 3`` set the
-metadata of the response.
+Comment lines of the form ``# kind: modulus``, ``# units: MPa``, ``# name: PP sample 3`` or
+``# symbol: E`` (the measured quantity's letter: G shear or E tensile modulus, J or D their
+compliances, :mod:`~bayesfo.data.symbols`) set the metadata of the response. Lab files give the
+letter by their column names (``E'``, ``E_stor``, ``Tensile storage modulus``).
 
 Limits
 ------

@@ -285,8 +285,10 @@ def _data_set_(choice, cols, ctx, vals, kept, ignored, linenos_all, idx, label, 
                 f"{where}, line {lines[bad[0]]}, column '{labels.get(key, key)}': the value "
                 "is not finite in SI units (beyond the range of a double after converting "
                 "its unit); check the unit of the column")
-    fr = _from_columns(values, lines, where, kind=choice.kind, meta={}, units=units,
-                       name=_name(ctx, label), source=str(ctx["path"]), labels=labels)
+    fr = _from_columns(values, lines, where, kind=choice.kind,
+                       meta={k: v for k, v in ctx["meta"].items() if k == "symbol"}, units=units,
+                       name=_name(ctx, label), source=str(ctx["path"]), labels=labels,
+                       symbol=choice.symbol or None)
     if choice.series is None:
         w = values["omega"] if "omega" in values else 2 * np.pi * values["freq"]
         order = np.argsort(w, kind="stable")

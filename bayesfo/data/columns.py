@@ -278,6 +278,14 @@ class Choice:
     sigma: Column | None = None
     series: Column | None = None
 
+    @property
+    def symbol(self) -> str:
+        """The letter the response columns give the measured quantity (``"E"`` for ``E'`` and
+        ``E''`` or ``"Tensile storage modulus"``, ``"G"``, ``"J"``, ``"D"``), or ``""`` where
+        they give none or disagree."""
+        letters = {c.letter for c in self.response.values() if c.letter}
+        return next(iter(letters)) if len(letters) == 1 else ""
+
     def used(self) -> list[Column]:
         cols = [self.frequency, *self.response.values(), self.sigma, self.series,
                 self.temperature, self.block, self.frequency_check]

@@ -18,6 +18,7 @@ from .frequency_response import (
     FrequencyResponse,
     _mean_and_standard_error,
 )
+from .symbols import SYMBOLS
 
 FREQUENCY_COLUMNS = ("omega", "freq")
 RESPONSE_FORMS = (("real", "imag"), ("magnitude", "phase_deg"), ("storage", "loss"))
@@ -75,6 +76,10 @@ def read_csv(
     name: str | None = None,
 ) -> FrequencyResponse:
     """Read a frequency response from a CSV file in the bayesfo contract.
+
+    A ``# symbol:`` comment (``G``, ``E``, ``J`` or ``D``) names the measured quantity:
+    ``# symbol: E`` for a tensile modulus E′, E″ of a DMA (:attr:`FrequencyResponse.symbol`;
+    default G).
 
     Parameters
     ----------
@@ -138,7 +143,7 @@ def read_csv(
             body = stripped.lstrip("#").strip()
             if ":" in body:
                 key, value = body.split(":", 1)
-                if key.strip().lower() in ("kind", "units", "name"):
+                if key.strip().lower() in ("kind", "units", "name", "symbol"):
                     meta[key.strip().lower()] = value.strip()
             continue
         cells = csv_cells(line, where, lineno)
@@ -185,6 +190,7 @@ def _from_columns(
     values: dict[str, np.ndarray], linenos: np.ndarray, where: str, *, kind: str | None,
     meta: dict[str, str], units: str | None, name: str | None, source: str,
     notes: tuple[str, ...] = (), labels: dict[str, str] | None = None,
+    symbol: str | None = None,
 ) -> FrequencyResponse:
     """The checked, sorted response from parsed columns named as in the contract.
 
@@ -193,7 +199,8 @@ def _from_columns(
     in the file; every check of :func:`read_csv` after parsing the cells happens here, so that
     other readers that normalise a file to these columns keep the same limits. ``labels`` maps a
     contract name to the name shown in messages (a column of the original file); ``notes`` start
-    the notes of the response.
+    the notes of the response; ``symbol`` (the letter the columns give the response) else a
+    ``# symbol:`` line of ``meta`` else G names the measured quantity.
     """
     labels = labels or {}
 
@@ -211,6 +218,12 @@ def _from_columns(
     kind = kind if kind is not None else meta.get("kind", "generic")
     if kind not in KINDS:
         raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {show(str(kind))}")
+    if symbol is None:
+        symbol = meta.get("symbol", "G").strip()
+        if symbol not in SYMBOLS:
+            raise InputError(f"{where}: the '# symbol:' line must say G (shear modulus), E "
+                             "(tensile modulus), J (shear compliance) or D (tensile compliance), "
+                             f"got {show(symbol)}")
 
     if "omega" in values:
         omega, fcol = values["omega"], "omega"
@@ -274,6 +287,7 @@ def _from_columns(
         name=name if name is not None else meta.get("name", ""),
         source=source,
         notes=tuple(notes),
+        symbol=symbol,
     )
     return fr.sorted()
 

@@ -32,7 +32,7 @@ def comment_meta(lines: list[Line]) -> dict[str, str]:
         if ln.kind == "comment":
             key, sep, value = ln.text.strip().lstrip("#").partition(":")
             key = key.strip().lower()
-            if sep and key in ("kind", "units", "name", "temperature"):
+            if sep and key in ("kind", "units", "name", "temperature", "symbol"):
                 meta.setdefault(key, value.strip())
     return meta
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._io import atomic_write_text
 from ..errors import InputError
+from .symbols import RECIPROCAL, SYMBOLS, compliance_symbol, modulus_symbol, response_symbol
 
 KINDS = ("compliance", "modulus", "generic")
 
@@ -62,6 +63,15 @@ class FrequencyResponse:
     distinct_frequencies : bool
         Refuse a frequency that appears twice (default). Joint data sets of several isotherms
         (:mod:`bayesfo.tts`) repeat the frequencies of the sweep.
+    symbol : {"G", "E", "J", "D"}
+        The letter of the measured quantity, for names only (:mod:`bayesfo.data.symbols`):
+        ``"G"`` a shear modulus (the default), ``"E"`` a tensile (Young's) modulus as a DMA
+        measures it, ``"J"`` a shear and ``"D"`` a tensile compliance. The readers take it from
+        the columns (``E'``, ``E_stor``, ``"Tensile storage modulus"``, ``D'``) or a
+        ``# symbol:`` line; figures, reports and the terminal then say E′, E″, |E*|, E_e
+        instead of G′, G″, |G*|, G_e. It does not change a computation. Every copy keeps it
+        (slices, :meth:`split`, :meth:`to_csv_text`, :meth:`to_dict`); :meth:`reciprocal` turns
+        a modulus' letter into its compliance's (E → D).
 
     Raises
     ------
@@ -89,6 +99,7 @@ class FrequencyResponse:
     source: str = ""
     notes: tuple[str, ...] = field(default=())
     distinct_frequencies: bool = True
+    symbol: str = "G"
 
     def __post_init__(self):
         omega = _as_1d(self.omega, "omega", float)
@@ -127,6 +138,10 @@ class FrequencyResponse:
                 )
         if self.kind not in KINDS:
             raise InputError(f"argument 'kind' must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        if self.symbol not in SYMBOLS:
+            raise InputError(f"argument 'symbol' must be one of {', '.join(SYMBOLS)} (shear "
+                             f"modulus, tensile modulus, shear compliance, tensile compliance), "
+                             f"got {self.symbol!r}")
         for name, arr in (("omega", omega), ("response", response), ("sigma", sigma)):
             if arr is not None:
                 arr.setflags(write=False)
@@ -153,6 +168,22 @@ class FrequencyResponse:
     def phase_deg(self) -> np.ndarray:
         """arg G(jω) in degrees, in (−180, 180]."""
         return np.degrees(np.angle(self.response))
+
+    @property
+    def modulus_symbol(self) -> str:
+        """``"G"`` for shear, ``"E"`` for tensile data (whatever the kind)."""
+        return modulus_symbol(self.symbol)
+
+    @property
+    def compliance_symbol(self) -> str:
+        """``"J"`` for shear, ``"D"`` for tensile data (whatever the kind)."""
+        return compliance_symbol(self.symbol)
+
+    @property
+    def response_symbol(self) -> str:
+        """The letter of the response as its kind says: E for a tensile modulus, D for a
+        tensile compliance, G or J for shear (``symbol`` for a generic response)."""
+        return response_symbol(self.symbol, self.kind)
 
     @property
     def omega_ref(self) -> float:
@@ -224,12 +255,14 @@ class FrequencyResponse:
         mag2 = np.abs(self.response) ** 2
         kind = {"compliance": "modulus", "modulus": "compliance"}.get(self.kind, self.kind)
         units = f"1/({self.units})" if self.units else ""
+        symbol = RECIPROCAL[self.symbol] if kind != self.kind else self.symbol
         return replace(
             self,
             response=1.0 / self.response,
             sigma=None if self.sigma is None else self.sigma / mag2,
             kind=kind,
             units=units,
+            symbol=symbol,
             notes=self.notes + ("reciprocal of the measured response",),
         )
 
@@ -293,7 +326,7 @@ class FrequencyResponse:
     @classmethod
     def from_replicates(
         cls, omega, responses, *, kind: str = "generic", units: str = "", name: str = "",
-        source: str = "",
+        source: str = "", symbol: str = "G",
     ) -> FrequencyResponse:
         """Average replicate series measured at the same frequencies.
 
@@ -319,7 +352,8 @@ class FrequencyResponse:
         if responses.shape[0] < 2:
             raise InputError("argument 'responses' needs at least 2 replicate series")
         mean, sigma = _mean_and_standard_error([responses[:, k] for k in range(omega.size)])
-        return cls(omega, mean, sigma, kind=kind, units=units, name=name, source=source)
+        return cls(omega, mean, sigma, kind=kind, units=units, name=name, source=source,
+                   symbol=symbol)
 
     # ------------------------------------------------------------------ output
     def to_csv(self, path: str | os.PathLike) -> Path:
@@ -328,14 +362,16 @@ class FrequencyResponse:
 
     def to_csv_text(self, comments=()) -> str:
         """The response as CSV text of the contract (numbers written exactly), with ``# name:``,
-        ``# kind:`` and ``# units:`` lines and then ``comments`` (e.g. ``"temperature: 20 C"``),
-        each as a ``#`` line."""
+        ``# kind:``, ``# units:`` and, for a symbol other than the default G, ``# symbol:``
+        lines, and then ``comments`` (e.g. ``"temperature: 20 C"``), each as a ``#`` line."""
         lines = []
         if self.name:
             lines.append(f"# name: {self.name}")
         lines.append(f"# kind: {self.kind}")
         if self.units:
             lines.append(f"# units: {self.units}")
+        if self.symbol != "G":
+            lines.append(f"# symbol: {self.symbol}")
         lines.extend(f"# {c}" for c in comments)
         header = ["omega", "real", "imag"] + (["sigma"] if self.sigma is not None else [])
         lines.append(",".join(header))
@@ -357,12 +393,14 @@ class FrequencyResponse:
             return None
 
     def to_dict(self) -> dict:
-        """Plain-Python summary for JSON output (no arrays of data)."""
+        """Plain-Python summary for JSON output (no arrays of data); ``symbol`` is the letter
+        of the measured quantity (:attr:`symbol`)."""
         return {
             "name": self.label,
             "path": self.source,
             "kind": self.kind,
             "units": self.units,
+            "symbol": self.symbol,
             "n_frequencies": self.n_frequencies,
             "omega_min": float(self.omega.min()),
             "omega_max": float(self.omega.max()),

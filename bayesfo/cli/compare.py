@@ -67,8 +67,11 @@ def _compare(data, structures, out, workers, formats, no_figures, options):
     return result
 
 
-def _units_note(path, kind: str) -> str:
-    """What a run on data without units says: the parameters are in the data's own unit."""
+def _units_note(path, kind: str, letter: str = "G") -> str:
+    """What a run on data without units says: the parameters are in the data's own unit
+    (``[G]``, or ``[E]`` for tensile data measured as ``letter`` E)."""
+    from ..data.symbols import in_symbol
+
     if kind == "compliance":
         symbol, how = "[J]", ("give the response columns a unit in brackets (e.g. \"J' [1/Pa]\", "
                               "in the header or with --columns), or add a '# units: 1/Pa' line "
@@ -78,20 +81,34 @@ def _units_note(path, kind: str) -> str:
                               "Modulus [Pa]\",loss=\"Loss Modulus [Pa]\" (with the file's "
                               "headers), or add a '# units: Pa' line to a bayesfo CSV")
     return (f"bayesfo: note: '{path}' gives no unit for the response, so the parameters are in "
-            f"the data's own unit ({symbol} in the table and report); to name it, {how}")
+            f"the data's own unit ({in_symbol(symbol, letter)} in the table and report); to "
+            f"name it, {in_symbol(how, letter)}")
+
+
+def _quantity(data) -> str:
+    """`` (tensile: E′, E″)`` after the kind for tensile data (a DMA's E′, E″ or D′, D″),
+    nothing for shear data (G′, G″ or J′, J″, the default) and generic responses."""
+    from ..data.symbols import mode, parts
+
+    if data.kind not in ("modulus", "compliance") or mode(data.symbol) == "shear":
+        return ""
+    storage, loss = parts(data.symbol, data.kind)
+    return f" ({mode(data.symbol)}: {storage}, {loss})"
 
 
 def _print_undetermined(result) -> None:
     """Beneath the table: the parameters (in the form natural to the data) that the data do
     not determine, and the poorly determined orders, of each structure, best first."""
     from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names
+    from ..data.symbols import parameter_label
 
+    symbol = result.data.symbol
     vague, poor = [], []
     for row in result.table():
         if row.get("error"):
             continue
         r = result[row["structure"]]
-        names = flagged_names(r.natural_parameters)
+        names = [parameter_label(n, symbol) for n in flagged_names(r.natural_parameters)]
         if names:
             vague.append(f"{r.name}: {', '.join(names)}")
         orders = [n for n in r.structure.exponent_params
@@ -165,10 +182,11 @@ def run(args) -> int:
               "the summary", file=sys.stderr)
     if not args.quiet:
         if not data.units:
-            print(_units_note(args.data, data.kind), file=sys.stderr)
+            print(_units_note(args.data, data.kind, data.symbol), file=sys.stderr)
         n_fit = result.data.n_frequencies
         held = "" if result.holdout is None else f" ({result.holdout.n_frequencies} more held out)"
-        print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}; ranked by "
+        print(f"{data.label}: {n_fit} frequencies fitted{held}, kind {data.kind}"
+              f"{_quantity(data)}; ranked by "
               "log-evidence ln Z (importance or bridge sampling; L: from a tempered ladder); "
               "P = posterior "
               "probability, equal prior odds; ok = posterior certified; fits = posterior "

@@ -80,11 +80,19 @@ def run(args) -> int:
 def _print(info: dict, seen: set | None = None) -> None:
     """One data set's description; a note already printed for an earlier data set of the file
     (``seen``) is not repeated (a file of 20 isotherms printed the same 8 notes 20 times)."""
+    from ..data.symbols import describe, mode, response_symbol
+
     reading = info["reading"]
+    symbol = info.get("symbol", "G")
+    # Tensile data say so (E′, E″ of a DMA); shear, the default, is not repeated.
+    quantity = describe(symbol, info["kind"]) if mode(symbol) == "tensile" else ""
     print(f"{info['name']}: {info['n_frequencies']} frequencies, "
           f"{info['omega_min']:.4g} to {info['omega_max']:.4g} rad/s, kind {info['kind']}"
+          + (f" ({quantity})" if quantity else "")
           + (f", units {info['units']}" if info["units"] else ""))
-    print(f"|G| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}; "
+    letter = response_symbol(symbol, info["kind"])
+    star = "*" if info["kind"] in ("modulus", "compliance") else ""
+    print(f"|{letter}{star}| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}; "
           f"scaling omega_ref = {info['omega_ref']:.4g} rad/s, g_ref = {info['g_ref']:.4g}")
     print("sigma: " + ("given per point" if info["has_sigma"] else "not given (estimated when fitting)"))
     bad = info["dissipation_violations"]

@@ -8,6 +8,11 @@ coefficients, the form natural to the data first), warnings and convergence, and
 PNG figures are embedded as base64 data URIs and the style sheet is inline, so the file needs
 nothing else to be read or mailed. All text from data, files and results is escaped.
 
+The report speaks in the letters of the data (:attr:`bayesfo.data.FrequencyResponse.symbol`):
+for tensile data (a DMA's E′, E″) the data section says "tensile modulus E* = E′ + iE″", and
+the formulas, parameter names (E_e for the card's G_e, :mod:`bayesfo.data.symbols`) and captions
+say E and D where they say G and J for shear data.
+
 This module does not draw: it takes the figure files written by
 :func:`bayesfo.plotting.write_figures`, so it needs no plotting library.
 """
@@ -21,6 +26,7 @@ from pathlib import Path
 from .._io import atomic_write_text
 from ..comparison.parameters import UNDETERMINED_DECADES
 from ..comparison.table import number
+from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
@@ -107,10 +113,19 @@ def _noise(comparison) -> list[tuple[str, str]]:
     return seen
 
 
+def _symbol(comparison) -> str:
+    """The letter of the data's measured quantity (G when the data do not say)."""
+    return getattr(comparison.data, "symbol", "G")
+
+
 def _data_section(comparison) -> str:
     d = comparison.data
     rows = [
-        ("name", d.label), ("source", d.source or "(not from a file)"), ("kind", d.kind),
+        ("name", d.label), ("source", d.source or "(not from a file)"), ("kind", d.kind)]
+    quantity = describe(_symbol(comparison), d.kind)
+    if quantity and mode(_symbol(comparison)) == "tensile":  # shear, the default, is not said
+        rows.append(("quantity", quantity))
+    rows += [
         ("units", d.units or "(not given)"), ("frequencies", str(d.n_frequencies)),
         ("ω range", f"{d.omega.min():.4g} – {d.omega.max():.4g} rad/s"),
         ("σ per point", "given by the data" if d.sigma is not None else "not given"),
@@ -196,7 +211,17 @@ def _families(comparison) -> str:
             f"{rows}</table>")
 
 
+def _names_note(symbol: str) -> str:
+    """For tensile data: the moduli shown as E_e are keyed G_e in the files and options."""
+    if parameter_label("G_e", symbol) == "G_e":
+        return ""
+    return (" The moduli are named by the letter of the data, E for a tensile modulus (E_e, "
+            "E_m); summary.json, ranking.csv, the NetCDF files and --prior name them as the "
+            "structure's card does (G_e, G_m).")
+
+
 def _priors_section(comparison) -> str:
+    symbol = _symbol(comparison)
     parts = []
     for name in comparison.ranking:
         r = comparison[name]
@@ -209,7 +234,8 @@ def _priors_section(comparison) -> str:
                 desc = f"mean {prior['mu']:.4g}, sd {prior['sd']:.4g}"
             else:
                 desc = ", ".join(f"{k} = {v}" for k, v in prior.items() if k != "prior")
-            rows.append(f"<tr>{_text_cell(name)}{_text_cell(kind)}{_text_cell(desc)}</tr>")
+            rows.append(f"<tr>{_text_cell(parameter_label(name, symbol))}{_text_cell(kind)}"
+                        f"{_text_cell(desc)}</tr>")
         scale = ""
         if r.fit is not None and getattr(r.fit, "scaling", None) is not None:
             sc = r.fit.scaling
@@ -221,17 +247,18 @@ def _priors_section(comparison) -> str:
         if comparison.data.kind == "modulus" and r.structure.modulus_formula is not None:
             formula = (f"G*(s) = {r.structure.modulus_formula}, sampled as the card's "
                        f"compliance {formula}")
-        parts.append(f"<h3>{_e(r.name)}</h3><p class='small'>{_e(formula)}."
-                     f"{_e(scale)}</p><table><tr><th class='text'>parameter</th>"
+        parts.append(f"<h3>{_e(r.name)}</h3><p class='small'>{_e(in_symbol(formula, symbol))}."
+                     f"{_e(in_symbol(scale, symbol))}</p><table><tr><th class='text'>parameter</th>"
                      f"<th class='text'>prior</th><th class='text'>range</th></tr>"
                      f"{''.join(rows)}</table>")
     return ("<p class='small'>Coefficient priors apply on the scaled data (so that they mean "
             "the same for any units); exponents are unscaled. Every structure is also "
-            "restricted to stable, dissipative parameters (and its card's inequalities).</p>"
-            + "".join(parts))
+            "restricted to stable, dissipative parameters (and its card's inequalities)."
+            f"{_e(_names_note(symbol))}</p>" + "".join(parts))
 
 
 def _parameters_section(comparison) -> str:
+    symbol = _symbol(comparison)
     parts = []
     for name in comparison.ranking:
         r = comparison[name]
@@ -241,7 +268,8 @@ def _parameters_section(comparison) -> str:
         for p, s in r.posterior.summary.items():
             flags = _flags(judged.get(p, {})) + (["multimodal"] if s.multimodal else [])
             rows.append(
-                f"<tr>{_text_cell(p)}{_text_cell(units.get(p, ''))}{_cell(s.mean, '.4g')}"
+                f"<tr>{_text_cell(parameter_label(p, symbol))}"
+                f"{_text_cell(in_symbol(units.get(p, ''), symbol))}{_cell(s.mean, '.4g')}"
                 f"{_cell(s.sd, '.3g')}"
                 f"{_cell(s.hdi_low, '.4g')}{_cell(s.hdi_high, '.4g')}{_cell(s.median, '.4g')}"
                 f"{_cell(s.map, '.4g')}"
@@ -252,17 +280,23 @@ def _parameters_section(comparison) -> str:
         if phys is None or phys["picture"] is None:
             parts.append(f"<h3>{_e(name)}</h3>{sampled}")
             continue
-        physical = _physical_table(phys["physical"])
-        picture = _picture_text(r.structure, phys["picture"])
+        physical = _physical_table(phys["physical"], symbol)
+        picture = _picture_text(r.structure, phys["picture"], symbol)
+        compliance = _e(in_symbol(r.structure.formula, symbol))
         if phys["natural_form"] == "physical":
             parts.append(f"<h3>{_e(name)}</h3><p class='small'>Physical parameters ({picture}):"
                          f"</p>{physical}<p class='small'>As sampled: the card's coefficients "
-                         f"(compliance {_e(r.structure.formula)}) and the noise:</p>{sampled}")
+                         f"(compliance {compliance}) and the noise:</p>{sampled}")
         else:
             parts.append(f"<h3>{_e(name)}</h3><p class='small'>As sampled: the card's "
-                         f"coefficients (compliance {_e(r.structure.formula)}) and the noise:"
+                         f"coefficients (compliance {compliance}) and the noise:"
                          f"</p>{sampled}<p class='small'>Physical parameters ({picture}):</p>"
                          f"{physical}")
+    intro = in_symbol(
+        "Each structure's parameters are given in the form natural to the data first (modulus "
+        "data: moduli G [stress], quasi-properties c [stress·s^order], orders and times "
+        "τ [s]; compliance data: the card's coefficients a, b and orders), then in the "
+        "other form.", symbol) + _names_note(symbol)
     return (f"<p class='small'>Posterior summaries in physical units, the units derived from "
             f"the data's; HDI: {HDI_PERCENT} % highest-density interval; MAP: the draw of "
             "highest posterior density (for a physical parameter, its value at that draw). "
@@ -272,11 +306,7 @@ def _parameters_section(comparison) -> str:
             f"than {UNDETERMINED_DECADES:g} decades or runs to 0 or infinity (for a signed "
             "quantity: reaches across 0), or the quantity is undefined at more draws than the "
             "HDI leaves out, so the data do not fix even its order of magnitude and its numbers "
-            "are not estimates. Each "
-            "structure's parameters are given in the form natural to the data first (modulus "
-            "data: moduli G [stress], quasi-properties c [stress·s^order], orders and times "
-            "τ [s]; compliance data: the card's coefficients a, b and orders), then in the "
-            "other form.</p>" + "".join(parts))
+            f"are not estimates. {_e(intro)}</p>" + "".join(parts))
 
 
 _PARAMETER_HEAD = ("<tr><th class='text'>parameter</th><th class='text'>unit</th><th>mean</th>"
@@ -290,12 +320,14 @@ def _flags(s: dict) -> list[str]:
             else []) + (["poorly determined"] if s.get("poorly_determined") else [])
 
 
-def _physical_table(block: dict) -> str:
+def _physical_table(block: dict, symbol: str = "G") -> str:
     rows = []
     for p, s in block.items():
         flags = _flags(s)
         rows.append(
-            f"<tr>{_text_cell(p)}{_text_cell(s['unit'])}{_cell(s['mean'], '.4g')}"
+            f"<tr>{_text_cell(parameter_label(p, symbol))}"
+            f"{_text_cell(in_symbol(s['unit'], symbol))}"
+            f"{_cell(s['mean'], '.4g')}"
             f"{_cell(s['sd'], '.3g')}{_cell(s['hdi_low'], '.4g')}{_cell(s['hdi_high'], '.4g')}"
             f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}"
             f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
@@ -303,15 +335,16 @@ def _physical_table(block: dict) -> str:
             "</table>")
 
 
-def _picture_text(structure, picture: str) -> str:
-    """The picture's name, title and mechanical network, escaped."""
+def _picture_text(structure, picture: str, symbol: str = "G") -> str:
+    """The picture's name, title and mechanical network, escaped; the network's moduli and
+    G*(s) in the letters of data measured as ``symbol`` (E_e and E*(s) for tensile data)."""
     from ..structures import picture_of
 
     pic = picture_of(structure, picture)
     text = pic.name + (f", {pic.title}" if pic.title else "")
     if pic.network is not None:
-        text += (f"; network {pic.network.text}, G*(s) = "
-                 f"{pic.network.modulus_text(dict(structure.fixed))}")
+        text += in_symbol(f"; network {pic.network.text}, G*(s) = "
+                          f"{pic.network.modulus_text(dict(structure.fixed))}", symbol)
     if structure.fixed:
         text += " with " + ", ".join(f"{k} = {float(v):g}" for k, v in structure.fixed.items())
     return _e(text)
@@ -372,7 +405,8 @@ def _caption(name: str, comparison=None) -> str:
         if text:
             return text
     if name in CAPTIONS:
-        return CAPTIONS[name]
+        return CAPTIONS[name] if comparison is None else in_symbol(CAPTIONS[name],
+                                                                   _symbol(comparison))
     kind, _, structure = name.partition("_")
     if kind == "corner":
         return (f"Posterior of {structure}: marginal and pairwise distributions (log10 of "

@@ -19,6 +19,7 @@ import math
 
 from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names
 from ..comparison.table import ORDER_SYMBOLS
+from ..data.symbols import in_symbol, parameter_label
 
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
 EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
@@ -250,7 +251,8 @@ def _undetermined(result) -> list[str]:
     lists beneath the ranking."""
     if getattr(result, "posterior", None) is None:
         return []
-    return flagged_names(result.natural_parameters)
+    symbol = getattr(result, "data_symbol", "G")
+    return [parameter_label(n, symbol) for n in flagged_names(result.natural_parameters)]
 
 
 def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
@@ -260,15 +262,17 @@ def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
     if not phys or phys["picture"] is None:
         return []
     parts, vague = [], []
-    for p, s in phys["physical"].items():
-        if skip is not None and p in skip:
+    symbol = getattr(result, "data_symbol", "G")
+    for key, s in phys["physical"].items():
+        if skip is not None and key in skip:
             continue
+        p = parameter_label(key, symbol)  # E_e for G_e of tensile data
         if s.get("not_determined"):  # before the value: an undefined median is named too
             vague.append(f"{p} ({s['not_determined_reason']})")
             continue
         if not _finite(s.get("median")):
             continue
-        unit = f" {s['unit']}" if s["unit"] else ""
+        unit = f" {in_symbol(s['unit'], symbol)}" if s["unit"] else ""
         hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"
                if _finite(s.get("hdi_low")) and _finite(s.get("hdi_high")) else "")
         parts.append(f"{p} = {s['median']:.3g}{unit}{hdi}")

@@ -19,10 +19,11 @@ Modules
     :func:`~bayesfo.plotting.design.plot_design`: the predictions over an instrument window
     with the proposed frequencies (:func:`bayesfo.design`).
 ``material``
-    :func:`~bayesfo.plotting.material.plot_time_functions`: G(t) and J(t) with their bands.
+    :func:`~bayesfo.plotting.material.plot_time_functions`: G(t) and J(t) (E(t) and D(t) for
+    tensile data) with their bands.
 ``moduli``
-    :func:`plot_moduli`: storage and loss parts (G′, G″ or J′, J″) and tan δ with the
-    posterior bands.
+    :func:`plot_moduli`: storage and loss parts (G′, G″ or J′, J″; E′, E″ for tensile data)
+    and tan δ with the posterior bands.
 ``posterior``
     :func:`plot_corner`, :func:`plot_trace` (one structure).
 ``orders``

@@ -206,7 +206,8 @@ def sampling_coordinates(result):
     is_log = np.array([priors.get(n, {}).get("prior") == "log-uniform" for n in post.param_names])
     values = to_coordinates(post.samples, is_log)
     units = result_units(result)
-    labels = [_label(n, log, units.get(n, "")) for n, log in zip(post.param_names, is_log)]
+    symbol = result_symbol(result)
+    labels = [_label(n, log, units.get(n, ""), symbol) for n, log in zip(post.param_names, is_log)]
     return values, labels, is_log
 
 
@@ -251,8 +252,8 @@ def natural_coordinates(result) -> Coordinates:
     """The parameters that a structure's corner and trace figures draw: in the form natural to
     the data, as the report's tables and the verdict name them. For modulus data and a
     structure with a physical picture, its physical parameters (moduli, quasi-properties and
-    orders, e.g. G_e, c_q, q of the fractional Voigt; not the derived times), each positive
-    one on a log10 axis; otherwise the card's parameters as sampled
+    orders, e.g. G_e, c_q, q of the fractional Voigt, named E_e for tensile data; not the
+    derived times), each positive one on a log10 axis; otherwise the card's parameters as sampled
     (:func:`sampling_coordinates`). The noise parameters follow, as sampled."""
     post = result.posterior
     s = result.structure
@@ -280,10 +281,18 @@ def natural_coordinates(result) -> Coordinates:
     is_log = [n not in orders and bool(np.all(draws[:, i] > 0)) for i, n in enumerate(units)]
     is_log += [priors.get(n, {}).get("prior") == "log-uniform" for n in noise]
     sampled_units = result_units(result)
-    labels = ([_label(n, log, u) for (n, u), log in zip(units.items(), is_log)]
-              + [_label(n, log, sampled_units.get(n, ""))
+    symbol = result_symbol(result)
+    labels = ([_label(n, log, u, symbol) for (n, u), log in zip(units.items(), is_log)]
+              + [_label(n, log, sampled_units.get(n, ""), symbol)
                  for n, log in zip(noise, is_log[len(units):])])
     return Coordinates([*units, *noise], labels, is_log, convert, True)
+
+
+def result_symbol(result) -> str:
+    """The letter of the measured quantity of the data a result was run on
+    (:attr:`bayesfo.comparison.StructureResult.data_symbol`; ``"G"`` when it does not say)."""
+    symbol = getattr(result, "data_symbol", "G")
+    return symbol if isinstance(symbol, str) else "G"
 
 
 def result_units(result) -> dict[str, str]:
@@ -368,9 +377,13 @@ def param_symbol(name: str) -> str:
     return f"${head}_{{{tail}}}$" if tail and head else f"${name}$"
 
 
-def _label(name: str, log: bool, unit: str = "") -> str:
-    sym = param_symbol(name)
-    return (f"log$_{{10}}$ {sym}" if log else sym) + unit_suffix(unit)
+def _label(name: str, log: bool, unit: str = "", symbol: str = "G") -> str:
+    """The axis label of a parameter: its name in the letters of data measured as ``symbol``
+    (``G_e`` → ``$E_{e}$`` for tensile data), log10 where drawn so, and its unit."""
+    from ..data.symbols import in_symbol, parameter_label
+
+    sym = param_symbol(parameter_label(name, symbol))
+    return (f"log$_{{10}}$ {sym}" if log else sym) + unit_suffix(in_symbol(unit, symbol))
 
 
 #: Two curves that differ by less than this fraction of their axis' span at every point are

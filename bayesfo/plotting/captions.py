@@ -97,7 +97,18 @@ def nyquist_form(comparison) -> str:
 def figure_caption(name: str, comparison) -> str | None:
     """The caption of the figure ``name`` of :func:`~bayesfo.plotting.write_figures` drawn from
     ``comparison`` (``corner_<structure>`` and ``trace_<structure>`` by the structure's file
-    stem), or None for a name it does not know."""
+    stem), or None for a name it does not know. The response's symbols follow the data's
+    (E′, E″, E(t), D(t) for tensile data, :attr:`~bayesfo.data.FrequencyResponse.symbol`)."""
+    from ..data.symbols import in_symbol
+
+    text = _combined_caption(name, comparison)
+    if text is not None:
+        return in_symbol(text, getattr(comparison.data, "symbol", "G"))
+    return _structure_caption(name, comparison)
+
+
+def _combined_caption(name: str, comparison) -> str | None:
+    """The caption of a figure of the whole comparison, written for shear data."""
     if name == "ranking":
         return ("Log-evidence (top) and information criteria (bottom) relative to the best "
                 "structure, in nats, higher is better; posterior probabilities right of the "
@@ -136,6 +147,11 @@ def figure_caption(name: str, comparison) -> str | None:
         return ("Posterior density of the fractional order per structure (best on top), with "
                 "the prior (dashed), the 94 % HDI (bar) and the mean (tick); orders determined "
                 "too sharply to see at this scale are zoomed in an inset.")
+    return None
+
+
+def _structure_caption(name: str, comparison) -> str | None:
+    """The caption of a structure's corner or trace figure."""
     kind, _, stem = name.partition("_")
     by_stem = {file_stem(r.name): r for r in comparison.results if r.error is None}
     result = by_stem.get(stem)

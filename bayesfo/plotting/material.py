@@ -4,7 +4,8 @@ compliance J(t) of each structure's posterior, with credible bands.
 G(t) and J(t) are those of :func:`bayesfo.predict` (fixed-Talbot inversion of G*(s)/s and
 J*(s)/s for every draw; :mod:`bayesfo.predictions`), for thinned posterior draws. The times run
 from a tenth of 1/ω_max to ten times 1/ω_min; the data inform about 1/ω_max … 1/ω_min, and the
-stretches beyond are shaded as extrapolation.
+stretches beyond are shaded as extrapolation. Tensile data (``symbol`` E) are labelled E(t) and
+D(t), the tensile relaxation modulus and creep compliance.
 """
 
 from __future__ import annotations
@@ -55,7 +56,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
         For generic (transfer-function) data, or an unknown or failed structure.
     """
     from ..predictions import evaluate
-    from ..predictions.functions import QUANTITIES, _unit
+    from ..predictions.functions import _unit
 
     data = comparison.data
     if data.kind not in ("modulus", "compliance"):
@@ -70,6 +71,9 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
     from .style import style
 
     quantities = ("relaxation_modulus", "creep_compliance")
+    # G(t) and J(t) for shear data, E(t) and D(t) for tensile data
+    symbols = {"relaxation_modulus": f"{data.modulus_symbol}(t)",
+               "creep_compliance": f"{data.compliance_symbol}(t)"}
     with style():
         fig = new_figure(fig, (COLUMN_WIDTH, 4.4))
         axes = fig.subplots(2, 1, sharex=True)
@@ -86,7 +90,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
             ax.set_xscale("log")
             ax.set_yscale("log")
             u = _unit(q, data) if data.units else ""
-            ax.set_ylabel(QUANTITIES[q][1] + (f" [{u}]" if u else ""))
+            ax.set_ylabel(symbols[q] + (f" [{u}]" if u else ""))
             lo, hi = t[0], t[-1]
             ax.axvspan(lo, window[0], color="0.93", lw=0, zorder=0)
             ax.axvspan(window[1], hi, color="0.93", lw=0, zorder=0)

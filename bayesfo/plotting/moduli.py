@@ -2,7 +2,8 @@
 
 For a modulus G* = G′ + iG″ the figure shows G′(ω), G″(ω) and tan δ = G″/G′; for a compliance
 J* = J′ − iJ″ (the loss compliance J″ ≥ 0, see :class:`~bayesfo.data.FrequencyResponse`) it
-shows J′, J″ and tan δ = J″/J′. Generic transfer functions have no storage and loss parts:
+shows J′, J″ and tan δ = J″/J′. Tensile data (``symbol`` E, a DMA's E′, E″) are labelled E′, E″
+(compliance D′, D″). Generic transfer functions have no storage and loss parts:
 :func:`plot_moduli` refuses them.
 
 The bands are those of the Bode figure (:mod:`bayesfo.plotting.response`): pointwise 50 % and
@@ -19,6 +20,7 @@ import math
 
 import numpy as np
 
+from ..data.symbols import parts as part_symbols
 from ..errors import InputError
 from ._base import Drawn, new_figure
 from ._compute import (
@@ -33,7 +35,8 @@ from ._legend import _legend, _note_artists
 from .response import DATA_STYLE, HOLDOUT_STYLE, OMEGA_LABEL, _band_handle, positive_band
 from .style import COLUMN_WIDTH, comparison_styles, unit_suffix
 
-#: Symbols of the panels for each kind of data: (storage, loss).
+#: Symbols of the panels for each kind of shear data: (storage, loss); tensile data (symbol E)
+#: take E′, E″ and D′, D″ (:func:`bayesfo.data.symbols.parts`).
 PARTS = {"modulus": ("G′", "G″"), "compliance": ("J′", "J″")}
 QUANTITIES = ("storage", "loss", "tan_delta")
 
@@ -111,7 +114,7 @@ def plot_moduli(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS
     data = comparison.data
     storage_loss(np.zeros(1, complex), data.kind)  # refuses generic data before any work
     results = select_results(comparison, structures)
-    sym_storage, sym_loss = PARTS[data.kind]
+    sym_storage, sym_loss = part_symbols(data.symbol, data.kind)
     omega = omega_grid(comparison, n_grid)
     styles = comparison_styles(comparison)
     values, artists = {"omega": omega}, {}

@@ -410,8 +410,9 @@ def _plot_particles(result, fig, ds, lp, coords, chains) -> Drawn:
                      f"particles\nR-hat {post.rhat_max:.3f}, ESS {post.ess_min:.0f} across "
                      "the runs")
         else:
-            title = (f"{result.name}: {n_draws} draws resampled from importance "
-                     f"weights\n(ESS of the weights {post.ess_min:.0f})")
+            # Two short lines: a long structure name on one line ran past the column's edges.
+            title = (f"{result.name}: {n_draws} draws\nresampled from importance weights "
+                     f"(ESS of the weights {post.ess_min:.0f})")
         if not post.converged:
             title += ": the runs disagree"
         fig.suptitle(title, color=FLAG_COLOR if not post.converged else "black", fontsize=7.5)

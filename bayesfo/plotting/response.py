@@ -160,7 +160,7 @@ def plot_bode(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS, 
     data = comparison.data
     omega = omega_grid(comparison, n_grid)
     styles = comparison_styles(comparison)
-    sym = quantity_symbol(data.kind)
+    sym = quantity_symbol(data.kind, data.symbol)
     values, artists = {"omega": omega}, {}
     handles, labels = [], []
     with style():
@@ -284,7 +284,7 @@ def plot_nyquist(comparison, structures=None, ax=None, *, n_draws: int = N_DRAWS
     log = form == "log"
     omega = omega_grid(comparison, n_grid)
     styles = comparison_styles(comparison)
-    sym = quantity_symbol(data.kind)
+    sym = quantity_symbol(data.kind, data.symbol)
     units = unit_suffix(data.units)
     values = {"omega": omega, "form": form, "decades": decades}
     artists = {}

@@ -160,9 +160,14 @@ def colors_for(names) -> dict[str, str]:
 QUANTITY = {"compliance": "J^*", "modulus": "G^*", "generic": "G"}
 
 
-def quantity_symbol(kind: str) -> str:
-    """Mathtext symbol of the response for data of ``kind`` (J*, G*, or G)."""
-    return QUANTITY.get(kind, "G")
+def quantity_symbol(kind: str, symbol: str = "G") -> str:
+    """Mathtext symbol of the response for data of ``kind`` measured as ``symbol``
+    (:attr:`~bayesfo.data.FrequencyResponse.symbol`): G* or J* for shear, E* or D* for
+    tensile data, the plain letter for a generic response."""
+    from ..data.symbols import response_symbol
+
+    letter = response_symbol(symbol, kind)
+    return f"{letter}^*" if kind in ("modulus", "compliance") else letter
 
 
 def unit_suffix(units: str) -> str:

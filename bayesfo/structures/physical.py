@@ -17,6 +17,11 @@ of the orders). A picture without ``parameters`` takes the card's parameters as 
 their units then follow from the terms (:mod:`bayesfo.structures.scaling`). Exponent parameters
 (orders) are physical parameters of every picture, without unit.
 
+The names are keys (``summary.json``, ``ranking.csv``, ``--prior``) whatever the data; for
+tensile data (:attr:`~bayesfo.data.FrequencyResponse.symbol` E, a DMA's E′, E″) figures, the
+report and the terminal show the moduli in the tensile letter, E_e for G_e
+(:func:`display_name`).
+
 Units come from the data: for modulus data in Pa the stress unit is Pa; for compliance data in
 1/Pa it is again Pa; for other units the inverse of the data's unit (``1/(µm/N)``); without
 units, ``[G]`` (modulus data) or ``1/[J]`` (compliance data, generic data). All functions take
@@ -205,6 +210,20 @@ def _check_points(structure) -> np.ndarray:
 
 def _inverse_values(picture: Picture, phys: dict) -> dict:
     return {k: e(phys) for k, e in picture.inverse}
+
+
+def display_name(name: str, symbol: str = "G") -> str:
+    """A parameter's name as shown for data measured as ``symbol``: ``G_e`` → ``E_e`` for
+    tensile data (:func:`bayesfo.data.symbols.parameter_label`); the key stays ``G_e``.
+
+    Examples
+    --------
+    >>> display_name("G_m", "E"), display_name("G_m", "G"), display_name("c_q", "E")
+    ('E_m', 'G_m', 'c_q')
+    """
+    from ..data.symbols import parameter_label
+
+    return parameter_label(name, symbol)
 
 
 # ---------------------------------------------------------------------------- units

@@ -100,7 +100,7 @@ def run(args) -> int:
 def _csv_text(p) -> str:
     from ..predictions.functions import QUANTITIES
 
-    lines = [f"# {QUANTITIES[p.quantity][1]} ({p.quantity}) in {p.unit or 'no unit'}; "
+    lines = [f"# {p.symbol or QUANTITIES[p.quantity][1]} ({p.quantity}) in {p.unit or 'no unit'}; "
              f"94 % HDI of the posterior; "
              + (f"structure {p.structure}" if p.weights is None else
                 f"{p.average} average: {_weights(p)}")]
@@ -125,7 +125,8 @@ def _print(p) -> None:
 
     who = f"structure {p.structure}" if p.weights is None else f"{p.average} average ({_weights(p)})"
     unit = f" [{p.unit}]" if p.unit else ""
-    print(f"{QUANTITIES[p.quantity][1]}{unit} of {who}: posterior median and 94 % HDI")
+    print(f"{p.symbol or QUANTITIES[p.quantity][1]}{unit} of {who}: posterior median and 94 % "
+          "HDI")
     print(f"{'x [' + p.x_unit + ']':>14} {'median':>12} {'HDI low':>12} {'HDI high':>12}")
     for x, m, lo, hi, out in zip(p.x, p.median, p.hdi_low, p.hdi_high, p.extrapolated,
                                  strict=True):

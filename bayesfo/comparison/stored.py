@@ -309,7 +309,7 @@ def _mastercurve(summary: dict, d: Path, library):
     sigma = obs.attrs.get("sigma")
     sigma = None if sigma is None else np.atleast_1d(np.asarray(sigma, dtype=float))
     common = dict(kind=meta["kind"], units=meta.get("units") or "",
-                  source=meta.get("path") or "")
+                  source=meta.get("path") or "", symbol=meta.get("symbol") or "G")
     isotherms = tuple(
         FrequencyResponse(omega[point == i], response[point == i],
                           None if sigma is None else sigma[point == i], name=m["name"],

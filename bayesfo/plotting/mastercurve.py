@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..data.symbols import parts as parts_of
+from ..data.symbols import response_symbol
 from ._base import Drawn, new_figure
 
 
@@ -30,8 +32,9 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     axes = fig.subplots(1, 3)
     modulus = mc.data.kind == "modulus"
     parts = ("storage", "loss") if modulus else ("storage_compliance", "loss_compliance")
-    symbols = ("G′", "G″") if modulus else ("J′", "J″")
-    unit = mc.data.units or ("[G]" if modulus else "[J]")
+    symbols = parts_of(mc.data.symbol, mc.data.kind)
+    letter = response_symbol(mc.data.symbol, mc.data.kind)
+    unit = mc.data.units or f"[{letter}]"
     temps = np.asarray(mc.temperatures)
     cmap = mpl.colormaps["coolwarm"]
     norm = mpl.colors.Normalize(temps.min(), temps.max())
@@ -132,7 +135,7 @@ def plot_van_gurp_palmen(mc, *, ax=None) -> Drawn:
             (artists[f"{t:g}"],) = ax.plot(mag, delta, "o-", ms=2.5, lw=0.7,
                                            color=cmap(norm(t)))
         ax.set_xscale("log")
-        sym = "G" if mc.data.kind == "modulus" else "J"
+        sym = response_symbol(mc.data.symbol, mc.data.kind)
         unit = f" [{mc.data.units}]" if mc.data.units else ""
         ax.set_xlabel(f"|{sym}*|{unit}")
         ax.set_ylabel("loss angle δ [deg]")

@@ -84,6 +84,9 @@ class Prediction:
         weightings disagreeing, a discrete spectrum).
     values : ndarray, shape (n_draws, n_x)
         The quantity for each draw used.
+    symbol : str
+        The quantity's symbol in the letters of the data (E′, E(t), D(t) for tensile data;
+        :mod:`bayesfo.data.symbols`).
     """
 
     quantity: str
@@ -99,13 +102,15 @@ class Prediction:
     average: str | None = None
     notes: tuple[str, ...] = ()
     values: np.ndarray = field(default=None, repr=False)
+    symbol: str = ""
 
     def to_dict(self) -> dict:
         """The JSON form (``bayesfo predict --json``): plain lists, NaN as None."""
         def plain(a):
             return [None if not math.isfinite(v) else float(v) for v in np.asarray(a, float)]
 
-        out = {"quantity": self.quantity, "unit": self.unit, "x": plain(self.x),
+        out = {"quantity": self.quantity, "symbol": self.symbol or QUANTITIES[self.quantity][1],
+               "unit": self.unit, "x": plain(self.x),
                "x_unit": self.x_unit, "median": plain(self.median),
                "hdi_low": plain(self.hdi_low), "hdi_high": plain(self.hdi_high),
                "extrapolated": [bool(v) for v in self.extrapolated]}
@@ -208,7 +213,7 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
     undefined = np.flatnonzero(np.isnan(median))
     if undefined.size:
         shown = ", ".join(f"{v:.4g}" for v in x[undefined[:6]])
-        notes.append(f"{QUANTITIES[quantity][1]} is not finite for some draws at {X_NAMES[domain]} "
+        notes.append(f"{_symbol(quantity, data)} is not finite for some draws at {X_NAMES[domain]} "
                      f"{shown}{' and more' if undefined.size > 6 else ''} {X_UNITS[domain]}: "
                      "no value or band there")
     return Prediction(
@@ -216,7 +221,7 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, data.omega),
         structure=next(iter(weights)) if average is None else None,
         weights=dict(weights) if average is not None else None, average=average,
-        notes=tuple(notes), values=values)
+        notes=tuple(notes), values=values, symbol=_symbol(quantity, data))
 
 
 #: How each kind of quantity scales with the vertical shift b_T and the horizontal a_T
@@ -257,7 +262,8 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
     return Prediction(
         quantity=quantity, unit=_unit(quantity, mc.data), x=x, x_unit=X_UNITS[domain],
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, window),
-        structure=mc.structure, notes=tuple(notes), values=values)
+        structure=mc.structure, notes=tuple(notes), values=values,
+        symbol=_symbol(quantity, mc.data))
 
 
 # ---------------------------------------------------------------------------- checks
@@ -446,6 +452,13 @@ def _outside(x, domain: str, omega) -> np.ndarray:
     if domain == "omega":
         return (x < w_lo) | (x > w_hi)
     return (x < 1.0 / w_hi) | (x > 1.0 / w_lo)
+
+
+def _symbol(quantity: str, data) -> str:
+    """The quantity's symbol in the data's letters (E′ for a tensile modulus)."""
+    from ..data.symbols import in_symbol
+
+    return in_symbol(QUANTITIES[quantity][1], getattr(data, "symbol", "G"))
 
 
 def _unit(quantity: str, data) -> str:

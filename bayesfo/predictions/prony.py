@@ -44,6 +44,9 @@ FORMATS = ("csv", "abaqus", "ansys", "lsdyna")
 LSDYNA_MAX_TERMS = 18
 #: Decades of relaxation times beyond the data window on each side.
 TAU_MARGIN = 2
+#: A g_0 more than this many times the largest measured |G*| is named in the files as the
+#: model's extrapolation.
+EXTRAPOLATED = 1.5
 
 
 @dataclass(frozen=True)
@@ -71,6 +74,12 @@ class Prony:
         For a master curve: ``{"name": "wlf" | "arrhenius", "reference_temperature",
         "parameters": {NAME: value}, "temperatures": (min, max), "chi2_per_dof"}`` (values
         in °C and J/mol, posterior means), written with the series.
+    symbol : str
+        The letter of the measured quantity (``"G"`` shear, ``"E"`` tensile; see
+        :mod:`bayesfo.data.symbols`), which the files name.
+    measured_max : float
+        The largest |G*| the data give (NaN where unknown): a g_0 far above it is the model
+        extrapolated past the highest measured frequency, and the files say so.
     """
 
     tau: np.ndarray
@@ -83,6 +92,8 @@ class Prony:
     max_rel_error_relaxation: float
     band_rel_halfwidth: float
     shift_law: dict | None = None
+    symbol: str = "G"
+    measured_max: float = math.nan
 
     @property
     def g_0(self) -> float:
@@ -101,14 +112,26 @@ class Prony:
         """The series in ``fmt`` (one of :data:`FORMATS`)."""
         if fmt not in FORMATS:
             raise InputError(f"export: format must be one of {', '.join(FORMATS)}, got {fmt!r}")
-        head = [f"Prony series of {self.source} (bayesfo), modulus in {self.unit or 'the data unit'} "
-                "(shear G or tensile E, as measured)",
+        from ..data.symbols import mode as mode_of
+        from ..data.symbols import modulus_symbol
+
+        e, mode = modulus_symbol(self.symbol), mode_of(self.symbol)
+        head = [f"Prony series of {self.source} (bayesfo), {mode} modulus {e} in "
+                f"{self.unit or 'the data unit'}, as measured",
                 f"fitted over t = {self.window[0]:.4g} to {self.window[1]:.4g} s (the data window)",
                 f"g_inf = {self.g_inf:.10g}", f"g_0 = {self.g_0:.10g}",
                 f"max_rel_error = {max(self.max_rel_error_modulus, self.max_rel_error_relaxation):.3g}"
-                f" (G', G'': {self.max_rel_error_modulus:.3g}; G(t): "
-                f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of G(t) is at least "
-                f"+-{self.band_rel_halfwidth:.3g} (relative) there"]
+                f" ({e}', {e}'': {self.max_rel_error_modulus:.3g}; {e}(t): "
+                f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of {e}(t) is at "
+                f"least +-{self.band_rel_halfwidth:.3g} (relative) there"]
+        if self.g_0 > EXTRAPOLATED * self.measured_max:
+            head.append(f"g_0 is the model's modulus {TAU_MARGIN} decades past the highest "
+                        f"measured frequency, {self.g_0 / self.measured_max:.3g} x the largest "
+                        f"measured |{e}*| ({self.measured_max:.4g}): ratios g_i/g_0 depend on "
+                        "that extrapolation")
+        if mode == "tensile" and fmt in ("abaqus", "ansys"):
+            head.append("a tensile series: its ratios g_i/g_0 stand for the shear ratios the "
+                        "code takes under a constant Poisson's ratio")
         law = self.shift_law
         if law is not None:
             head.append(self._law_text())
@@ -284,8 +307,11 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     half = float(np.min((g_t.hdi_high - g_t.hdi_low) / 2 / np.abs(g_t.median)))
     from dataclasses import replace
 
+    data = result.master_data() if master else result.data
+    measured = np.abs(data.response if data.kind == "modulus" else 1.0 / data.response)
     return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
-                   band_rel_halfwidth=half, shift_law=_shift_law(result) if master else None)
+                   band_rel_halfwidth=half, shift_law=_shift_law(result) if master else None,
+                   symbol=data.symbol, measured_max=float(np.max(measured)))
 
 
 def _shift_law(mc) -> dict:

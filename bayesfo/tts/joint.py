@@ -69,7 +69,7 @@ class _Isotherms:
             omega, response, sigma, kind=first.kind, units=first.units,
             name=f"{first.label.split(',')[0]}: {len(self.data)} isotherms, "
                  f"{min(self.temperatures):g} to {max(self.temperatures):g} °C",
-            source=first.source, distinct_frequencies=False)
+            source=first.source, distinct_frequencies=False, symbol=first.symbol)
 
     @cached_property
     def point_isotherm(self) -> np.ndarray:
@@ -183,7 +183,8 @@ def _reduced(iso: _Isotherms, log_shifts, log_vertical=None) -> FrequencyRespons
         np.add.at(s2, groups, (j.sigma * scale)[order] ** 2)
         sigma = np.sqrt(s2) / np.bincount(groups)
     return FrequencyResponse(omega[keep], r, sigma, kind=j.kind, units=j.units,
-                             name=f"master curve of {j.label}", source=j.source)
+                             name=f"master curve of {j.label}", source=j.source,
+                             symbol=j.symbol)
 
 
 # ---------------------------------------------------------------------------- result

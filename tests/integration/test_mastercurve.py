@@ -400,3 +400,12 @@ def test_the_master_curve_figure_shows_the_shifts_and_the_laws_evidence(wlf_case
         assert np.max(np.abs(drawn.values["storage_median"] / z.real - 1)) < 0.03
     finally:
         plt.close(drawn.figure)
+
+
+def test_tensile_isotherms_keep_their_letter():
+    from bayesfo.tts.joint import _isotherms, _reduced
+
+    pairs = [(FrequencyResponse(d.omega, d.response, kind="modulus", units="Pa", symbol="E"), t)
+             for d, t in isotherms(np.zeros(6))]
+    iso = _isotherms(pairs, 20.0)
+    assert iso.joint.symbol == "E" and _reduced(iso, np.zeros(6)).symbol == "E"

@@ -137,3 +137,23 @@ def test_terminal_lines_of_inspect_and_compare(comparison, tmp_path, capsys):
     out = capsys.readouterr().out
     assert ("dma sim: 12 frequencies fitted, kind modulus (tensile: E′, E″); ranked by "
             "log-evidence") in out
+
+
+def test_predictions_and_prony_files_speak_the_tensile_letter(comparison):
+    from bayesfo.predictions import predict, prony_series
+
+    p = predict(comparison, "relaxation_modulus", [0.1, 1.0])
+    assert p.symbol == "E(t)" and p.to_dict()["symbol"] == "E(t)"
+    assert predict(comparison, "storage", [1.0]).symbol == "E′"
+    assert predict(comparison, "creep_compliance", [1.0]).symbol == "D(t)"
+    prony = prony_series(comparison)
+    assert prony.symbol == "E"
+    head = prony.text("abaqus").splitlines()[0]
+    assert "tensile modulus E in" in head
+    text = prony.text("abaqus")
+    assert "(E', E'':" in text and "E(t):" in text and "G(t)" not in text
+    assert "stand for the shear ratios the code takes under a constant Poisson's ratio" in text
+    # The Voigt's modulus grows without bound: g_0 is the model two decades past the data,
+    # and the file says how far above the largest measured |E*| it lies.
+    assert prony.g_0 > 1.5 * prony.measured_max
+    assert f"{prony.g_0 / prony.measured_max:.3g} x the largest measured |E*|" in text

@@ -33,11 +33,16 @@ def add_parser(subparsers):
     who = p.add_mutually_exclusive_group()
     who.add_argument("--structure", metavar="S", help="the structure (default: the best ranked)")
     who.add_argument("--average", choices=AVERAGES, help="an average over the structures")
+    p.add_argument("--figure", metavar="FILE.png",
+                   help="also draw the series' G(t) against the model's band and its relative "
+                        "error (format from the suffix: png, pdf, svg)")
     p.add_argument("--seed", type=int, default=0, help="seed of the draws used (default 0)")
     return p
 
 
 def run(args) -> int:
+    from pathlib import Path
+
     from .._io import atomic_write_text
     from ..comparison import load
     from ..errors import InputError
@@ -52,6 +57,10 @@ def run(args) -> int:
         raise InputError(str(exc).replace("predict: ", "", 1).replace("export: ", "", 1)
                          .replace("terms per decade", "--per-decade")
                          .replace("the number of terms", "--terms")) from None
+    if args.figure is not None:
+        suffix = Path(args.figure).suffix.lower()
+        if suffix not in (".png", ".pdf", ".svg"):
+            raise InputError(f"--figure '{args.figure}': give a .png, .pdf or .svg file")
     try:
         text = prony.text(args.format)
     except InputError as exc:
@@ -62,6 +71,21 @@ def run(args) -> int:
     except OSError as exc:
         raise InputError(f"--out '{args.out}': cannot be written ({exc.strerror or exc})") \
             from None
+    if args.figure is not None:
+        from ._libraries import load_libraries
+
+        load_libraries((Path(args.figure).suffix.lower().lstrip("."),))
+        from ..plotting.output import save_figure
+        from ..plotting.prony import plot_prony
+
+        drawn = plot_prony(result, prony, structure=args.structure, average=args.average,
+                           seed=args.seed)
+        try:
+            save_figure(drawn.figure, args.figure, close=True)
+        except OSError as exc:
+            raise InputError(f"--figure '{args.figure}': cannot be written "
+                             f"({exc.strerror or exc})") from None
+        print(f"wrote {args.figure}")
     error = max(prony.max_rel_error_modulus, prony.max_rel_error_relaxation)
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "

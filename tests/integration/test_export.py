@@ -162,3 +162,31 @@ def test_lsdyna_cards_read_back_as_the_series(written, tmp_path, run_cli):
                              "--out", tmp_path / "many.k")
     assert status == 2 and "at most 18 terms" in err and "--terms 17" in err
     assert not (tmp_path / "many.k").exists()
+
+
+def test_the_series_is_drawn_against_the_band(written, tmp_path, run_cli):
+    import matplotlib.pyplot as plt
+
+    from bayesfo.plotting.prony import plot_prony
+
+    result, out = written
+    prony = prony_series(result)
+    drawn = plot_prony(result, prony)
+    try:
+        v = drawn.values
+        np.testing.assert_allclose(v["series"], prony.relaxation(v["t"]))
+        inside = (v["t"] >= prony.window[0]) & (v["t"] <= prony.window[1])
+        # On a finer grid than the stated error's (50 times), within twice that error.
+        assert np.max(np.abs(v["relative_error"][inside])) <= 2 * prony.max_rel_error_relaxation
+        assert np.all(v["model_low"] <= v["model_median"]) and np.all(
+            v["model_median"] <= v["model_high"])
+    finally:
+        plt.close(drawn.figure)
+    status, text, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "p.csv",
+                                "--figure", tmp_path / "p.png")
+    assert status == 0, err
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    status, _, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "q.csv",
+                             "--figure", tmp_path / "p.gif")
+    assert status == 2 and "give a .png, .pdf or .svg file" in err
+    assert not (tmp_path / "q.csv").exists()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 from ..errors import InputError
 
@@ -41,6 +42,8 @@ def add_parser(subparsers):
                    help="[°C] of a master curve: the function at T (within the isotherms' "
                         "temperatures) instead of the reference temperature, each draw with its "
                         "own shift factors")
+    p.add_argument("--figure", metavar="FILE.png",
+                   help="also draw the median and 94 %% band (png, pdf or svg by the suffix)")
     p.add_argument("--seed", type=int, default=0, help="seed of the draws used (default 0)")
     return p
 
@@ -78,6 +81,9 @@ def run(args) -> int:
         raise InputError(f"--quantity {args.quantity} is a function of {_X_NAMES[domain]}: "
                          f"give {option}, not {given}")
     x = parse_grid(getattr(args, option.lstrip("-")), option)
+    if args.figure is not None and Path(args.figure).suffix.lower() not in (".png", ".pdf",
+                                                                           ".svg"):
+        raise InputError(f"--figure '{args.figure}': give a .png, .pdf or .svg file")
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     try:
         p = predict(result, args.quantity, x, structure=args.structure, average=args.average,
@@ -86,6 +92,8 @@ def run(args) -> int:
         text = str(exc).replace("predict: ", "", 1)
         text = text.replace("average must be", "--average must be")
         raise InputError(f"--{text}" if text.startswith("temperature ") else text) from None
+    if args.figure is not None:
+        _figure(p, args.figure)
     if args.json:
         print(json.dumps(p.to_dict(), indent=1))
         return 0
@@ -95,6 +103,19 @@ def run(args) -> int:
         return 0
     _print(p)
     return 0
+
+
+def _figure(p, path) -> None:
+    from ..plotting.material import plot_prediction
+    from ..plotting.output import save_figure
+    from ._libraries import load_libraries
+
+    load_libraries((Path(path).suffix.lower().lstrip("."),))
+    try:
+        save_figure(plot_prediction(p).figure, path, close=True)
+    except OSError as exc:
+        raise InputError(f"--figure '{path}': cannot be written ({exc.strerror or exc})") \
+            from None
 
 
 def _csv_text(p) -> str:

@@ -98,3 +98,48 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
         axes[-1].set_xlabel("t [s] (shaded: beyond the measured window)")
         _legend(fig, handles, labels)
     return Drawn.build(fig, axes, values, artists)
+
+
+def plot_prediction(prediction, *, ax=None) -> Drawn:
+    """A material function of :func:`bayesfo.predict` (any quantity, one structure, an average
+    or a master curve): its posterior median and 94 % band, the arguments outside the data
+    window shaded as extrapolation; logarithmic axes where the values are positive.
+
+    Returns
+    -------
+    Drawn
+        Values: ``"x"``, ``"median"``, ``"hdi_low"``, ``"hdi_high"``.
+    """
+    from ._base import axes_or_new
+
+    p = prediction
+    fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 3.2))
+    finite = np.isfinite(p.median)
+    positive = bool(finite.any()) and bool(np.all(p.hdi_low[finite] > 0))
+    ax.set_xscale("log")
+    if positive:
+        ax.set_yscale("log")
+    band = ax.fill_between(p.x, p.hdi_low, p.hdi_high, color="0.3", alpha=0.25, lw=0,
+                           label="94 % band")
+    who = (p.structure if p.weights is None else
+           f"{p.average} average of " + ", ".join(
+               k for k, w in sorted(p.weights.items(), key=lambda kv: -kv[1]) if w >= 0.01))
+    (line,) = ax.plot(p.x, p.median, "k-", lw=1.2, label="posterior median")
+    ax.set_title(who, fontsize=8, wrap=True)
+    out = np.asarray(p.extrapolated, bool)
+    if out.any():
+        # Shade each run of extrapolated arguments, to the midpoint with the next one inside.
+        edges = np.sqrt(p.x[1:] * p.x[:-1])
+        bounds = np.r_[p.x[0], edges, p.x[-1]]
+        for i in np.flatnonzero(out):
+            ax.axvspan(bounds[i], bounds[i + 1], color="0.88", lw=0, zorder=0)
+    from ..predictions.functions import QUANTITIES
+
+    domain = QUANTITIES[p.quantity][0]
+    ax.set_xlabel({"omega": "ω [rad/s]", "time": "t [s]", "tau": "τ [s]"}[domain])
+    ax.set_ylabel(f"{p.symbol}" + (f" [{p.unit}]" if p.unit else ""))
+    ax.legend(loc="best", fontsize=8)
+    values = {"x": p.x, "median": p.median, "hdi_low": p.hdi_low, "hdi_high": p.hdi_high}
+    return Drawn.build(fig, (ax,), values, {"median": line, "band": band},
+                       caption=f"{p.symbol}: posterior median and 94 % band; extrapolated "
+                               "arguments shaded")

@@ -152,6 +152,33 @@ def test_the_command_prints_writes_and_refuses(result, tmp_path, run_cli):
     status, text, err = run_cli("predict", tmp_path / "none", "--quantity", "storage",
                                 "--omega", "1")
     assert status == 2 and err.count("\n") == 1
+    # A figure of the prediction: the same numbers, the extrapolated arguments shaded.
+    status, text, err = run_cli("predict", out, "--quantity", "relaxation_spectrum", "--tau",
+                                "0.001:1000:30", "--figure", tmp_path / "h.png")
+    assert status == 0, err
+    assert (tmp_path / "h.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    status, _, err = run_cli("predict", out, "--quantity", "storage", "--omega", "1",
+                             "--figure", tmp_path / "h.jpg")
+    assert status == 2 and "give a .png, .pdf or .svg file" in err
+
+
+def test_a_prediction_is_drawn_with_its_band(result):
+    import matplotlib.pyplot as plt
+
+    from bayesfo.plotting.material import plot_prediction
+
+    p = result.predict("relaxation_modulus", np.logspace(-4, 2, 25))
+    drawn = plot_prediction(p)
+    try:
+        np.testing.assert_array_equal(drawn.values["median"], p.median)
+        np.testing.assert_array_equal(drawn.values["hdi_high"], p.hdi_high)
+        ax = drawn.axes[0]
+        assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "G(t) [Pa]"
+        assert ax.get_yscale() == "log" and ax.get_title() == "zener"
+        # One shaded span per extrapolated time.
+        assert len(ax.patches) == int(p.extrapolated.sum()) > 0
+    finally:
+        plt.close(drawn.figure)
 
 
 @pytest.mark.slow

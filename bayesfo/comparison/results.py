@@ -308,9 +308,17 @@ def _parent(structure) -> str | None:
     return structure.name[: -len("-int")] if structure.integer else None
 
 
+#: A Kramers–Kronig inconsistency whose best causal description misses the data by more than
+#: this (rms, relative) is warned as a problem of the data: no linear viscoelastic structure can
+#: fit them better. Smaller ones (real isotherms fail the test by 0.3-4 %) are stated in the
+#: verdict and ``summary.json["data"]["kramers_kronig"]`` only.
+KK_WARN_RMS = 0.05
+
+
 def data_problems(data: FrequencyResponse) -> list[str]:
     """What is wrong with ``data`` for every structure: points with the loss of the wrong sign
-    for a passive material (an instrument artefact or noise that no passive structure fits)."""
+    for a passive material (an instrument artefact or noise that no passive structure fits), and
+    parts far from Kramers–Kronig consistent (misfit over :data:`KK_WARN_RMS`)."""
     out = []
     bad = data.omega[data.dissipation_violations()]
     if bad.size:
@@ -321,6 +329,9 @@ def data_problems(data: FrequencyResponse) -> list[str]:
         out.append(f"{data.label}: {bad.size} of {data.n_frequencies} points have negative loss "
                    f"({loss}), impossible for a passive {data.kind}, at omega = {shown} rad/s; "
                    "no passive structure can fit them")
+    kk = data.kramers_kronig() if data.kind in ("modulus", "compliance") else None
+    if kk is not None and not kk.consistent and kk.misfit_rms > KK_WARN_RMS:
+        out.append(f"{data.label}: {kk.describe()}")
     return out
 
 

@@ -127,7 +127,8 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     out: list[tuple[str, bool]] = [(f"Data: {w.split(': ', 1)[1]}.", True)
                                    for w in comparison.data_warnings]
     kk = comparison.data.kramers_kronig()
-    if kk is not None and not kk.consistent:
+    if kk is not None and not kk.consistent and not any(
+            kk.describe() in w for w in comparison.data_warnings):
         out.append((f"Data: {kk.describe()}.", True))
     if not rows:
         return out + [("No structure could be run on these data.", True)]

@@ -31,7 +31,9 @@ def add_parser(subparsers):
                         "or directories of such files")
     p.add_argument("--structures", default=DEFAULT_STRUCTURES, metavar="S,...",
                    help="master structures to rank by ln Z on the joint data (default "
-                        f"{DEFAULT_STRUCTURES}; 'bayesfo structures' lists them)")
+                        f"{DEFAULT_STRUCTURES}; 'bayesfo structures' lists them), and "
+                        "'spectrum': a discrete relaxation spectrum with a smoothness prior, "
+                        "which needs no structure (slower: minutes on many isotherms)")
     p.add_argument("--reference-temperature", type=float, default=None, metavar="T",
                    help="reference temperature [°C], an isotherm's (default: the middle one)")
     p.add_argument("--noise", default="proportional", choices=("proportional", "constant",
@@ -89,11 +91,11 @@ def read_isotherm_files(paths) -> list[tuple]:
 
 def run(args) -> int:
     from ..outdir import check_output_directory, staged_run
-    from ..structures import resolve_structures
     from ..tts import mastercurve
+    from ..tts.joint import _master_names
     from ._libraries import load_libraries
 
-    structures = resolve_structures(args.structures)  # an unknown name fails before reading
+    structures = _master_names(args.structures)  # an unknown name fails before reading
     isotherms = read_isotherm_files(args.data)
     target = Path(args.out or "bayesfo-mastercurve")
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))

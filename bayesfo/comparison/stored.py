@@ -282,6 +282,8 @@ def _mastercurve(summary: dict, d: Path, library):
     from ..structures import get_structure
     from ..tts import MasterCurve
     from ..tts.model import ShiftedStructure
+    from ..tts.spectrum import NAME as SPECTRUM
+    from ..tts.spectrum import Spectrum
 
     where = d / "summary.json"
     if "posterior" not in summary or "isotherms" not in summary:
@@ -292,7 +294,8 @@ def _mastercurve(summary: dict, d: Path, library):
     path = d / f"{name}.nc"
     idata = _read_netcdf(path, name)
     try:
-        master = get_structure(name, library)
+        master = (Spectrum(tuple(float(t) for t in summary["spectrum"]["tau_s"]))
+                  if name == SPECTRUM else get_structure(name, library))
     except InputError as exc:
         raise InputError(f"'{where}': structure '{name}' is not in the library ({exc}); give "
                          "its card with models=") from None

@@ -35,6 +35,8 @@ from ..data import FrequencyResponse
 from ..errors import InputError
 from .laws import _fit_laws
 from .model import LAWS, ShiftedStructure
+from .spectrum import NAME as SPECTRUM
+from .spectrum import Spectrum
 
 #: The vertical shifts ``mastercurve`` knows.
 VERTICAL = ("none", "density", "free")
@@ -396,7 +398,9 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         objects (``bayesfo.read_isotherms`` of a TRIOS, pyvisco or temperature-column file).
     structures : str, Structure or sequence
         The master function: a structure of the library, or several (a comma list or a
-        sequence), ranked by ln Z on the joint data as ``compare`` ranks them.
+        sequence), ranked by ln Z on the joint data as ``compare`` ranks them; ``"spectrum"``
+        is a discrete relaxation spectrum with a smoothness prior, which needs no structure
+        (:mod:`bayesfo.tts.spectrum`).
     reference_temperature : float, optional
         [°C]; an isotherm's temperature (default: the middle isotherm).
     noise : {"proportional", "constant", "known"}
@@ -423,14 +427,11 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         Fewer than two isotherms, a missing or repeated temperature, isotherms of different
         kinds or units, a reference temperature without an isotherm.
     """
-    from ..structures import resolve_structures
-
     if vertical not in VERTICAL:
         raise InputError(f"vertical must be one of {', '.join(VERTICAL)}, got {vertical!r}")
     if law not in ("auto", *LAWS):
         raise InputError(f"law must be one of auto, {', '.join(LAWS)}, got {law!r}")
-    names = resolve_structures(structures) if isinstance(structures, str) else (
-        [structures] if not isinstance(structures, (list, tuple)) else list(structures))
+    names = _master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
     first = "free" if law == "auto" else law
     fits = [_fit_one(iso, s, noise, seed, vertical, first) for s in names]
@@ -466,6 +467,19 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
                      f"over {ISOTHERM_MISFIT:g} times the median isotherm's")
     return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes),
                    law_evidence=law_evidence)
+
+
+def _master_names(structures) -> list:
+    """The master functions asked for: structures of the library (names resolved as
+    ``compare`` resolves them) and ``"spectrum"`` (:mod:`bayesfo.tts.spectrum`)."""
+    from ..structures import resolve_structures
+
+    if isinstance(structures, str):
+        parts = [p.strip() for p in structures.split(",") if p.strip()]
+        rest = ",".join(p for p in parts if p.lower() != SPECTRUM)
+        names = resolve_structures(rest) if rest else []
+        return ([SPECTRUM] if any(p.lower() == SPECTRUM for p in parts) else []) + list(names)
+    return [structures] if not isinstance(structures, (list, tuple)) else list(structures)
 
 
 def _choose_law(iso: _Isotherms, structure, free: MasterCurve, fit) -> tuple:
@@ -510,22 +524,30 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
     from ..structures import Scaling, get_structure
     from ..structures.response import dissipation_grid
 
-    master = get_structure(structure) if isinstance(structure, str) else structure
+    spectral = structure == SPECTRUM or isinstance(structure, Spectrum)
+    if not spectral:
+        master = get_structure(structure) if isinstance(structure, str) else structure
     joint = iso.joint
     scaling = Scaling.from_data(joint)
     shifts0 = _seed_shifts(iso)
     # The master's dissipation is checked over the reduced window the seeds span, widened.
     reduced0 = _reduced(iso, shifts0)
     w = reduced0.omega / scaling.omega_ref
+    if spectral:  # its relaxation times span the reduced window the seeds give, widened
+        master = Spectrum.over(w.min(), w.max())
     shifted = ShiftedStructure(master, iso.temperatures, iso.reference, iso.point_isotherm,
                                dissipation_grid(w.min(), w.max()), vertical, law)
     lik = Likelihood(shifted, joint, noise=noise, scaling=scaling)
     # Master seeds on the reduced data, then everything jointly (least squares on relative
     # residuals, in the sampling coordinates: logs of the log-uniform parameters).
-    fit = fit_structure(master, reduced0, rng=seed, seed_methods=True, scaling=scaling)
-    modes = master.to_scaled(master.to_physical(np.atleast_2d(fit.optima if fit.optima.size
-                                                              else fit.theta_scaled),
-                                                fit.scaling), scaling)
+    if spectral:
+        modes = master.seed(FrequencyResponse(w, reduced0.response / scaling.g_ref,
+                                              kind=joint.kind))[None, :]
+    else:
+        fit = fit_structure(master, reduced0, rng=seed, seed_methods=True, scaling=scaling)
+        modes = master.to_scaled(master.to_physical(
+            np.atleast_2d(fit.optima if fit.optima.size else fit.theta_scaled), fit.scaling),
+            scaling)
     shift_cols = _law_start(iso, shifts0, shifted) if law != "free" else \
         np.delete(shifts0, iso.reference)
     if vertical == "free":
@@ -549,7 +571,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
         with np.errstate(divide="ignore"):
             u0 = np.where(log, np.log(np.abs(theta0)), theta0)
         u0 = np.clip(u0, lo + 1e-9, hi - 1e-9)
-        sol = least_squares(residuals, u0, bounds=(lo, hi), x_scale="jac", max_nfev=400)
+        sol = least_squares(residuals, u0, bounds=(lo, hi), x_scale="jac",
+                            max_nfev=max(400, 40 * k_all))
         theta = to_theta(sol.x)
         if shifted.admissible(theta, joint.kind) and (best is None or sol.cost < best[1]):
             best = (theta, sol.cost)
@@ -565,8 +588,14 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
                      f"({'; '.join(post.messages)})")
     physical = np.asarray(post.samples)
     k = master.n_params
-    # Each isotherm's relative residual (rms over its points) at the posterior median.
-    fitted = lik.model(np.median(post.samples_scaled[:, :k_all], axis=0)[None, :])[0]
+    # Each isotherm's relative residual (rms over its points) of the posterior median model
+    # (the median of the curves over draws: a spectrum's parameters taken one by one at their
+    # medians make a curve no draw has).
+    rows = np.random.default_rng(seed).choice(post.samples_scaled.shape[0],
+                                              size=min(200, post.samples_scaled.shape[0]),
+                                              replace=False)
+    curves = lik.model(post.samples_scaled[rows, :k_all])
+    fitted = np.median(curves.real, axis=0) + 1j * np.median(curves.imag, axis=0)
     rel = np.abs(fitted - g) / np.abs(g)
     rms = np.array([math.sqrt(float(np.mean(rel[iso.point_isotherm == i] ** 2)))
                     for i in range(len(iso.data))])
@@ -602,7 +631,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
         log_evidence=math.nan if ev is None else ev.log_z,
         log_evidence_err=math.nan if ev is None else ev.log_z_err, laws=laws, data=joint,
         isotherms=iso.data, notes=tuple(notes), tts_checks={"isotherm_fit": isotherm_fit},
-        vertical=vertical, vertical_draws=vertical_draws, master=master, law=shifted.law)
+        vertical=vertical, vertical_draws=vertical_draws,
+        master=master.physical(scaling) if spectral else master, law=shifted.law)
 
 
 def _law_start(iso: _Isotherms, shifts0, shifted: ShiftedStructure) -> np.ndarray:

@@ -13,7 +13,8 @@ Prony series follow from it as from a comparison.
     ``sigma`` where the data carry σ.
 
 and in ``summary.json``: ``"isotherms"`` (``[{"temperature", "name", "n_frequencies"}]`` in the
-order of the points) and ``"posterior"`` (the joint posterior's summary, as ``compare`` writes a
+order of the points), for a relaxation-spectrum master ``"spectrum"`` (its relaxation times
+``tau_s`` [s]; :mod:`bayesfo.tts.spectrum`) and ``"posterior"`` (the joint posterior's summary, as ``compare`` writes a
 structure's: every parameter's ``mean``, ``sd``, ``hdi_low``, ``hdi_high``, …, the noise model,
 the sampler and its diagnostics).
 """
@@ -46,7 +47,12 @@ def netcdf_of(mc):
 def summary_fields(mc) -> dict:
     """The blocks of ``summary.json`` that restore the master curve: ``"isotherms"`` and
     ``"posterior"``."""
+    from .spectrum import Spectrum
+
     post = mc.posterior
-    return {"isotherms": [{"temperature": t, "name": d.label, "n_frequencies": d.n_frequencies}
-                          for t, d in zip(mc.temperatures, mc.isotherms, strict=True)],
-            "posterior": {"name": mc.structure, **post.to_dict()}}
+    out = {"isotherms": [{"temperature": t, "name": d.label, "n_frequencies": d.n_frequencies}
+                         for t, d in zip(mc.temperatures, mc.isotherms, strict=True)],
+           "posterior": {"name": mc.structure, **post.to_dict()}}
+    if isinstance(mc.master, Spectrum):
+        out["spectrum"] = mc.master.to_dict()
+    return out

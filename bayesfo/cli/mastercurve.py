@@ -22,8 +22,8 @@ def add_parser(subparsers):
                     "Arrhenius laws to the shifts, test whether superposition holds (van "
                     "Gurp–Palmen), and write summary.json, master.csv (the reduced data, which "
                     "'bayesfo compare' reads), the joint posterior (STRUCTURE.nc, which "
-                    "'bayesfo predict' and 'bayesfo export' read), figures/mastercurve.png and "
-                    "figures/van_gurp_palmen.png.")
+                    "'bayesfo predict' and 'bayesfo export' read), report.html, "
+                    "figures/mastercurve.png and figures/van_gurp_palmen.png.")
     p.add_argument("data", nargs="+", metavar="DATA",
                    help="files of isotherms: a lab export with several (TRIOS steps, a "
                         "temperature column, pyvisco), or one file per temperature (the "
@@ -135,9 +135,14 @@ def run(args) -> int:
             (stage / "figures").mkdir()
             from ..plotting.mastercurve import plot_van_gurp_palmen
 
+            figures = {}
             for name, plot in (("mastercurve", plot_mastercurve),
                                ("van_gurp_palmen", plot_van_gurp_palmen)):
-                save_figure(plot(mc).figure, stage / "figures" / f"{name}.png", close=True)
+                figures[name] = stage / "figures" / f"{name}.png"
+                save_figure(plot(mc).figure, figures[name], close=True)
+            from ..output.mastercurve_report import write_mastercurve_report
+
+            write_mastercurve_report(mc, stage, figures)
     if args.json:
         print(json.dumps({k: summary[k] for k in ("shift_factors", "shift_law")}, indent=1,
                          ensure_ascii=False))
@@ -188,4 +193,4 @@ def _print(mc, out) -> None:
         print(f"note: {n}")
     print(f"wrote {out}/summary.json, master.csv, {mc.structure}.nc" + (
         "" if not (out / "figures").exists()
-        else " and figures/mastercurve.png, figures/van_gurp_palmen.png"))
+        else ", report.html and figures/mastercurve.png, figures/van_gurp_palmen.png"))

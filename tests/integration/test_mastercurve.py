@@ -341,10 +341,11 @@ def test_a_shift_law_inside_the_posterior_is_stored_and_loaded(tmp_path, run_cli
         path.write_text(data.to_csv_text([f"temperature: {t:g} C"]))
         files.append(path)
     status, out, err = run_cli("mastercurve", *files, "--structures", "zener", "--law", "wlf",
-                               "--reference-temperature", "20", "--out", tmp_path / "mc",
-                               "--no-figures")
+                               "--reference-temperature", "20", "--out", tmp_path / "mc")
     assert status == 0, err
-    assert "shift factors (WLF) of zener" in out
+    assert "shift factors (WLF) of zener" in out and "report.html" in out
+    report = (tmp_path / "mc" / "report.html").read_text()
+    assert "Superposition holds by the van Gurp" in report and report.count("<img") == 2
     mc = bf.load(tmp_path / "mc")
     assert mc.law == "wlf" and mc.law_evidence == {}
     assert {"wlf_C1", "wlf_C2"} <= set(mc.posterior.param_names)
@@ -453,3 +454,37 @@ def test_a_relaxation_spectrum_master_gives_the_shifts_without_a_structure(tmp_p
     np.testing.assert_allclose(loaded.master.tau, mc.master.tau, rtol=1e-12)
     p = bf.predict(loaded, "relaxation_modulus", [0.01, 1.0], temperature=40.0)
     assert np.all(np.isfinite(p.median)) and p.unit == "Pa"
+
+
+def test_the_report_says_in_words_what_the_master_curve_found(wlf_case, tmp_path):
+    import matplotlib.pyplot as plt
+
+    from bayesfo.output.mastercurve_report import (mastercurve_verdict,
+                                                   render_mastercurve_report)
+    from bayesfo.plotting import save_figure
+    from bayesfo.plotting.mastercurve import plot_mastercurve
+
+    _, mc = wlf_case
+    sentences = [t for t, _ in mastercurve_verdict(mc)]
+    assert sentences[0].startswith("Superposition holds by the van Gurp")
+    z = mc.law_evidence["wlf"]["log_evidence"] - mc.law_evidence["free"]["log_evidence"]
+    assert (f"The shifts follow the WLF law (ln Z {z:.1f} above free shifts); its parameters "
+            "were sampled with the master function.") in sentences
+    assert not any(flagged for _, flagged in mastercurve_verdict(mc))
+    drawn = plot_mastercurve(mc)
+    save_figure(drawn.figure, tmp_path / "m.png")
+    plt.close(drawn.figure)
+    html = render_mastercurve_report(mc, {"mastercurve": tmp_path / "m.png"})
+    assert "data:image/png;base64," in html and "<b>mastercurve</b>: Storage and loss" in html
+    for f in mc.shift_factors():
+        a = f["log10_aT"]
+        assert f"<td>{f['temperature']:g}</td><td>{a['mean']:.3f}</td>" in html
+    # A master function that misses every isotherm is said to, with the way out.
+    from dataclasses import replace
+
+    bad = replace(mc, tts_checks={**mc.tts_checks, "isotherm_fit": {
+        "temperatures": list(mc.temperatures), "rms_relative": [0.08, 0.2, 0.12, 0.1, 0.1, 0.3],
+        "misfit": []}})
+    text, flagged = next((t, f) for t, f in mastercurve_verdict(bad) if "misses" in t)
+    assert flagged and text.startswith("The joint fit of zener misses the isotherms by 8–30 % "
+                                       "rms (median 11 %)")

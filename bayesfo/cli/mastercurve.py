@@ -184,11 +184,14 @@ def _print(mc, out) -> None:
         text = ", ".join(f"{k} = {v['mean']:.4g} ± {v['sd']:.2g} {v['unit']}".rstrip()
                          for k, v in law["parameters"].items())
         print(f"{name:>10}: {text}; probability {law['probability']:.3f}")
-    from ..tts.validity import describe
+    from ..tts.validity import describe, describe_parts
 
     vgp = mc.tts_checks.get("van_gurp_palmen")
     if vgp is not None and vgp["valid"]:
         print(describe(vgp))  # a failing or untested test is among the notes
+    parts = mc.tts_checks.get("shift_parts")
+    if parts is not None and parts["consistent"]:
+        print(describe_parts(parts))
     for n in mc.notes:
         print(f"note: {n}")
     print(f"wrote {out}/summary.json, master.csv, {mc.structure}.nc" + (

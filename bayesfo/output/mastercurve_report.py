@@ -33,13 +33,18 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     does the master function describe every isotherm, which master function and which shift
     law the evidence supports, and whether the posterior is certified."""
     from ..tts.joint import ISOTHERM_MISFIT
-    from ..tts.validity import describe
+    from ..tts.validity import describe, describe_parts
 
     out: list[tuple[str, bool]] = []
     vgp = mc.tts_checks.get("van_gurp_palmen")
     if vgp is not None:
         text = describe(vgp)
         out.append((text[0].upper() + text[1:] + ".", vgp["valid"] is not True))
+    parts = mc.tts_checks.get("shift_parts")
+    if parts is not None and parts["consistent"] is not None:
+        text = describe_parts(parts)
+        out.append((text[0].upper() + text[1:] + ".",
+                    not parts["consistent"] and mc.vertical == "none"))
     fit = mc.tts_checks.get("isotherm_fit", {})
     misfit = fit.get("misfit") or []
     rms = [r for r in fit.get("rms_relative", []) if r is not None]

@@ -252,11 +252,18 @@ class MasterCurve:
 
     @property
     def tts_valid(self) -> bool | None:
-        """Whether superposition holds by the van Gurp–Palmen test of the isotherms
-        (:mod:`bayesfo.tts.validity`); None where no two neighbouring isotherms overlap in
-        |G*|."""
-        check = self.tts_checks.get("van_gurp_palmen")
-        return None if check is None else check["valid"]
+        """Whether superposition holds by the model-free tests of the isotherms
+        (:mod:`bayesfo.tts.validity`): the van Gurp–Palmen test, and without vertical shifts
+        in the model also the agreement of the shifts that G′, G″ and tan δ give (a vertical
+        shift in the model accounts for their disagreement); None where neither could be
+        made. ``tts_checks`` says which test failed, and where."""
+        vgp = self.tts_checks.get("van_gurp_palmen")
+        parts = self.tts_checks.get("shift_parts")
+        found = [vgp["valid"]] if vgp is not None else []
+        if parts is not None and self.vertical == "none":
+            found.append(parts["consistent"])
+        known = [v for v in found if v is not None]
+        return None if not known else all(known)
 
     @property
     def log_shift_mean(self) -> np.ndarray:
@@ -447,7 +454,7 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
                             if math.isfinite(fp[0].log_evidence) else np.inf))
     from dataclasses import replace
 
-    from .validity import describe, van_gurp_palmen
+    from .validity import describe, describe_parts, shifts_by_part, van_gurp_palmen
 
     chosen = fits[best]
     law_evidence, law_notes = {}, []
@@ -456,10 +463,16 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
             iso, names[best], chosen, lambda how: _fit_one(iso, names[best], noise, seed,
                                                            vertical, how))
     vgp = van_gurp_palmen(iso.data, iso.temperatures)
-    checks = {"van_gurp_palmen": vgp, "isotherm_fit": chosen.tts_checks["isotherm_fit"]}
+    parts = shifts_by_part(iso.data, iso.temperatures)
+    checks = {"van_gurp_palmen": vgp, "shift_parts": parts,
+              "isotherm_fit": chosen.tts_checks["isotherm_fit"]}
     notes = list(chosen.notes) + law_notes
     if vgp["valid"] is not True:
         notes.append(describe(vgp))
+    if parts["consistent"] is False:
+        notes.append(describe_parts(parts) + (
+            "" if vertical == "none" else " (the model's vertical shifts account for the "
+                                          "former)"))
     misfit = checks["isotherm_fit"]["misfit"]
     if misfit:
         notes.append(f"the joint fit of {chosen.structure} misses the isotherm(s) at "

@@ -129,3 +129,126 @@ def describe(check: dict) -> str:
     if check["untested"]:
         text += (f"; {len(check['untested'])} pair(s) without overlap in |G*| were not tested")
     return text
+
+
+#: Disagreement [decades] between the horizontal shifts that G′, G″ and tan δ give a pair of
+#: isotherms, beyond which (and beyond three standard errors) they are judged to differ.
+PARTS_TOLERANCE = 0.1
+#: A part whose log changes by less than this per decade of ω over the overlap is too flat to
+#: give a shift (a plateau of G′, a flat tan δ): that part is left out for the pair.
+MIN_SLOPE = 0.05
+#: The parts compared, by name.
+PARTS = ("storage", "loss", "tan_delta")
+
+
+def _part(data, name: str) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(data.omega)
+    g = data.response[order]
+    if data.kind == "compliance":
+        g = np.conj(g)  # J* = J′ − iJ″: the loss part positive, as for a modulus
+    with np.errstate(divide="ignore", invalid="ignore"):
+        y = {"storage": np.log10(g.real), "loss": np.log10(g.imag),
+             "tan_delta": np.log10(g.imag / g.real)}[name]
+    return np.log10(data.omega[order]), y
+
+
+def _shift_of(xl, yl, xu, yu) -> dict | None:
+    """The shift d (decades) that lays (xu + d, yu) on (xl, yl), by a grid search and a local
+    refinement, with its standard error from the residual scatter and the mean slope; None
+    where the curves do not overlap or the part is too flat there."""
+    ok_l, ok_u = np.isfinite(yl), np.isfinite(yu)
+    xl, yl, xu, yu = xl[ok_l], yl[ok_l], xu[ok_u], yu[ok_u]
+    if xl.size < 3 or xu.size < 3:
+        return None
+    span = max(xl.max(), xu.max()) - min(xl.min(), xu.min())
+
+    def cost(d):
+        x = xu + d
+        inside = (x >= xl.min()) & (x <= xl.max())
+        if inside.sum() < 3:
+            return np.inf, inside
+        r = np.interp(x[inside], xl, yl) - yu[inside]
+        return float(np.mean(r**2)) * (1.0 + 1.0 / inside.sum()), inside
+
+    grid = np.arange(-span - 2.0, span + 2.0, 0.02)
+    costs = [cost(d)[0] for d in grid]
+    k = int(np.argmin(costs))
+    if not np.isfinite(costs[k]):
+        return None
+    fine = np.linspace(grid[k] - 0.02, grid[k] + 0.02, 41)
+    d = float(fine[int(np.argmin([cost(v)[0] for v in fine]))])
+    _, inside = cost(d)
+    x = xu[inside] + d
+    slope = float(np.mean(np.gradient(np.interp(x, xl, yl), x))) if x.size > 1 else 0.0
+    if abs(slope) < MIN_SLOPE:
+        return None
+    r = np.interp(x, xl, yl) - yu[inside]
+    se = float(np.std(r, ddof=1) / abs(slope) / math.sqrt(inside.sum()))
+    return {"log_shift": d, "se": se, "n_overlap": int(inside.sum())}
+
+
+def shifts_by_part(isotherms, temperatures, *, tolerance: float = PARTS_TOLERANCE) -> dict:
+    """The horizontal shift between neighbouring isotherms from G′, from G″ and from tan δ
+    alone, compared.
+
+    For a thermorheologically simple material without vertical shift the three agree; tan δ
+    is free of any vertical shift (a density or temperature factor scales G′ and G″ alike), so
+    G′ and G″ shifts that agree with each other but not with tan δ's point to a vertical
+    shift, and parts that disagree among themselves to a material that is not simple.
+
+    Returns
+    -------
+    dict
+        ``consistent`` (True, False, or None where no pair had two parts to compare),
+        ``tolerance`` [decades], ``pairs``: per neighbouring pair ``temperatures``, per part
+        (``storage``, ``loss``, ``tan_delta``) ``{"log_shift", "se"}`` or None (no overlap,
+        or too flat there), ``spread`` (largest difference between the parts' shifts) and
+        ``agree``; ``disagreeing``: the temperature pairs whose parts differ.
+    """
+    pairs = []
+    for i in range(len(isotherms) - 1):
+        lower, upper = isotherms[i], isotherms[i + 1]
+        parts = {}
+        for name in PARTS:
+            xl, yl = _part(lower, name)
+            xu, yu = _part(upper, name)
+            found = _shift_of(xl, yl, xu, yu)
+            parts[name] = None if found is None else {"log_shift": found["log_shift"],
+                                                      "se": found["se"]}
+        have = [p for p in parts.values() if p is not None]
+        pair = {"temperatures": [float(temperatures[i]), float(temperatures[i + 1])],
+                **parts}
+        if len(have) >= 2:
+            worst, agree = 0.0, True
+            for a in range(len(have)):
+                for b in range(a + 1, len(have)):
+                    diff = abs(have[a]["log_shift"] - have[b]["log_shift"])
+                    worst = max(worst, diff)
+                    limit = max(tolerance, Z_FAIL * math.hypot(have[a]["se"], have[b]["se"]))
+                    agree &= diff <= limit
+            pair.update(spread=worst, agree=bool(agree))
+        pairs.append(pair)
+    compared = [p for p in pairs if "agree" in p]
+    return {"consistent": None if not compared else all(p["agree"] for p in compared),
+            "tolerance": tolerance, "pairs": pairs,
+            "disagreeing": [p["temperatures"] for p in compared if not p["agree"]]}
+
+
+def describe_parts(check: dict) -> str:
+    """The comparison of the parts' shifts in words."""
+    if check["consistent"] is None:
+        return "the shifts of G′, G″ and tan δ could not be compared (no pair with two parts)"
+    n = sum("agree" in p for p in check["pairs"])
+    if check["consistent"]:
+        return (f"the horizontal shifts that G′, G″ and tan δ give each of {n} pairs of "
+                f"neighbouring isotherms agree (within {check['tolerance']:g} decade or three "
+                "standard errors)")
+    worst = max((p for p in check["pairs"] if "agree" in p and not p["agree"]),
+                key=lambda p: p["spread"])
+    shown = ", ".join(f"{name.replace('_', ' ')} {worst[name]['log_shift']:+.2f}"
+                      for name in PARTS if worst[name] is not None)
+    where = "; ".join(f"{a:g}/{b:g} °C" for a, b in check["disagreeing"])
+    return (f"the horizontal shifts that G′, G″ and tan δ give disagree for {where} (at "
+            f"{worst['temperatures'][0]:g}/{worst['temperatures'][1]:g} °C: {shown} decades): "
+            "a vertical shift (tan δ is free of it) or a material that is not "
+            "thermorheologically simple")

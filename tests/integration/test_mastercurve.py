@@ -459,8 +459,7 @@ def test_a_relaxation_spectrum_master_gives_the_shifts_without_a_structure(tmp_p
 def test_the_report_says_in_words_what_the_master_curve_found(wlf_case, tmp_path):
     import matplotlib.pyplot as plt
 
-    from bayesfo.output.mastercurve_report import (mastercurve_verdict,
-                                                   render_mastercurve_report)
+    from bayesfo.output.mastercurve_report import mastercurve_verdict, render_mastercurve_report
     from bayesfo.plotting import save_figure
     from bayesfo.plotting.mastercurve import plot_mastercurve
 
@@ -488,3 +487,28 @@ def test_the_report_says_in_words_what_the_master_curve_found(wlf_case, tmp_path
     text, flagged = next((t, f) for t, f in mastercurve_verdict(bad) if "misses" in t)
     assert flagged and text.startswith("The joint fit of zener misses the isotherms by 8–30 % "
                                        "rms (median 11 %)")
+
+
+def test_shifts_from_storage_loss_and_tan_delta_agree_only_without_vertical_shifts():
+    """Model-free: G′, G″ and tan δ give a simple material's isotherms the same shifts (the
+    truth, within 0.03 decade or four of their standard errors where the part is flat, as G″
+    near its peak); divided by vertical factors of up to 25 %, the parts'
+    shifts part (tan δ is free of the factor), and the pairs are named."""
+    from bayesfo.tts.validity import describe_parts, shifts_by_part
+
+    truth = wlf(np.array(TEMPS), 20.0, 8.0, 80.0)
+    simple = shifts_by_part([d for d, _ in isotherms(truth)], TEMPS)
+    assert simple["consistent"] is True and simple["disagreeing"] == []
+    for pair, step in zip(simple["pairs"], np.diff(truth), strict=True):
+        found = [part for part in ("storage", "loss", "tan_delta") if pair[part] is not None]
+        assert len(found) >= 2  # a part too flat over the overlap gives no shift
+        for part in found:
+            # The warmer isotherm's frequencies times 10^d lie on the colder one's curve.
+            error = abs(pair[part]["log_shift"] - step)
+            assert error < max(0.03, 4 * pair[part]["se"]), (pair, part)
+    assert describe_parts(simple).startswith("the horizontal shifts that G′, G″ and tan δ "
+                                             "give each of 5 pairs")
+    log_b = np.array([0.08, -0.05, 0.0, 0.06, -0.1, 0.04])
+    scaled = shifts_by_part([d for d, _ in isotherms(truth, log_bT=log_b)], TEMPS)
+    assert scaled["consistent"] is False and [0.0, 10.0] in scaled["disagreeing"]
+    assert "a vertical shift (tan δ is free of it)" in describe_parts(scaled)

@@ -287,11 +287,12 @@ def fit_and_screen(s: Structure, data: FrequencyResponse, options: RunOptions):
 def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions):
     """Step 1 as :func:`fit_and_screen`, and whether the rest promises to be quick: the
     screen's raw importance weights of every noise model still to sample have a Pareto k̂ below
-    :data:`~bayesfo.inference.importance.K_HAT_MAX`, so that importance sampling will most
-    likely certify the posterior (a fraction of a second) and neither the ladder nor emcee will
-    run. Returns ((fit, screened, noise models), quick). The numbers and the warnings are those
-    of :func:`fit_and_screen`: the estimates that the screen does not make itself are made
-    with their warnings discarded, and they only guide where the next steps run."""
+    :data:`~bayesfo.inference.importance.K_HAT_MAX` and leave no order undetermined, so that
+    importance sampling will most likely certify the posterior (a fraction of a second) and
+    neither the ladder nor emcee will run. Returns ((fit, screened, noise models), quick).
+    The numbers and the warnings are those of :func:`fit_and_screen`: the estimates that the
+    screen does not make itself are made with their warnings discarded, and they only guide
+    where the next steps run."""
     candidates, fit = _fit(s, data, options)
     quick = (_quick_estimates(s, data, candidates, fit, options)
              if len(candidates) > 1 and fit.optima.size else {})
@@ -308,7 +309,8 @@ def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions):
                     quick.update(_quick_estimates(s, data, (noise,), fit, options))
                 except (InputError, np.linalg.LinAlgError, FloatingPointError):
                     quick[noise] = None
-    promise = all(quick.get(n) is not None and quick[n]["k_hat"] < K_HAT_MAX for n in noises)
+    promise = all(quick.get(n) is not None and quick[n]["k_hat"] < K_HAT_MAX
+                  and not quick[n].get("undetermined") for n in noises)
     return (fit, screened, noises), promise
 
 

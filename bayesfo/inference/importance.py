@@ -6,8 +6,17 @@ posterior under the noise model at hand (L-BFGS-B; the optimiser's least squares
 residuals by the data's magnitude). Around each (in the sampling coordinates u, log for
 log-uniform priors), the curvature of the log posterior gives a Laplace approximation;
 a mixture of multivariate Student-t distributions (5 degrees of freedom, scale 1.5 × the
-Laplace covariance, each mode weighted by its Laplace mass) is the proposal. One vectorised
-call of the likelihood on 20 000 proposal draws gives the importance weights, and from them
+Laplace covariance, each mode weighted by its Laplace mass) is the proposal. Where most of its
+draws leave the support (optima on bounds of the prior box, such as a Maxwell order at 0 with a
+coefficient at its smallest value: each such coordinate spills half of its component over the
+bound), the mixture is built again in unbounded coordinates z, the logit of each coordinate
+within its prior range (:class:`~bayesfo.inference.transform._Unbounded`), where no draw
+leaves the box; the weights are then the posterior density in z (the density in u times the
+Jacobian |du/dz|) over the proposal's, so that their mean is still the evidence. The proposal
+stays in u wherever it keeps its draws: a coordinate that leans on a bound along a ridge is
+covered better there, by a component cut at the bound, than in z, where the curvature at the
+mode does not reach along the ridge (BENCHMARKS.md, twelfth session). One vectorised call of
+the likelihood on 20 000 proposal draws gives the importance weights, and from them
 
 * the evidence, ln Z' = ln mean(w), with the standard error of that mean (the prior normalised
   on its support as elsewhere: ln Z = ln Z' − ln P(S)), where k̂ < 0.5;
@@ -50,6 +59,7 @@ from scipy.special import gammaln, logsumexp
 from ..errors import InputError
 from ._arviz import psis
 from .likelihood import Likelihood
+from .transform import _Unbounded
 
 #: Certificate of the importance weights: Pareto k̂ below this (Vehtari et al.'s threshold of
 #: reliable estimates) and at least this many effective draws.
@@ -138,16 +148,25 @@ def _polish(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return res.x if np.isfinite(res.fun) and -res.fun > f0 else u0
 
 
-def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: int = 4):
-    """The mode near ``u0`` (a few Newton steps on the log posterior) and the Laplace
-    approximation there, as the eigenvalues and eigenvectors ``(w, v)`` of its precision
-    (directions without curvature floored, see below); None where the difference stencil
-    leaves the support or the Hessian is singular or not finite."""
+def _polished(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """:func:`_polish` within the box: an optimum on a bound of the prior box (a coefficient at
+    its smallest value) is moved just inside, so that the difference stencil of
+    :func:`_laplace` stays in the box."""
     span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u0))
     h = 1e-4 * span
-    # An optimum on a bound of the prior box (a coefficient at its smallest value) is moved just
-    # inside, so that the difference stencil stays in the box.
-    u = _polish(f, np.clip(u0, lo + 3 * h, hi - 3 * h), lo + 3 * h, hi - 3 * h)
+    return _polish(f, np.clip(u0, lo + 3 * h, hi - 3 * h), lo + 3 * h, hi - 3 * h)
+
+
+def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: int = 4,
+             broad: float | None = None, polish: bool = True):
+    """The mode near ``u0`` (a few Newton steps on the log posterior) and the Laplace
+    approximation there, as the eigenvalues and eigenvectors ``(w, v)`` of its precision
+    (directions without curvature floored at the variance ``broad``, by default one that
+    spreads over the box, see below); None where the difference stencil leaves the support or
+    the Hessian is singular or not finite."""
+    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u0))
+    h = 1e-4 * span
+    u = _polished(f, u0, lo, hi) if polish else np.clip(u0, lo + 3 * h, hi - 3 * h)
     best = None
     for _ in range(newton_steps + 1):
         out = _hessian(f, u, h)
@@ -173,7 +192,8 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
     # Directions without curvature (a parameter the data leave to its prior, a peak cut by a
     # bound) get a variance that spreads the proposal over the prior box; the certificate of
     # the weights decides whether that describes the posterior.
-    broad = (np.max(span[np.isfinite(span)]) / 4.0) ** 2
+    if broad is None:
+        broad = (np.max(span[np.isfinite(span)]) / 4.0) ** 2
     w = np.where(w > 1.0 / broad, w, 1.0 / broad)
     return f0, u, (w, v)
 
@@ -338,7 +358,12 @@ def _widest(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray) -> tuple[str, flo
 def _weights(lik: Likelihood, tr, modes_scaled, n_proposals: int, rng: np.random.Generator):
     """Proposal draws ``x`` (u coordinates) from the Student-t mixture at the Laplace
     approximations of the modes, their log importance weights, which are finite, and the number
-    of distinct modes; or a dict with the ``reason`` the route does not apply."""
+    of distinct modes; or a dict with the ``reason`` the route does not apply.
+
+    The mixture is built in u; where most of its draws leave the support (an optimum on a bound
+    of the box, such as an order at 0, spills half of its component over it), it is built again
+    in the unbounded coordinates of :class:`~.transform._Unbounded`, from new draws, with the
+    weights in those coordinates (see :func:`_proposal`)."""
     from .transform import _log_prob_fn
 
     log_prob = _log_prob_fn(lik, tr)
@@ -347,68 +372,113 @@ def _weights(lik: Likelihood, tr, modes_scaled, n_proposals: int, rng: np.random
         return {"reason": "no optimum"}
     if lik.noise_param:
         modes = np.column_stack([modes, lik.noise_estimate(modes)])
-    u_modes = tr.to_u(modes)
+    u_modes = [u0 for u0 in tr.to_u(modes)
+               if np.all(np.isfinite(u0)) and np.isfinite(log_prob(u0[None, :])[0])]
+    if not u_modes:
+        return {"reason": "no optimum lies in the support"}
+    polished = {}  # the optima polished in u, shared by the two proposals
+    out = _proposal(log_prob, tr, u_modes, polished, n_proposals, rng, unbounded=False)
+    if isinstance(out, dict) and out["reason"] == LEAVE:
+        out = _proposal(log_prob, tr, u_modes, polished, n_proposals, rng, unbounded=True)
+    return out
+
+
+#: Why the route gives up where the proposal's draws fall mostly outside the support.
+LEAVE = "most proposal draws leave the support"
+
+
+def _proposal(log_prob, tr, u_modes, polished: dict, n_proposals: int,
+              rng: np.random.Generator, *, unbounded: bool):
+    """:func:`_weights` with the proposal built in u, or in the coordinates z of
+    :class:`~.transform._Unbounded` (``unbounded``), where the target is the posterior density
+    in z: the weights are target over proposal density in the coordinates of the draws, so that
+    their mean is the evidence in either. ``polished``: the optima polished in u, by index,
+    filled as they are computed."""
+    d = len(u_modes[0])
+    if unbounded:
+        zc = _Unbounded(tr.lo_u, tr.hi_u)
+        log_target, to_u = zc.target(log_prob), zc.to_u
+        free = np.full(d, -np.inf), np.full(d, np.inf)
+    else:
+        log_target, to_u = log_prob, _identity
     peaks = []
-    for u0 in u_modes:
-        if not np.all(np.isfinite(u0)) or not np.isfinite(log_prob(u0[None, :])[0]):
-            continue
-        peak = _laplace(log_prob, u0, tr.lo_u, tr.hi_u, newton_steps=NEWTON)
+    for i, u0 in enumerate(u_modes):
+        if i not in polished:
+            polished[i] = _polished(log_prob, u0, tr.lo_u, tr.hi_u)
+        if unbounded:
+            z0 = zc.start(log_target, polished[i])
+            peak = _laplace(log_target, z0, *free, newton_steps=NEWTON, broad=zc.broad(z0),
+                            polish=False)
+        else:
+            peak = _laplace(log_prob, polished[i], tr.lo_u, tr.hi_u, newton_steps=NEWTON,
+                            polish=False)
         if peak is None:
             return {"reason": "no curvature at an optimum (the support ends or the Hessian is "
                               "singular there)"}
         if not any(np.allclose(peak[1], p[1], rtol=1e-6, atol=1e-8) for p in peaks):
             peaks.append(peak)
-    if not peaks:
-        return {"reason": "no optimum lies in the support"}
     means = np.array([p[1] for p in peaks])
     factors = [(w / SCALE**2, v) for _, _, (w, v) in peaks]
     # Each mode weighted by its Laplace mass: height × sqrt(det covariance).
     log_weights = np.array([p[0] - 0.5 * np.sum(np.log(p[2][0])) for p in peaks])
-    x, log_q = _mvt(factors, means, log_weights, n_proposals, rng)
-    lp = log_prob(x)
-    log_w = np.where(np.isfinite(lp), lp - log_q(x), -np.inf)
+    proposal = {"factors": factors, "means": means, "log_weights": log_weights,
+                "log_target": log_target, "to_u": to_u}
+    out = _draw(proposal, n_proposals, rng)
+    if out is None:
+        return {"reason": LEAVE}
+    x, log_w, finite, z = out
+    return x, log_w, finite, len(peaks), {**proposal, "z": z}
+
+
+def _identity(u):
+    return u
+
+
+def _draw(proposal: dict, n_proposals: int, rng: np.random.Generator):
+    """Draws of the mixture ``proposal`` and their log importance weights: (draws in u, log
+    weights, finite, draws in the proposal's coordinates, u or z); None where fewer than a tenth
+    are in the support."""
+    z, log_q = _mvt(proposal["factors"], proposal["means"], proposal["log_weights"],
+                    n_proposals, rng)
+    lp = proposal["log_target"](z)
+    log_w = np.where(np.isfinite(lp), lp - log_q(z), -np.inf)
     finite = np.isfinite(log_w)
     if finite.sum() < 0.1 * n_proposals:
-        return {"reason": "most proposal draws leave the support"}
-    proposal = {"factors": factors, "means": means, "log_weights": log_weights,
-                "log_prob": log_prob}
-    return x, log_w, finite, len(peaks), proposal
+        return None
+    return proposal["to_u"](z), log_w, finite, z
 
 
 def _adapted(first, n_proposals: int, rng: np.random.Generator):
     """A second round of importance sampling whose proposal adds, with half the weight, a
-    Student-t matched to the mean and covariance of the first round's weighted draws (one step
-    of population Monte Carlo). The half of the first proposal keeps its coverage of every
-    mode; the matched component reaches the skewed or bounded directions the Laplace
-    approximations miss, such as a parameter leaning on its prior bound (BENCHMARKS.md,
-    "Measurements behind design choices"). None where the first round's draws are too few to
-    estimate a covariance."""
-    x, log_w, finite, n_modes, prop = first
-    xs = x[finite]
+    Student-t matched to the mean and covariance of the first round's weighted draws, in the
+    coordinates of its proposal (one step of population Monte Carlo). The half of the first
+    proposal keeps its coverage of every mode; the matched component reaches the skewed or
+    bounded directions the Laplace approximations miss, such as a parameter leaning on its prior
+    bound (BENCHMARKS.md, "Measurements behind design choices"). None where the first round's
+    draws are too few to estimate a covariance."""
+    _, log_w, finite, n_modes, prop = first
+    zs = prop["z"][finite]
     smoothed, _ = psis(log_w[finite])
     w = np.exp(smoothed - logsumexp(smoothed))
-    d = xs.shape[1]
+    d = zs.shape[1]
     if 1.0 / np.sum(w**2) < 10 * d:
         return None
-    mean = w @ xs
-    centred = xs - mean
+    mean = w @ zs
+    centred = zs - mean
     cov = (centred * w[:, None]).T @ centred
     eig, vec = np.linalg.eigh(cov)
     if not np.all(np.isfinite(eig)) or eig.min() <= 0:
         return None
     base = prop.get("base", prop)
     lw0 = base["log_weights"] - logsumexp(base["log_weights"])
-    factors = list(base["factors"]) + [(1.0 / eig, vec)]
-    means = np.vstack([base["means"], mean])
-    log_weights = np.append(lw0 + math.log(0.5), math.log(0.5))
-    x2, log_q = _mvt(factors, means, log_weights, n_proposals, rng)
-    lp = prop["log_prob"](x2)
-    log_w2 = np.where(np.isfinite(lp), lp - log_q(x2), -np.inf)
-    finite2 = np.isfinite(log_w2)
-    if finite2.sum() < 0.1 * n_proposals:
+    proposal = {**prop, "factors": list(base["factors"]) + [(1.0 / eig, vec)],
+                "means": np.vstack([base["means"], mean]),
+                "log_weights": np.append(lw0 + math.log(0.5), math.log(0.5)), "base": base}
+    out = _draw(proposal, n_proposals, rng)
+    if out is None:
         return None
-    return x2, log_w2, finite2, n_modes, {**prop, "factors": factors, "means": means,
-                                          "log_weights": log_weights, "base": base}
+    x2, log_w2, finite2, z2 = out
+    return x2, log_w2, finite2, n_modes, {**proposal, "z": z2}
 
 
 def _log_support(lik, rng):
@@ -427,7 +497,12 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
     :func:`bayesfo.comparison.run.compare`): a structure's two noise models share its ridges and
     modes, so the proposal's shortfall largely cancels in the difference of their ln Z, and a
     gap of many nats decides without a certified posterior of the loser. ``k_hat`` is returned
-    so that the caller can see how rough the estimate is.
+    so that the caller can see how rough the estimate is. Where the first proposal's k̂ is
+    :data:`K_HAT_MAX` or more, the estimate is that of a second round adapted to its weighted
+    draws (:func:`_adapted`, as in :func:`importance_posterior`), if its k̂ is lower.
+    ``undetermined`` names the order that the same weights leave undetermined (see
+    :data:`UNDETERMINED`; "" if none), for which the importance route will not certify the
+    posterior whatever k̂.
     """
     from .transform import _Transform
 
@@ -437,8 +512,13 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
     if isinstance(out, dict):
         return None
     x, log_w, finite, _, _ = out
-    lw = log_w[finite]
-    smoothed, k_hat = psis(lw)
+    smoothed, k_hat = psis(log_w[finite])
+    if not k_hat < K_HAT_MAX:
+        adapted = _adapted(out, n_proposals, rng)
+        if adapted is not None:
+            smoothed2, k_hat2 = psis(adapted[1][adapted[2]])
+            if k_hat2 < k_hat:
+                (x, log_w, finite, _, _), smoothed, k_hat = adapted, smoothed2, k_hat2
     try:
         log_s, _ = _log_support(lik, rng)
     except InputError:
@@ -456,5 +536,7 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
         lo = theta[order[min(np.searchsorted(cdf, tail), cdf.size - 1)], i]
         hi = theta[order[min(np.searchsorted(cdf, 1.0 - tail), cdf.size - 1)], i]
         intervals[p.name] = (float(lo), float(hi))
+    name, share = _widest(lik, tr, x[finite], w)
     return {"log_z": log_z, "k_hat": float(k_hat), "intervals": intervals,
+            "undetermined": name if share > UNDETERMINED else "",
             "method": "importance (uncertified)"}

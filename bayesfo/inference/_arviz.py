@@ -145,8 +145,13 @@ def write_tree(tree, path) -> None:
     """
     import io
 
+    import dask
+
     buffer = io.BytesIO()
-    tree.to_netcdf(buffer, engine="h5netcdf")
+    # Inside a Dask worker xarray would take a distributed lock named after the target, which
+    # a buffer cannot name; the arrays are in memory, so the local scheduler's lock serves.
+    with dask.config.set(scheduler="synchronous"):
+        tree.to_netcdf(buffer, engine="h5netcdf")
     with open(path, "wb") as f:
         f.write(buffer.getbuffer())
 

@@ -34,6 +34,16 @@ class Parameter:
     prior: Prior
 
 
+def in_prior_support(parameters, theta) -> np.ndarray:
+    """True where every column of ``theta`` (one per :class:`Parameter`) lies within the
+    support of that parameter's prior; a bool per row, or one bool for a single set."""
+    theta2 = np.atleast_2d(np.asarray(theta, float))
+    ok = np.ones(theta2.shape[0], dtype=bool)
+    for i, p in enumerate(parameters):
+        ok &= p.prior.contains(theta2[:, i])
+    return ok if np.ndim(theta) == 2 else ok[0]
+
+
 @dataclass(frozen=True, eq=False)
 class Structure:
     """A transfer-function structure with priors and constraints.
@@ -345,11 +355,7 @@ class Structure:
     # ------------------------------------------------------------------ constraints
     def in_support(self, theta) -> np.ndarray:
         """True where every free parameter lies within the support of its prior."""
-        theta2 = np.atleast_2d(np.asarray(theta, float))
-        ok = np.ones(theta2.shape[0], dtype=bool)
-        for i, p in enumerate(self.parameters):
-            ok &= p.prior.contains(theta2[:, i])
-        return ok if np.ndim(theta) == 2 else ok[0]
+        return in_prior_support(self.parameters, theta)
 
     def stable(self, theta, kind: str = "generic") -> np.ndarray:
         """Stability of the poles, and for materials of the zeros.

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..priors import LogUniform, Normal, Uniform
-from ..structures.structure import Parameter
+from ..structures.structure import Parameter, in_prior_support
 
 #: The structure name that stands for the spectrum in ``--structures``.
 NAME = "spectrum"
@@ -148,11 +148,8 @@ class Spectrum:
         return c
 
     def in_support(self, theta) -> np.ndarray:
-        theta2 = np.atleast_2d(np.asarray(theta, float))
-        ok = np.ones(theta2.shape[0], dtype=bool)
-        for i, p in enumerate(self.parameters):
-            ok &= p.prior.contains(theta2[:, i])
-        ok &= np.all(np.isfinite(theta2), axis=1)
+        finite = np.all(np.isfinite(np.atleast_2d(np.asarray(theta, float))), axis=1)
+        ok = np.atleast_1d(in_prior_support(self.parameters, theta)) & finite
         return ok if np.ndim(theta) == 2 else ok[0]
 
     def constraints_hold(self, theta, kind: str, omega_grid=None, where=None) -> np.ndarray:

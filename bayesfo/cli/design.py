@@ -60,6 +60,10 @@ def run(args) -> int:
             raise InputError(f"--figure {args.figure}: directory '{figure.parent}' does not "
                              "exist")
     result = load(args.directory, models=getattr(args, "models", ()) or ())
+    if hasattr(result, "shift_draws"):
+        raise InputError(f"'{args.directory}' holds a master curve: design chooses frequencies "
+                         "between structures of a comparison; run it on a bayesfo compare "
+                         "directory (e.g. of the master curve's master.csv)")
     structures = None if args.structures is None else [
         s.strip() for s in args.structures.split(",") if s.strip()]
     if args.parameter is not None:

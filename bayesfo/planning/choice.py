@@ -305,6 +305,9 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         Fewer than two structures to tell apart, a window that is not two positive increasing
         frequencies, an unknown cost or structure.
     """
+    if hasattr(result, "shift_draws"):
+        raise InputError("design: a master curve is not a comparison of structures; design "
+                         "on a comparison (e.g. of the master curve's master_data())")
     data = result.data
     lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
     w_lo, w_hi = _checked(data, window, points, cost)

@@ -97,6 +97,9 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
     if parameter not in post.param_names[: r.structure.n_params]:
         raise InputError(f"design: structure {name} has no parameter '{parameter}'; its "
                          f"parameters are {', '.join(post.param_names[: r.structure.n_params])}")
+    if hasattr(result, "shift_draws"):
+        raise InputError("design: a master curve is not a comparison of structures; design "
+                         "on a comparison (e.g. of the master curve's master_data())")
     data = result.data
     omega = np.logspace(math.log10(w_lo), math.log10(w_hi), N_CANDIDATES)
     rng = np.random.default_rng(seed)

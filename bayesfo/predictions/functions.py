@@ -248,7 +248,12 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
     log_a, log_b = log_a[rows], log_b[rows]
     a = 10.0 ** log_a[:, None]
     x_ref = x[None, :] * a if domain == "omega" else x[None, :] / a
-    values = _evaluate(mc.master, theta, quantity, x_ref)
+    master = mc.master
+    if master is None:  # a MasterCurve built by hand, with the structure's name only
+        from ..structures import get_structure
+
+        master = get_structure(mc.structure)
+    values = _evaluate(master, theta, quantity, x_ref)
     pa, pb = _SCALING[QUANTITIES[quantity][2]]
     if pa or pb:
         values = values * 10.0 ** (pa * log_a + pb * log_b)[:, None]

@@ -346,6 +346,8 @@ def test_a_shift_law_inside_the_posterior_is_stored_and_loaded(tmp_path, run_cli
     assert "shift factors (WLF) of zener" in out and "report.html" in out
     report = (tmp_path / "mc" / "report.html").read_text()
     assert "Superposition holds by the van Gurp" in report and report.count("<img") == 2
+    status, _, err = run_cli("design", tmp_path / "mc")
+    assert status == 2 and "holds a master curve: design chooses frequencies" in err
     mc = bf.load(tmp_path / "mc")
     assert mc.law == "wlf" and mc.law_evidence == {}
     assert {"wlf_C1", "wlf_C2"} <= set(mc.posterior.param_names)

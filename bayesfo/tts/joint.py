@@ -46,6 +46,9 @@ VERTICAL_PLAUSIBLE = 0.1
 #: A law whose χ²/dof against the shifts' posterior exceeds this misses them: a note says so
 #: (the 99.9 % point of χ²/dof for 5 degrees of freedom is 4.1).
 LAW_MISS = 4.0
+#: Isotherms from which ``law="auto"`` also fits the laws inside the posterior: with fewer,
+#: WLF has as many parameters as there are shifts, and the comparison says nothing.
+AUTO_LAWS_MIN = 4
 #: An isotherm whose relative residuals under the joint fit (rms) exceed this many times the
 #: median isotherm's is named as one the master structure misses.
 ISOTHERM_MISFIT = 3.0
@@ -421,7 +424,8 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         ``"arrhenius"``). ``"auto"`` ranks the master structures with free shifts, then fits
         the best one with each law too and keeps the model of highest ln Z among the three
         (a law is kept only where its posterior is certified); ``law_evidence`` says how
-        the three compare.
+        the three compare. With fewer than :data:`AUTO_LAWS_MIN` isotherms, ``"auto"`` is
+        ``"free"``.
     seed : int
 
     Returns
@@ -458,7 +462,7 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
 
     chosen = fits[best]
     law_evidence, law_notes = {}, []
-    if law == "auto":
+    if law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN:
         chosen, law_evidence, law_notes = _choose_law(
             iso, names[best], chosen, lambda how: _fit_one(iso, names[best], noise, seed,
                                                            vertical, how))

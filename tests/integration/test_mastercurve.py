@@ -514,3 +514,12 @@ def test_shifts_from_storage_loss_and_tan_delta_agree_only_without_vertical_shif
     scaled = shifts_by_part([d for d, _ in isotherms(truth, log_bT=log_b)], TEMPS)
     assert scaled["consistent"] is False and [0.0, 10.0] in scaled["disagreeing"]
     assert "a vertical shift (tan δ is free of it)" in describe_parts(scaled)
+
+
+def test_auto_fits_no_law_inside_the_posterior_on_three_isotherms():
+    from bayesfo.tts.joint import AUTO_LAWS_MIN
+
+    truth = wlf(np.array(TEMPS), 20.0, 8.0, 80.0)
+    mc = _fit(isotherms(truth)[1:4])  # 10, 20, 30 °C: two shifts, as many as WLF's parameters
+    assert AUTO_LAWS_MIN == 4 and mc.law == "free" and mc.law_evidence == {}
+    assert not any("shift law over all isotherms" in n for n in mc.notes)

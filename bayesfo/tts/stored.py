@@ -1,5 +1,5 @@
 """What a master curve's output directory stores of its posterior, so that
-:func:`bayesfo.load` can restore the :class:`~bayesfo.tts.joint.MasterCurve` and predictions and
+:func:`bayesfo.load` can restore the :class:`~bayesfo.tts.result.MasterCurve` and predictions and
 Prony series follow from it as from a comparison.
 
 ``bayesfo mastercurve`` writes, besides ``summary.json`` and ``master.csv``:

@@ -1,0 +1,151 @@
+"""The isotherms of a master curve: checked and ordered (:class:`_Isotherms`), the seed shifts
+from overlaying neighbouring isotherms, and the data reduced to the reference temperature."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ..data import FrequencyResponse
+from ..errors import InputError
+
+
+# ---------------------------------------------------------------------------- inputs
+@dataclass(frozen=True)
+class _Isotherms:
+    """The isotherms in order of temperature, checked."""
+
+    data: tuple[FrequencyResponse, ...]
+    temperatures: tuple[float, ...]
+    reference: int
+
+    @cached_property
+    def joint(self) -> FrequencyResponse:
+        omega = np.concatenate([d.omega for d in self.data])
+        response = np.concatenate([d.response for d in self.data])
+        sigma = (np.concatenate([d.sigma for d in self.data])
+                 if all(d.sigma is not None for d in self.data) else None)
+        first = self.data[0]
+        return FrequencyResponse(
+            omega, response, sigma, kind=first.kind, units=first.units,
+            name=f"{first.label.split(',')[0]}: {len(self.data)} isotherms, "
+                 f"{min(self.temperatures):g} to {max(self.temperatures):g} °C",
+            source=first.source, distinct_frequencies=False, symbol=first.symbol)
+
+    @cached_property
+    def point_isotherm(self) -> np.ndarray:
+        return np.concatenate([np.full(d.n_frequencies, i) for i, d in enumerate(self.data)])
+
+
+def _isotherms(isotherms, reference_temperature) -> _Isotherms:
+    """Check and sort the isotherms: (FrequencyResponse, temperature) pairs or objects with
+    ``data`` and ``temperature`` (:class:`bayesfo.data.Isotherm`)."""
+    pairs = []
+    for k, item in enumerate(isotherms):
+        if hasattr(item, "data") and hasattr(item, "temperature"):
+            data, temperature = item.data, item.temperature
+        else:
+            try:
+                data, temperature = item
+            except (TypeError, ValueError):
+                raise InputError(f"isotherm {k + 1}: give (FrequencyResponse, temperature in °C) "
+                                 "or an Isotherm of bayesfo.read_isotherms") from None
+        if not isinstance(data, FrequencyResponse):
+            raise InputError(f"isotherm {k + 1}: the data must be a FrequencyResponse")
+        if temperature is None or not math.isfinite(float(temperature)):
+            raise InputError(f"isotherm {k + 1} ({data.label}): no temperature; give each "
+                             "isotherm's temperature in °C")
+        pairs.append((data, float(temperature)))
+    if len(pairs) < 2:
+        raise InputError(f"a master curve needs two or more isotherms, got {len(pairs)}")
+    pairs.sort(key=lambda p: p[1])
+    temps = [t for _, t in pairs]
+    for a, b in zip(temps, temps[1:]):
+        if abs(a - b) < 0.5:
+            raise InputError(f"two isotherms at {a:g} and {b:g} °C: temperatures must differ "
+                             "(by 0.5 °C or more); merge or drop one")
+    kinds = {d.kind for d, _ in pairs}
+    if len(kinds) > 1 or kinds & {"generic"}:
+        raise InputError("the isotherms must all be modulus or all compliance data, got "
+                         + ", ".join(sorted(kinds)))
+    units = {d.units for d, _ in pairs}
+    if len(units) > 1:
+        raise InputError("the isotherms are in different units (" + ", ".join(sorted(units))
+                         + "); convert them to one")
+    if reference_temperature is None:
+        ref = len(pairs) // 2
+    else:
+        ref = int(np.argmin([abs(t - reference_temperature) for t in temps]))
+        if abs(temps[ref] - reference_temperature) > 0.5:
+            raise InputError(f"reference temperature {reference_temperature:g} °C: no isotherm "
+                             f"there; the isotherms are at {', '.join(f'{t:g}' for t in temps)} °C")
+    return _Isotherms(tuple(d for d, _ in pairs), tuple(temps), ref)
+
+
+# ---------------------------------------------------------------------------- seeds
+def _pair_shift(lower: FrequencyResponse, upper: FrequencyResponse) -> float:
+    """log10 of the factor by which ``upper``'s frequencies are multiplied to lie on
+    ``lower``'s curve (log|G*| and phase overlaid where the two overlap), by a grid search."""
+    def curve(d):
+        order = np.argsort(d.omega)
+        return (np.log10(d.omega[order]), np.log10(np.abs(d.response[order])),
+                np.angle(d.response[order]))
+
+    xl, ml, pl = curve(lower)
+    xu, mu, pu = curve(upper)
+    span = max(xl.max(), xu.max()) - min(xl.min(), xu.min())
+    best, best_cost = 0.0, np.inf
+    for d in np.arange(-span - 2.0, span + 2.0, 0.02):
+        x = xu + d
+        inside = (x >= xl.min()) & (x <= xl.max())
+        if inside.sum() < 2:
+            continue
+        cost = (np.mean((np.interp(x[inside], xl, ml) - mu[inside]) ** 2)
+                + np.mean((np.interp(x[inside], xl, pl) - pu[inside]) ** 2))
+        # Fewer overlapping points are worth less: a shift that overlays one point trivially
+        # must not beat one that overlays the whole sweep.
+        cost *= 1.0 + 1.0 / inside.sum()
+        if cost < best_cost:
+            best, best_cost = float(d), cost
+    return best
+
+
+def _seed_shifts(iso: _Isotherms) -> np.ndarray:
+    """log10 a_T of each isotherm from the pairwise overlays, 0 at the reference."""
+    n = len(iso.data)
+    steps = [_pair_shift(iso.data[i], iso.data[i + 1]) for i in range(n - 1)]
+    shifts = np.zeros(n)
+    for i in range(iso.reference + 1, n):
+        shifts[i] = shifts[i - 1] + steps[i - 1]
+    for i in range(iso.reference - 1, -1, -1):
+        shifts[i] = shifts[i + 1] - steps[i]
+    return shifts
+
+
+def _reduced(iso: _Isotherms, log_shifts, log_vertical=None) -> FrequencyResponse:
+    """The isotherms on one reduced frequency axis (a_T ω), each multiplied by b_T (a
+    compliance divided by it), sorted; points that land on the same frequency averaged."""
+    j = iso.joint
+    omega = j.omega * 10.0 ** np.asarray(log_shifts)[iso.point_isotherm]
+    b = np.ones_like(omega) if log_vertical is None else \
+        10.0 ** np.asarray(log_vertical)[iso.point_isotherm]
+    scale = b if j.kind == "modulus" else 1.0 / b
+    order = np.argsort(omega)
+    omega, response = omega[order], (j.response * scale)[order]
+    keep = np.r_[True, np.diff(omega) > 1e-12 * omega[1:]]
+    groups = np.cumsum(keep) - 1
+    n = groups[-1] + 1
+    r = np.zeros(n, complex)
+    np.add.at(r, groups, response)
+    r /= np.bincount(groups)
+    sigma = None
+    if j.sigma is not None:
+        s2 = np.zeros(n)
+        np.add.at(s2, groups, (j.sigma * scale)[order] ** 2)
+        sigma = np.sqrt(s2) / np.bincount(groups)
+    return FrequencyResponse(omega[keep], r, sigma, kind=j.kind, units=j.units,
+                             name=f"master curve of {j.label}", source=j.source,
+                             symbol=j.symbol)

@@ -4,9 +4,10 @@ horizontal shift log10 a_T, on all isotherms' complex data at once.
 Isotherm i, measured at temperature T_i, is modelled as the master function at reduced
 frequency: G_i(ω) = G_master(a_T,i · ω) / b_T,i, with a_T = b_T = 1 at the reference
 temperature. The parameters are the master structure's, one log10 a_T per other isotherm
-(uniform prior over ±:data:`~bayesfo.tts.model.SHIFT_RANGE` decades: no bound on the step
-between neighbours, and a shift the data do not fix, over a featureless plateau, comes out wide
-rather than pinned) and the noise. The vertical factor b_T is 1 (``vertical="none"``), the
+(uniform prior over ±:data:`~bayesfo.tts.model.SHIFT_RANGE` decades, or ± the largest seed
+shift plus :data:`~bayesfo.tts.model.SHIFT_MARGIN` where the isotherms span more: no bound on
+the step between neighbours, and a shift the data do not fix, over a featureless plateau, comes
+out wide rather than pinned) and the noise. The vertical factor b_T is 1 (``vertical="none"``), the
 density correction of entropic elasticity b_T = T_ref/T in kelvin with a constant density
 (``"density"``), or one log10 b_T per other isotherm (``"free"``, uniform over
 ±:data:`~bayesfo.tts.model.VERTICAL_RANGE` decades); compliances scale the other way,
@@ -33,7 +34,7 @@ from ..data import FrequencyResponse
 from ..errors import InputError
 from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F401
 from .laws import _fit_laws
-from .model import LAWS, ShiftedStructure
+from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
 from .result import MasterCurve, _num
 from .spectrum import NAME as SPECTRUM
 from .spectrum import Spectrum
@@ -212,8 +213,10 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
     w = reduced0.omega / scaling.omega_ref
     if spectral:  # its relaxation times span the reduced window the seeds give, widened
         master = Spectrum.over(w.min(), w.max())
+    # No shift the seeds reach is pinned at the prior's edge.
+    reach = max(SHIFT_RANGE, float(np.max(np.abs(shifts0))) + SHIFT_MARGIN)
     shifted = ShiftedStructure(master, iso.temperatures, iso.reference, iso.point_isotherm,
-                               dissipation_grid(w.min(), w.max()), vertical, law)
+                               dissipation_grid(w.min(), w.max()), vertical, law, reach)
     lik = Likelihood(shifted, joint, noise=noise, scaling=scaling)
     # Master seeds on the reduced data, then everything jointly (least squares on relative
     # residuals, in the sampling coordinates: logs of the log-uniform parameters).

@@ -17,8 +17,11 @@ from ..priors import LogUniform, Uniform
 from ..structures.structure import Parameter
 from .laws import arrhenius, wlf
 
-#: Prior of each log10 a_T: uniform over ±SHIFT_RANGE decades around the reference.
+#: Prior of each log10 a_T: uniform over ±SHIFT_RANGE decades around the reference, or wider
+#: where the seed shifts reach beyond SHIFT_RANGE − SHIFT_MARGIN (isotherms spanning 30
+#: decades): ± (largest seed + SHIFT_MARGIN).
 SHIFT_RANGE = 15.0
+SHIFT_MARGIN = 5.0
 #: Prior of each free log10 b_T: uniform over ±VERTICAL_RANGE decades (vertical factors are
 #: density and temperature ratios, a few tens of per cent).
 VERTICAL_RANGE = 1.0
@@ -63,6 +66,8 @@ class ShiftedStructure:
         The dissipation grid of the master (scaled), spanning the reduced window.
     vertical : {"none", "density", "free"}
         The vertical shift b_T (see the module).
+    shift_range : float
+        Each free log10 a_T is uniform over ± this many decades.
     law : {"free", "wlf", "arrhenius"}
         One free log10 a_T per isotherm other than the reference, or the shifts of a law
         whose parameters (``wlf_C1``, ``wlf_C2`` [°C]; ``Ea`` [J/mol]) are sampled instead
@@ -76,6 +81,7 @@ class ShiftedStructure:
     master_grid: np.ndarray | None = None
     vertical: str = "none"
     law: str = "free"
+    shift_range: float = SHIFT_RANGE
 
     @property
     def name(self) -> str:
@@ -100,7 +106,8 @@ class ShiftedStructure:
         if self.law != "free":
             raise InputError(f"law must be one of {', '.join(LAWS)}, got {self.law!r}")
         return tuple(Parameter(shift_name(self.temperatures[i]), "shift",
-                               Uniform(-SHIFT_RANGE, SHIFT_RANGE)) for i in self.shifted)
+                               Uniform(-self.shift_range, self.shift_range))
+                     for i in self.shifted)
 
     @cached_property
     def parameters(self) -> tuple:

@@ -523,3 +523,17 @@ def test_auto_fits_no_law_inside_the_posterior_on_three_isotherms():
     mc = _fit(isotherms(truth)[1:4])  # 10, 20, 30 °C: two shifts, as many as WLF's parameters
     assert AUTO_LAWS_MIN == 4 and mc.law == "free" and mc.law_evidence == {}
     assert not any("shift law over all isotherms" in n for n in mc.notes)
+
+
+def test_the_shift_prior_widens_where_the_seeds_reach_past_it():
+    from bayesfo.tts.model import SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
+
+    z = get_structure("zener")
+    wide = ShiftedStructure(z, tuple(TEMPS), 2, np.zeros(1, int), shift_range=28.0)
+    bounds = {p.name: p.prior.bounds for p in wide.parameters[z.n_params:]}
+    assert bounds[shift_name(0.0)] == (-28.0, 28.0)
+    assert wide.in_support(np.r_[ZENER, [27.0, 1.0, -1.0, -2.0, -3.0]])
+    assert not wide.in_support(np.r_[ZENER, [29.0, 1.0, -1.0, -2.0, -3.0]])
+    plain = ShiftedStructure(z, tuple(TEMPS), 2, np.zeros(1, int))
+    assert plain.parameters[-1].prior.bounds == (-SHIFT_RANGE, SHIFT_RANGE)
+    assert (SHIFT_RANGE, SHIFT_MARGIN) == (15.0, 5.0)

@@ -97,6 +97,11 @@ def run(args) -> int:
     return result.exit_status
 
 
+#: How a batch task records a warning about the data (negative loss, parts not Kramers–Kronig
+#: consistent, a sheet left out): the category, then the message.
+DATA_WARNING = "DataWarning: "
+
+
 def _print_table(result: BatchResult) -> None:
     """A line per data set: its best structure by ln Z, P, every order's mean, whether the
     structure describes the data (fits: the posterior predictive checks, as ``compare``
@@ -144,3 +149,8 @@ def _print_table(result: BatchResult) -> None:
         print(f"fits NO: on {len(misfit)} of {len(result.outcomes)} data sets the best structure "
               "fails the posterior predictive checks (none of the candidates describes those "
               "data; see each report's verdict): " + ", ".join(misfit))
+    # Problems of the data themselves (compare's data warnings), which no structure mends.
+    for o in result.outcomes:
+        for w in dict.fromkeys(getattr(o, "warnings", ())):
+            if w.startswith(DATA_WARNING):
+                print(f"data {o.dataset.id}: {w[len(DATA_WARNING):]}")

@@ -528,17 +528,22 @@ def test_batch_table_shows_every_order_and_whether_the_best_fits(capsys, tmp_pat
     from bayesfo.batch.task import OK
     from bayesfo.cli.batch import _print_table
 
-    def outcome(name, t, orders, fits):
+    def outcome(name, t, orders, fits, warnings=()):
         rows = [{"structure": "fractional_kelvin_voigt", "rank": 1, "best": True,
                  "converged": True, "posterior_probability": 1.0, "orders": orders,
                  "fits": fits}]
         return SimpleNamespace(dataset=SimpleNamespace(id=name, temperature=t), status=OK,
-                               rows=rows, reused=False)
+                               rows=rows, reused=False, warnings=warnings)
 
-    outcomes = [outcome("Tm040C", -40.0, "α 0.901 [0.88–0.92]; β 0.120 [0.11–0.13]", "no"),
+    loss = ("adhesive, -40 °C: 1 of 17 points have negative loss (Im G < 0), impossible for a "
+            "passive modulus, at omega = 125.7 rad/s; no passive structure can fit them")
+    outcomes = [outcome("Tm040C", -40.0, "α 0.901 [0.88–0.92]; β 0.120 [0.11–0.13]", "no",
+                        (f"DataWarning: {loss}", "PredictiveWarning: misfit", f"DataWarning: {loss}")),
                 outcome("Tp020C", 20.0, "α 0.589 [0.586–0.592]; β 0.138 [0.13–0.14]", "yes")]
     _print_table(SimpleNamespace(outcomes=outcomes, out_dir=tmp_path))
-    header, cold, warm, summary = capsys.readouterr().out.splitlines()
+    header, cold, warm, summary, data = capsys.readouterr().out.splitlines()
+    # The data's own problem, once, under the table: no structure mends it.
+    assert data == f"data Tm040C: {loss}"
     assert "orders (mean)" in header and header.split()[-2:] == ["fits", "status"]
     assert "α 0.901 β 0.120" in cold and cold.split()[-2:] == ["NO", "ok"]
     assert "α 0.589 β 0.138" in warm and warm.split()[-2:] == ["yes", "ok"]

@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from .._io import csv_cells, show, split_lines
-from ..errors import InputError
+from ..errors import DataWarning, InputError
 from .assemble import assemble_table
 from .columns import ROLES, Choice, Column, NotResponse, choose
 from .csv_reader import (
@@ -254,16 +255,24 @@ def read_isotherms(path: str | os.PathLike, *, kind: str | None = None,
     _check_arguments(kind, delimiter, decimal, duplicates)
     mapping = _mapping(columns)
     if path.suffix.lower() in _EXCEL:
-        per_sheet = []
+        per_sheet, refused = [], []
         for sheet, rows in excel_sheets(path):
             lines = classify_rows(rows)
             if any(ln.kind == "data" for ln in lines):
-                per_sheet.append((sheet, _read_lines(
-                    path, f"{where}, sheet '{sheet}'", lines, "cells", "Excel workbook",
-                    decimal, mapping, kind, duplicates, units, name,
-                    fmt=f"Excel workbook (sheet '{sheet}')")))
+                try:
+                    per_sheet.append((sheet, _read_lines(
+                        path, f"{where}, sheet '{sheet}'", lines, "cells", "Excel workbook",
+                        decimal, mapping, kind, duplicates, units, name,
+                        fmt=f"Excel workbook (sheet '{sheet}')")))
+                except InputError as exc:  # a header or log sheet of numbers beside the data
+                    refused.append(exc)
         if not per_sheet:
+            if refused:
+                raise refused[0]
             raise InputError(f"{where}: no sheet holds a table of numbers")
+        for exc in refused:
+            warnings.warn(f"{exc}; the sheet is left out, the other sheets are read",
+                          DataWarning, stacklevel=2)
         if len(per_sheet) == 1:
             return _renumber(per_sheet[0][1])
         return _renumber([_relabel(iso, ", ".join(x for x in (sheet, iso.label) if x), path)

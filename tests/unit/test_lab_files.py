@@ -721,3 +721,32 @@ def test_an_oversized_sheet_beside_the_data_is_left_out_with_a_warning(tmp_path)
         iso = read_isotherms(path)
     assert iso[0].reading.format == "Excel workbook (sheet 'sweep')"
     np.testing.assert_allclose(iso[0].data.response, G, rtol=1e-12)
+
+
+def test_a_sheet_of_numbers_without_a_frequency_is_left_out_beside_the_data(tmp_path):
+    """An instrument's header sheet (numbers, no frequency column, as the Eplexor export's
+    'Data header') beside the data sheet is left out with a warning; alone, it is the error."""
+    openpyxl = pytest.importorskip("openpyxl")
+    from bayesfo.errors import DataWarning
+
+    path = tmp_path / "eplexor.xlsx"
+    book = openpyxl.Workbook()
+    head = book.active
+    head.title = "Data header"
+    head.append(["Sample thickness [mm]", "Sample width [mm]"])
+    head.append([2.0, 10.0])
+    head.append([2.1, 10.2])
+    head.append([2.2, 10.1])
+    data = book.create_sheet("Exported Data")
+    data.append(["Angular Frequency [rad/s]", "Storage Modulus [Pa]", "Loss Modulus [Pa]"])
+    for w, g in zip(W, G, strict=True):
+        data.append([float(w), float(g.real), float(g.imag)])
+    book.save(path)
+    with pytest.warns(DataWarning, match=r"sheet 'Data header'.*the sheet is left out"):
+        iso = read_isotherms(path)
+    assert len(iso) == 1 and iso[0].reading.format == "Excel workbook (sheet 'Exported Data')"
+    np.testing.assert_allclose(iso[0].data.response, G, rtol=1e-12)
+    del book["Exported Data"]
+    book.save(path)
+    with pytest.raises(InputError, match="sheet 'Data header'"):
+        read_isotherms(path)

@@ -13,6 +13,7 @@ from .._io import show
 from ..errors import StructureError
 from ..priors import Prior
 from . import passivity
+from .parameters import Parameter, Parametrised, in_prior_support  # noqa: F401
 from .passivity import commensurate_passive, side_stable, springpot_sum_passive
 from .response import (
     commensurate_response,
@@ -25,27 +26,8 @@ from .scaling import ScalePlan, Scaling, scale_plan
 from .terms import Inequality, Term
 
 
-@dataclass(frozen=True)
-class Parameter:
-    """A free parameter: its name, its role (``coefficient`` or ``exponent``) and its prior."""
-
-    name: str
-    role: str
-    prior: Prior
-
-
-def in_prior_support(parameters, theta) -> np.ndarray:
-    """True where every column of ``theta`` (one per :class:`Parameter`) lies within the
-    support of that parameter's prior; a bool per row, or one bool for a single set."""
-    theta2 = np.atleast_2d(np.asarray(theta, float))
-    ok = np.ones(theta2.shape[0], dtype=bool)
-    for i, p in enumerate(parameters):
-        ok &= p.prior.contains(theta2[:, i])
-    return ok if np.ndim(theta) == 2 else ok[0]
-
-
 @dataclass(frozen=True, eq=False)
-class Structure:
+class Structure(Parametrised):
     """A transfer-function structure with priors and constraints.
 
     Build structures from cards (:func:`load_library`, :func:`get_structure`) rather than by
@@ -92,16 +74,6 @@ class Structure:
         self._validate()
 
     # ------------------------------------------------------------------ introspection
-    @property
-    def param_names(self) -> tuple[str, ...]:
-        """Names of the free parameters, in the column order of ``theta``."""
-        return tuple(p.name for p in self.parameters)
-
-    @property
-    def n_params(self) -> int:
-        """Number of free parameters (without noise parameters)."""
-        return len(self.parameters)
-
     @property
     def priors(self) -> dict[str, Prior]:
         return {p.name: p.prior for p in self.parameters}
@@ -353,10 +325,6 @@ class Structure:
         return g
 
     # ------------------------------------------------------------------ constraints
-    def in_support(self, theta) -> np.ndarray:
-        """True where every free parameter lies within the support of its prior."""
-        return in_prior_support(self.parameters, theta)
-
     def stable(self, theta, kind: str = "generic") -> np.ndarray:
         """Stability of the poles, and for materials of the zeros.
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..priors import LogUniform, Uniform
-from ..structures.structure import Parameter
+from ..structures.parameters import Parameter, Parametrised
 from .laws import arrhenius, wlf
 
 #: Prior of each log10 a_T: uniform over ±SHIFT_RANGE decades around the reference, or wider
@@ -46,7 +46,7 @@ def shift_name(temperature: float, factor: str = "aT") -> str:
 
 
 @dataclass(frozen=True, eq=False)
-class ShiftedStructure:
+class ShiftedStructure(Parametrised):
     """A master structure seen through the isotherms: the structure's parameters followed by
     one log10 a_T per isotherm other than the reference, evaluated on the joint data's points
     (each at its own isotherm's reduced frequency). It offers what the inference routes use of
@@ -117,14 +117,6 @@ class ShiftedStructure:
                                       Uniform(-VERTICAL_RANGE, VERTICAL_RANGE))
                             for i in self.shifted)
         return tuple(self.master.parameters) + shifts
-
-    @property
-    def param_names(self) -> tuple[str, ...]:
-        return tuple(p.name for p in self.parameters)
-
-    @property
-    def n_params(self) -> int:
-        return len(self.parameters)
 
     @property
     def fixed(self) -> dict:

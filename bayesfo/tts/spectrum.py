@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..priors import LogUniform, Normal, Uniform
-from ..structures.structure import Parameter, in_prior_support
+from ..structures.parameters import Parameter, Parametrised
 
 #: The structure name that stands for the spectrum in ``--structures``.
 NAME = "spectrum"
@@ -43,7 +43,7 @@ LN_G1_RANGE = (math.log(1e-10), math.log(1e6))
 
 
 @dataclass(frozen=True, eq=False)
-class Spectrum:
+class Spectrum(Parametrised):
     """A discrete relaxation spectrum on fixed relaxation times (see the module).
 
     Attributes
@@ -77,14 +77,6 @@ class Spectrum:
                       for k in range(1, len(self.tau)))
         return (Parameter("G_e", "coefficient", LogUniform(*G_E_RANGE)),
                 Parameter("ln_g_1", "coefficient", Uniform(*LN_G1_RANGE))) + steps
-
-    @property
-    def param_names(self) -> tuple[str, ...]:
-        return tuple(p.name for p in self.parameters)
-
-    @property
-    def n_params(self) -> int:
-        return len(self.parameters)
 
     fixed: dict = field(default_factory=dict, repr=False)
     inverted: bool = False
@@ -146,11 +138,6 @@ class Spectrum:
             with np.errstate(divide="ignore", invalid="ignore"):
                 return 1.0 / c
         return c
-
-    def in_support(self, theta) -> np.ndarray:
-        finite = np.all(np.isfinite(np.atleast_2d(np.asarray(theta, float))), axis=1)
-        ok = np.atleast_1d(in_prior_support(self.parameters, theta)) & finite
-        return ok if np.ndim(theta) == 2 else ok[0]
 
     def constraints_hold(self, theta, kind: str, omega_grid=None, where=None) -> np.ndarray:
         """Always: non-negative moduli on real relaxation times are passive and stable."""

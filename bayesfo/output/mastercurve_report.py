@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write_text
-from .report import CSS, _e, _num
+from .report import CSS, _e, _figures_section, _num
 
 #: Captions of the master curve's figures.
 CAPTIONS = {
@@ -172,33 +172,14 @@ def render_mastercurve_report(mc, figures: dict | None = None) -> str:
     if notes:
         sections.append(f"<h2 id='notes'>Notes</h2><ul>{notes}</ul>")
     if figures:
-        sections.append(f"<h2 id='figures'>Figures</h2>{_figures(figures)}")
+        sections.append(f"<h2 id='figures'>Figures</h2>"
+                        f"{_figures_section(figures, captions=CAPTIONS)}")
     return (
         "<!DOCTYPE html>\n<html lang='en'>\n<head>\n<meta charset='utf-8'>\n"
         "<meta name='viewport' content='width=device-width, initial-scale=1'>\n"
         f"<title>{_e(title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n"
         f"<h1>{_e(title)}</h1>\n<p class='small'>bayesfo {_e(__version__)}.</p>\n"
         + "\n".join(sections) + "\n</body>\n</html>\n")
-
-
-def _figures(figures: dict) -> str:
-    """The figures' PNG files embedded, with the master curve's captions."""
-    import base64
-
-    from ..errors import InputError
-
-    parts = []
-    for name, path in figures.items():
-        try:
-            data = Path(path).read_bytes()
-        except OSError as exc:
-            raise InputError(f"argument 'figures': cannot read figure '{name}' from "
-                             f"'{path}': {exc.strerror}") from None
-        uri = "data:image/png;base64," + base64.b64encode(data).decode("ascii")
-        caption = CAPTIONS.get(name, name)
-        parts.append(f"<figure id='fig-{_e(name)}'><img src='{uri}' alt='{_e(caption)}'>"
-                     f"<figcaption><b>{_e(name)}</b>: {_e(caption)}</figcaption></figure>")
-    return "".join(parts)
 
 
 def write_mastercurve_report(mc, out_dir, figures: dict | None = None) -> Path:

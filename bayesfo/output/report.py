@@ -424,12 +424,14 @@ def _paths(value) -> list[Path]:
     return [Path(v) for v in value]
 
 
-def _figures_section(figures: dict, comparison=None) -> str:
+def _figures_section(figures: dict, comparison=None, captions: dict | None = None) -> str:
+    """The figures' PNG files embedded with their captions (``captions``, else a comparison's
+    own)."""
     parts = []
     for name, value in figures.items():
         paths = _paths(value)
         png = next((p for p in paths if p.suffix.lower() == ".png"), None)
-        caption = _caption(name, comparison)
+        caption = captions.get(name, name) if captions is not None else _caption(name, comparison)
         if png is None:
             parts.append(f"<p class='small'>{_e(name)}: {_e(caption)} (not embedded: written as "
                          f"{_e(', '.join(p.name for p in paths))})</p>")

@@ -96,21 +96,46 @@ def _pair_shift(lower: FrequencyResponse, upper: FrequencyResponse) -> float:
 
     xl, ml, pl = curve(lower)
     xu, mu, pu = curve(upper)
+    d = overlay_shift(xl, (ml, pl), xu, (mu, pu))
+    return 0.0 if d is None else d
+
+
+#: Step of the grid of shifts [decades].
+GRID_STEP = 0.02
+
+
+def overlay_cost(xl, yl, xu, yu, d: float, min_inside: int = 2):
+    """(cost, inside) of laying the curves ``yu`` (at log10 ω ``xu + d``) on ``yl`` (at ``xl``):
+    the sum over the curves of the mean squared difference where they overlap, inf with fewer
+    than ``min_inside`` points inside."""
+    x = xu + d
+    inside = (x >= xl.min()) & (x <= xl.max())
+    n = int(inside.sum())
+    if n < min_inside:
+        return np.inf, inside
+    cost = sum(float(np.mean((np.interp(x[inside], xl, a) - b[inside]) ** 2))
+               for a, b in zip(yl, yu, strict=True))
+    # Fewer overlapping points are worth less: a shift that overlays one point trivially
+    # must not beat one that overlays the whole sweep.
+    return cost * (1.0 + 1.0 / n), inside
+
+
+def overlay_shift(xl, yl, xu, yu, *, min_inside: int = 2,
+                  refine: bool = False) -> float | None:
+    """The shift d [decades] of log10 ω that best lays the curves ``yu`` on ``yl`` (sequences
+    of arrays over ``xu`` and ``xl``), by a grid search over every overlap (and, with
+    ``refine``, a finer one around its best); None where they never overlap."""
     span = max(xl.max(), xu.max()) - min(xl.min(), xu.min())
-    best, best_cost = 0.0, np.inf
-    for d in np.arange(-span - 2.0, span + 2.0, 0.02):
-        x = xu + d
-        inside = (x >= xl.min()) & (x <= xl.max())
-        if inside.sum() < 2:
-            continue
-        cost = (np.mean((np.interp(x[inside], xl, ml) - mu[inside]) ** 2)
-                + np.mean((np.interp(x[inside], xl, pl) - pu[inside]) ** 2))
-        # Fewer overlapping points are worth less: a shift that overlays one point trivially
-        # must not beat one that overlays the whole sweep.
-        cost *= 1.0 + 1.0 / inside.sum()
-        if cost < best_cost:
-            best, best_cost = float(d), cost
-    return best
+    grid = np.arange(-span - 2.0, span + 2.0, GRID_STEP)
+    costs = [overlay_cost(xl, yl, xu, yu, d, min_inside)[0] for d in grid]
+    k = int(np.argmin(costs))
+    if not np.isfinite(costs[k]):
+        return None
+    if not refine:
+        return float(grid[k])
+    fine = np.linspace(grid[k] - GRID_STEP, grid[k] + GRID_STEP, 41)
+    return float(fine[int(np.argmin([overlay_cost(xl, yl, xu, yu, v, min_inside)[0]
+                                     for v in fine]))])
 
 
 def _seed_shifts(iso: _Isotherms) -> np.ndarray:

@@ -32,6 +32,8 @@ import math
 
 import numpy as np
 
+from .isotherms import overlay_cost, overlay_shift
+
 #: Difference of the loss angle at equal |G*| [deg] that a pair of isotherms may show before
 #: superposition is judged to fail (with three standard errors; see the module).
 TOLERANCE_DEG = 1.5
@@ -160,24 +162,10 @@ def _shift_of(xl, yl, xu, yu) -> dict | None:
     xl, yl, xu, yu = xl[ok_l], yl[ok_l], xu[ok_u], yu[ok_u]
     if xl.size < 3 or xu.size < 3:
         return None
-    span = max(xl.max(), xu.max()) - min(xl.min(), xu.min())
-
-    def cost(d):
-        x = xu + d
-        inside = (x >= xl.min()) & (x <= xl.max())
-        if inside.sum() < 3:
-            return np.inf, inside
-        r = np.interp(x[inside], xl, yl) - yu[inside]
-        return float(np.mean(r**2)) * (1.0 + 1.0 / inside.sum()), inside
-
-    grid = np.arange(-span - 2.0, span + 2.0, 0.02)
-    costs = [cost(d)[0] for d in grid]
-    k = int(np.argmin(costs))
-    if not np.isfinite(costs[k]):
+    d = overlay_shift(xl, (yl,), xu, (yu,), min_inside=3, refine=True)
+    if d is None:
         return None
-    fine = np.linspace(grid[k] - 0.02, grid[k] + 0.02, 41)
-    d = float(fine[int(np.argmin([cost(v)[0] for v in fine]))])
-    _, inside = cost(d)
+    _, inside = overlay_cost(xl, (yl,), xu, (yu,), d, 3)
     x = xu[inside] + d
     slope = float(np.mean(np.gradient(np.interp(x, xl, yl), x))) if x.size > 1 else 0.0
     if abs(slope) < MIN_SLOPE:

@@ -194,6 +194,8 @@ def run(args) -> int:
               "pass, but the fitted noise swamps points the fit misses)")
         for line in ranking_lines(result.table()):
             print(line)
+        if result.noise_note:
+            print(result.noise_note)
         _print_undetermined(result)
         pairs = result.baselines()
         if pairs:

@@ -150,6 +150,31 @@ def not_determined(summary: dict, draws=None) -> str | None:
                    hi - lo if math.isfinite(lo) and math.isfinite(hi) else math.inf, percent)
 
 
+def log_scale_hdi(summary: dict, draws) -> tuple[float, float] | None:
+    """The 94 % HDI of a positive quantity with a unit taken on a log scale, as values
+    (``10**`` the ends of the HDI of ``log10(draws)``): the interval that
+    :func:`not_determined` judges, which reports show in place of the HDI of the values (that
+    one leans towards small values). None for a pure number, a quantity with draws below 0,
+    undefined (NaN) draws, or no draws."""
+    if not summary.get("unit") or draws is None:
+        return None
+    x = np.asarray(draws, dtype=float).ravel()
+    if x.size < 2 or np.isnan(x).any() or np.any(x < 0):
+        return None
+    with np.errstate(divide="ignore"):
+        lo, hi = (float(v) for v in _hdi(np.log10(x)))
+    return 10.0 ** lo, 10.0 ** hi
+
+
+def shown_hdi(summary: dict) -> tuple[float, float]:
+    """The interval a report shows for a quantity summarised by :func:`with_determination`:
+    the HDI on a log scale where there is one (:func:`log_scale_hdi`), else the HDI of the
+    values."""
+    if summary.get("hdi_log_low") is not None and summary.get("hdi_log_high") is not None:
+        return summary["hdi_log_low"], summary["hdi_log_high"]
+    return summary.get("hdi_low"), summary.get("hdi_high")
+
+
 def _hdi(x):
     from ..inference._arviz import hdi
 
@@ -198,6 +223,9 @@ def with_determination(block: dict, poorly_determined=None, draws=None) -> dict:
         reason = not_determined(s, draws.get(name))
         out[name] = dict(s) | {"not_determined": reason is not None,
                                "not_determined_reason": reason}
+        judged = log_scale_hdi(s, draws.get(name))
+        if judged is not None:
+            out[name]["hdi_log_low"], out[name]["hdi_log_high"] = judged
         if name in poorly_determined:
             out[name]["poorly_determined"] = bool(poorly_determined[name])
     return out

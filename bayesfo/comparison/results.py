@@ -22,6 +22,7 @@ from .parameters import (  # noqa: F401  (re-exported: the names results offered
     parameter_units,
     physical_forms,
     physical_text,
+    shown_hdi,
     summarise_draws,
     with_determination,
 )
@@ -220,7 +221,7 @@ class StructureResult:
             block = self.sampled_parameters
         if block:
             width = max(len(n) for n in block)
-            lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI")
+            lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI (on a log scale for quantities with a unit)")
             for n, v in block.items():
                 unit = f" {v['unit']}" if v.get("unit") else ""
                 flags = ([f"not determined: {v['not_determined_reason']}"]
@@ -228,9 +229,9 @@ class StructureResult:
                     ["poorly determined: the HDI covers more than half of the prior range"]
                     if v.get("poorly_determined") else [])
                 flag = f"  ({'; '.join(flags)})" if flags else ""
+                lo, hi = shown_hdi(v)
                 lines.append(f"  {n:<{width}}  {number(v.get('median'), '11.4g')}  "
-                             f"[{number(v.get('hdi_low'), '.4g')}, {number(v.get('hdi_high'), '.4g')}]"
-                             f"{unit}{flag}")
+                             f"[{number(lo, '.4g')}, {number(hi, '.4g')}]{unit}{flag}")
         for w in self.criteria.warnings:
             lines.append(f"  ! {w}")
         return "\n".join(lines)
@@ -376,6 +377,20 @@ class Comparison:
 
         return [r.name for r in sorted(ok, key=key)]
 
+    @property
+    def noise_note(self) -> str | None:
+        """How the noise model enters ln Z, in words, where some structure's ln Z is
+        marginalised over noise models (``noise="auto"`` without σ); None otherwise."""
+        records = [r.criteria.noise_models for r in self.results
+                   if r.error is None and r.criteria.noise_models
+                   and "marginal" in r.criteria.noise_models]
+        if not records:
+            return None
+        models = list(dict.fromkeys(n for rec in records for n in rec["marginal"]["prior"]))
+        return (f"ln Z treats the noise model as a nuisance (the mean of the evidences under "
+                f"{' and '.join(models)} noise, equal prior weights), so every structure is "
+                "ranked on one footing; each posterior is under its more probable noise model")
+
     def predict(self, quantity: str, x, *, structure: str | None = None,
                 average: str | None = None, seed: int = 0):
         """A material function with its credible band: :func:`bayesfo.predict` of this
@@ -414,6 +429,8 @@ class Comparison:
         lines = [f"{d.label}: {d.n_frequencies} frequencies{held} "
                  f"({d.omega.min():.4g} to {d.omega.max():.4g} rad/s), {d.kind}; seed "
                  f"{self.seed}; ranked by ln Z", *ranking_lines(self.table())]
+        if self.noise_note:
+            lines.append(self.noise_note)
         for w in self.data_warnings:
             lines.append(f"! {w}")
         return "\n".join(lines)

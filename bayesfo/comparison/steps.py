@@ -208,7 +208,12 @@ def choose_noise(name: str, runs: list[NoiseRun],
     """The run whose noise model has the larger evidence, and the record of the choice: each
     noise model's ln Z (certified, or the quick estimate of a model left out by the screen),
     its posterior probability (equal prior odds) and the exponents' intervals, and
-    ``sensitive`` when an exponent's intervals under the two models do not overlap."""
+    ``sensitive`` when an exponent's intervals under the two models do not overlap.
+
+    The chosen run's evidence becomes the structure's evidence with the noise model as a
+    nuisance (:func:`_marginal_evidence`; ``record["marginal"]``), so that structures run
+    under different noise models are ranked on one footing; its posterior stays the one under
+    the chosen noise model (``evidence.given_noise`` holds that model's own ln Z)."""
     entries = []
     for r in runs:
         e = r.criteria["evidence"]
@@ -230,6 +235,13 @@ def choose_noise(name: str, runs: list[NoiseRun],
         prob = np.full(len(entries), np.nan)
     chosen = entries[best].run
     record = {"chosen": entries[best].noise, "models": {}}
+    marginal = _marginal_evidence(chosen.criteria["evidence"], log_z,
+                                  [e.log_z_err for e in entries])
+    if marginal is not None:
+        chosen.criteria["evidence"] = marginal
+        record["marginal"] = {
+            "log_evidence": float(marginal.log_z), "log_evidence_err": float(marginal.log_z_err),
+            "prior": {e.noise: 1.0 / len(entries) for e in entries}}
     for (noise, lz, err, method, hdi, _), p in zip(entries, prob, strict=True):
         record["models"][noise] = {
             "log_evidence": float(lz) if np.isfinite(lz) else None, "log_evidence_err": err,
@@ -268,6 +280,24 @@ def choose_noise(name: str, runs: list[NoiseRun],
         if not decided:
             warnings.warn(msg, NoiseWarning, stacklevel=3)
     return chosen, record
+
+
+def _marginal_evidence(given, log_z, errors):
+    """The evidence of the structure with the noise model as a nuisance: the mean of the noise
+    models' evidences (equal prior weights, the same as the probabilities of the choice), with
+    the error of that mean from theirs (a model the screen set aside adds its quick estimate,
+    without an error: it holds under 1 % of the sum). ``given`` (the chosen model's
+    :class:`~bayesfo.inference.evidence.Evidence`) is kept in the result as ``given_noise``;
+    None where it is None or not finite."""
+    if given is None or not np.isfinite(given.log_z):
+        return None
+    log_z = np.asarray(log_z, dtype=float)
+    top = np.max(log_z)
+    w = np.exp(log_z - top)
+    total = float(top + np.log(w.mean()))
+    share = w / w.sum()
+    err = float(np.sqrt(sum((p * (e or 0.0)) ** 2 for p, e in zip(share, errors, strict=True))))
+    return replace(given, log_z=total, log_z_err=err, given_noise=given)
 
 
 #: The evidence decides the noise model when it gives the chosen one at least this probability;

@@ -440,9 +440,17 @@ def _criteria(s: dict, idata) -> Criteria:
     main = None if method is None else {
         "log_z": s["log_evidence"], "log_z_err": s["log_evidence_err"], "method": method,
         "log_support": s["log_prior_support"]}
+    evidence = _evidence(main, idata.posterior.attrs)
+    noise_models = s.get("noise_models")
+    if evidence is not None and noise_models and "marginal" in noise_models:
+        # ln Z marginalised over the noise models; the chosen model's own estimate beside it.
+        given = noise_models["models"][noise_models["chosen"]]
+        evidence = dataclasses.replace(evidence, given_noise=dataclasses.replace(
+            evidence, log_z=_num(given["log_evidence"]),
+            log_z_err=_num(given["log_evidence_err"])))
     values.update(
         priors=s["priors"], warnings=tuple(s["warnings"]), importance=s.get("importance"),
-        evidence=_evidence(main, idata.posterior.attrs),
+        evidence=evidence,
         evidence_check=_evidence(s.get("evidence_check")),
         evidence_agree=s.get("evidence_agree"), noise_models=s.get("noise_models"),
         adequacy=_adequacy(s.get("adequacy")),

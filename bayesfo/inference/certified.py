@@ -257,8 +257,12 @@ def _evidence(lik, post: PosteriorResult, seed: int, route: str = "auto", *,
 
 def evidence_check(lik, post, evidence, seed: int) -> dict:
     """ln Z by dynesty nested sampling beside ``evidence``, and whether they agree within twice
-    their combined error: ``{"evidence_check", "evidence_agree", "warnings"}``."""
+    their combined error: ``{"evidence_check", "evidence_agree", "warnings"}``. Nested
+    sampling runs under the likelihood's one noise model: where ``evidence`` is marginalised
+    over noise models, it is compared with the estimate under that model
+    (:attr:`Evidence.conditional`)."""
     out = {"warnings": []}
+    evidence = evidence.conditional
     # Uniform draws from bounding ellipsoids where the posterior is one compact mode; slice
     # sampling where the walkers did not converge (ridges, several modes), on which uniform
     # draws stall (see nested_evidence).

@@ -63,6 +63,11 @@ class Evidence:
     reached_log_likelihood : float or None
         Tempered ladder only: the highest log-likelihood among the final particles of the run
         that reached least high (a run that ends well below the best fit has missed mass).
+    given_noise : Evidence or None
+        Where ``log_z`` is the evidence of a structure with the noise model as a nuisance
+        (marginalised over the candidate noise models, :func:`~bayesfo.comparison.steps.
+        choose_noise`): the estimate under the chosen noise model alone, which the posterior
+        is conditional on. None where ``log_z`` is that estimate itself.
     """
 
     log_z: float
@@ -72,9 +77,19 @@ class Evidence:
     n_likelihood: int
     seconds: float
     reached_log_likelihood: float | None = None
+    given_noise: Evidence | None = None
 
     def to_dict(self) -> dict:
-        return dict(self.__dict__)
+        out = dict(self.__dict__)
+        if self.given_noise is not None:
+            out["given_noise"] = self.given_noise.to_dict()
+        return out
+
+    @property
+    def conditional(self) -> Evidence:
+        """The estimate under one noise model: :attr:`given_noise` where ``log_z`` is
+        marginalised over several, else this estimate."""
+        return self if self.given_noise is None else self.given_noise
 
 
 def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_000) -> tuple[float, float]:

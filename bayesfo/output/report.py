@@ -24,7 +24,7 @@ import html
 from pathlib import Path
 
 from .._io import atomic_write_text
-from ..comparison.parameters import UNDETERMINED_DECADES
+from ..comparison.parameters import UNDETERMINED_DECADES, shown_hdi
 from ..comparison.table import number
 from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
@@ -271,8 +271,9 @@ def _parameters_section(comparison) -> str:
                 f"<tr>{_text_cell(parameter_label(p, symbol))}"
                 f"{_text_cell(in_symbol(units.get(p, ''), symbol))}{_cell(s.mean, '.4g')}"
                 f"{_cell(s.sd, '.3g')}"
-                f"{_cell(s.hdi_low, '.4g')}{_cell(s.hdi_high, '.4g')}{_cell(s.median, '.4g')}"
-                f"{_cell(s.map, '.4g')}"
+                + "".join(_cell(v, '.4g') for v in shown_hdi(
+                    judged.get(p, {"hdi_low": s.hdi_low, "hdi_high": s.hdi_high})))
+                + f"{_cell(s.median, '.4g')}{_cell(s.map, '.4g')}"
                 f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
         sampled = (f"<table>{_PARAMETER_HEAD}<th class='text'>flags</th></tr>{''.join(rows)}"
                    "</table>")
@@ -300,9 +301,11 @@ def _parameters_section(comparison) -> str:
     return (f"<p class='small'>Posterior summaries in physical units, the units derived from "
             f"the data's; HDI: {HDI_PERCENT} % highest-density interval; MAP: the draw of "
             "highest posterior density (for a physical parameter, its value at that draw). "
+            "For a positive quantity with a unit the HDI shown is taken on a log scale (of "
+            "the logarithms of the draws, so that a quantity and its reciprocal agree; "
+            "summary.json holds it as hdi_log_low/hdi_log_high beside the HDI of the values). "
             "'Poorly determined': the HDI covers more than half of the prior range. 'Not "
-            f"determined': the HDI of a quantity with a unit, taken on a log scale (of the "
-            f"logarithms of the draws, so that a quantity and its reciprocal agree), spans more "
+            f"determined': that log-scale HDI spans more "
             f"than {UNDETERMINED_DECADES:g} decades or runs to 0 or infinity (for a signed "
             "quantity: reaches across 0), or the quantity is undefined at more draws than the "
             "HDI leaves out, so the data do not fix even its order of magnitude and its numbers "
@@ -328,8 +331,8 @@ def _physical_table(block: dict, symbol: str = "G") -> str:
             f"<tr>{_text_cell(parameter_label(p, symbol))}"
             f"{_text_cell(in_symbol(s['unit'], symbol))}"
             f"{_cell(s['mean'], '.4g')}"
-            f"{_cell(s['sd'], '.3g')}{_cell(s['hdi_low'], '.4g')}{_cell(s['hdi_high'], '.4g')}"
-            f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}"
+            f"{_cell(s['sd'], '.3g')}" + "".join(_cell(v, '.4g') for v in shown_hdi(s))
+            + f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}"
             f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
     return (f"<table>{_PARAMETER_HEAD}<th class='text'>flags</th></tr>{''.join(rows)}"
             "</table>")
@@ -495,7 +498,9 @@ def render_report(comparison, figures: dict | None = None) -> str:
         "<meta name='viewport' content='width=device-width, initial-scale=1'>\n"
         f"<title>{_e(title)}</title>\n<style>{CSS}</style>\n</head>\n<body>\n"
         f"<h1>{_e(title)}</h1>\n<p class='small'>bayesfo {_e(__version__)}, seed "
-        f"{_e(comparison.seed)}, ranked by {_e(comparison.ranked_by.replace('_', ' '))}.</p>\n"
+        f"{_e(comparison.seed)}, ranked by {_e(comparison.ranked_by.replace('_', ' '))}"
+        + (f"; {_e(comparison.noise_note)}" if getattr(comparison, "noise_note", None) else "")
+        + ".</p>\n"
         + "\n".join(sections) + "\n</body>\n</html>\n"
     )
 

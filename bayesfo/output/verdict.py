@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names
+from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names, shown_hdi
 from ..comparison.table import ORDER_SYMBOLS
 from ..data.symbols import in_symbol, parameter_label
 
@@ -274,8 +274,8 @@ def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
         if not _finite(s.get("median")):
             continue
         unit = f" {in_symbol(s['unit'], symbol)}" if s["unit"] else ""
-        hdi = (f" ({s['hdi_low']:.3g}–{s['hdi_high']:.3g})"
-               if _finite(s.get("hdi_low")) and _finite(s.get("hdi_high")) else "")
+        lo, hi = shown_hdi(s)
+        hdi = f" ({lo:.3g}–{hi:.3g})" if _finite(lo) and _finite(hi) else ""
         parts.append(f"{p} = {s['median']:.3g}{unit}{hdi}")
     out = []
     picture = "" if phys["picture"] == name else f" ({phys['picture']})"
@@ -307,6 +307,9 @@ def _noise_sentences(name, result) -> list[tuple[str, bool]]:
     others = [n for n in models if n != chosen]
     text = (f"Noise model of {name}: {chosen}, chosen by evidence over "
             f"{_join(others)} noise" + (f" (probability {p:.3f})." if p is not None else "."))
+    if "marginal" in record:
+        text += (" Its ln Z in the ranking is averaged over the noise models (equal prior "
+                 "weights), as every structure's is.")
     if not record["sensitive"]:
         return [(text, False)]
     parts = []

@@ -10,6 +10,7 @@ import pytest
 import bayesfo as bf
 from bayesfo.comparison.steps import NOISE_DECISIVE
 from bayesfo.data import FrequencyResponse
+from bayesfo.inference.evidence import Evidence
 from bayesfo.structures import get_structure
 
 OMEGA = np.logspace(np.log10(0.6), np.log10(300.0), 25)
@@ -54,8 +55,16 @@ def test_evidence_picks_the_noise_model_that_made_the_data(truth):
     other = ({"constant", "proportional"} - {truth}).pop()
     assert models["models"][truth]["log_evidence"] > models["models"][other]["log_evidence"] + 5
     assert "chosen by evidence" in record["noise_reason"]
-    # The reported ln Z is that of the chosen noise model.
-    assert record["log_evidence"] == pytest.approx(models["models"][truth]["log_evidence"])
+    # The reported ln Z treats the noise model as a nuisance: the mean of the two evidences
+    # (equal prior weights), ln Z of the decisive model - ln 2 up to its e^-5 share.
+    z = np.array([models["models"][n]["log_evidence"] for n in ("constant", "proportional")])
+    marginal = float(np.logaddexp(*z) - np.log(2.0))
+    assert record["log_evidence"] == pytest.approx(marginal, abs=1e-9)
+    assert models["marginal"]["log_evidence"] == record["log_evidence"]
+    assert models["marginal"]["prior"] == {"constant": 0.5, "proportional": 0.5}
+    assert abs(record["log_evidence"] - (z.max() - np.log(2.0))) < 0.01
+    ev = result.criteria.evidence
+    assert ev.given_noise.log_z == pytest.approx(models["models"][truth]["log_evidence"])
 
 
 def test_a_forced_or_stated_noise_model_is_not_second_guessed():
@@ -82,7 +91,8 @@ def test_noise_sensitive_when_the_intervals_part():
         structure = SimpleNamespace(parameters=[SimpleNamespace(name="q", role="exponent"),
                                                 SimpleNamespace(name="b0", role="coefficient")])
         lik = SimpleNamespace(noise=noise, structure=structure)
-        ev = SimpleNamespace(log_z=log_z, log_z_err=0.01, method="importance")
+        ev = Evidence(log_z=log_z, log_z_err=0.01, method="importance", log_support=0.0,
+                      n_likelihood=0, seconds=0.0)
         return NoiseRun(lik, post, {"evidence": ev, "warnings": []})
 
     import dataclasses
@@ -107,6 +117,13 @@ def test_noise_sensitive_when_the_intervals_part():
             1 / (1 + np.exp(-0.5)))
         assert bool(caught) is sensitive
         assert "chosen by evidence" in chosen.post.noise_reason
+        # The structure's evidence: the mean of the two (equal prior weights), its error
+        # from theirs weighted by their shares; the chosen model's own estimate kept.
+        ev = chosen.criteria["evidence"]
+        assert ev.log_z == pytest.approx(np.log((np.exp(-10.0) + np.exp(-10.5)) / 2))
+        p = 1 / (1 + np.exp(-0.5))
+        assert ev.log_z_err == pytest.approx(0.01 * np.hypot(p, 1 - p))
+        assert ev.given_noise.log_z == -10.0 and ev.conditional is ev.given_noise
 
 
 def test_q_coverage_with_half_a_decade_and_relative_noise():

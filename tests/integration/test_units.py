@@ -139,9 +139,15 @@ def test_the_parameters_block_is_unchanged_and_gains_units(zener_run):
     post = result["zener"].posterior
     units = {"a1": "s^q", "b0": "1/MPa", "b1": "s^q/MPa", "q": ""}
     for name, summary in post.summary.items():
-        # Keys are only ever added: whether the data determine the parameter.
-        assert s["parameters"][name] == summary.to_dict() | {
-            "unit": units[name], "not_determined": False, "not_determined_reason": None}
+        # Keys are only ever added: whether the data determine the parameter, and for a
+        # positive quantity with a unit the HDI on a log scale that this judges.
+        added = {"unit": units[name], "not_determined": False, "not_determined_reason": None}
+        if units[name]:
+            x = post.samples[:, post.param_names.index(name)]
+            lo, hi = hdi(np.log10(x), 0.94)
+            added |= {"hdi_log_low": pytest.approx(10 ** lo, rel=1e-12),
+                      "hdi_log_high": pytest.approx(10 ** hi, rel=1e-12)}
+        assert s["parameters"][name] == summary.to_dict() | added
     # For modulus data the other form is the card's compliance coefficients, the same numbers.
     other = s["parameters_other_form"]
     assert list(other) == ["a1", "b0", "b1", "q"]

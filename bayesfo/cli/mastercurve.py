@@ -23,7 +23,8 @@ def add_parser(subparsers):
                     "Gurp–Palmen), and write summary.json, master.csv (the reduced data, which "
                     "'bayesfo compare' reads), the joint posterior (STRUCTURE.nc, which "
                     "'bayesfo predict' and 'bayesfo export' read), report.html, "
-                    "figures/mastercurve.png and figures/van_gurp_palmen.png.")
+                    "figures/mastercurve.png, figures/residuals.png (each isotherm's misfit) "
+                    "and figures/van_gurp_palmen.png.")
     p.add_argument("data", nargs="+", metavar="DATA",
                    help="files of isotherms: a lab export with several (TRIOS steps, a "
                         "temperature column, pyvisco), or one file per temperature (the "
@@ -133,10 +134,11 @@ def run(args) -> int:
             from ..plotting.output import save_figure
 
             (stage / "figures").mkdir()
-            from ..plotting.mastercurve import plot_van_gurp_palmen
+            from ..plotting.mastercurve import plot_isotherm_residuals, plot_van_gurp_palmen
 
             figures = {}
             for name, plot in (("mastercurve", plot_mastercurve),
+                               ("residuals", plot_isotherm_residuals),
                                ("van_gurp_palmen", plot_van_gurp_palmen)):
                 figures[name] = stage / "figures" / f"{name}.png"
                 save_figure(plot(mc).figure, figures[name], close=True)
@@ -196,4 +198,5 @@ def _print(mc, out) -> None:
         print(f"note: {n}")
     print(f"wrote {out}/summary.json, master.csv, {mc.structure}.nc" + (
         "" if not (out / "figures").exists()
-        else ", report.html and figures/mastercurve.png, figures/van_gurp_palmen.png"))
+        else ", report.html and figures/mastercurve.png, figures/residuals.png, "
+             "figures/van_gurp_palmen.png"))

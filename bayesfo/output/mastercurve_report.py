@@ -18,6 +18,10 @@ CAPTIONS = {
                    "coloured by temperature, with the master function's posterior median and "
                    "94 % band; right: log10 a_T against temperature (94 % HDI) with the WLF "
                    "and Arrhenius laws.",
+    "residuals": "Relative residuals of the storage and loss parts of every isotherm under the "
+                 "joint fit (each posterior draw's own shifts), against the reduced frequency, "
+                 "coloured by temperature; right: each isotherm's rms relative residual, with "
+                 "the level above which an isotherm is named as missed.",
     "van_gurp_palmen": "Loss angle against the magnitude of every isotherm, without any shift: "
                        "the isotherms of a thermorheologically simple material fall on one "
                        "curve.",

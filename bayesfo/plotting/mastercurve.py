@@ -149,3 +149,85 @@ def plot_van_gurp_palmen(mc, *, ax=None) -> Drawn:
             title = "no overlap in |G*|: not tested"
         artists["title"] = ax.set_title(title, fontsize=8)
     return Drawn.build(fig, (ax,), values, artists)
+
+
+def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) -> Drawn:
+    """How well the joint fit describes each isotherm: the relative residuals of the storage
+    and loss parts, (data − model)/|model| in per cent, against a_T·ω (each draw's own
+    shifts; the model is the median over draws at each point), coloured by temperature; and
+    each isotherm's rms relative residual against temperature (``tts_checks["isotherm_fit"]``)
+    with the level above which an isotherm is named as missed
+    (:data:`~bayesfo.tts.joint.ISOTHERM_MISFIT` times the median isotherm's).
+
+    Returns
+    -------
+    Drawn
+        Axes: (storage, loss, rms). Values: per isotherm ``"<T>/omega_reduced"``,
+        ``"<T>/storage_pct"``, ``"<T>/loss_pct"``; ``"temperature"``, ``"rms_relative"``,
+        ``"misfit_level"``. Artists: ``"<T>/storage"``, ``"<T>/loss"``, ``"rms"``,
+        ``"level"``.
+    """
+    import matplotlib as mpl
+
+    from ..predictions.functions import _evaluate
+    from ..structures import get_structure
+    from ..tts.joint import ISOTHERM_MISFIT
+
+    fig = new_figure(fig, (11.0, 3.6))
+    axes = fig.subplots(1, 3)
+    modulus = mc.data.kind == "modulus"
+    symbols = parts_of(mc.data.symbol, mc.data.kind)
+    temps = np.asarray(mc.temperatures)
+    cmap = mpl.colormaps["coolwarm"]
+    norm = mpl.colors.Normalize(temps.min(), temps.max())
+    structure = mc.master if mc.master is not None else get_structure(mc.structure)
+    rng = np.random.default_rng(seed)
+    rows = rng.choice(mc.master_draws.shape[0], size=min(n_draws, mc.master_draws.shape[0]),
+                      replace=False)
+    theta = mc.master_draws[rows]
+    vertical = (None if getattr(mc, "vertical_draws", None) is None
+                else mc.vertical_draws[rows])
+    values, artists = {}, {}
+    for i, (d, t) in enumerate(zip(mc.isotherms, temps, strict=True)):
+        shifts = mc.shift_draws[rows, i]
+        w = d.omega[None, :] * 10.0 ** shifts[:, None]
+        quantity = ("storage", "loss") if modulus else ("storage_compliance", "loss_compliance")
+        parts = [_evaluate(structure, theta, q, w) for q in quantity]
+        if vertical is not None:  # the model of the isotherm: the master divided by b_T
+            scale = 10.0 ** (-vertical[:, i] if modulus else vertical[:, i])
+            parts = [p * scale[:, None] for p in parts]
+        storage, loss = (np.median(p, axis=0) for p in parts)
+        magnitude = np.hypot(storage, loss)
+        measured = (d.response.real, d.response.imag if modulus else -d.response.imag)
+        reduced = d.omega * 10.0 ** mc.log_shift_mean[i]
+        values[f"{t:g}/omega_reduced"] = reduced
+        for ax, name, data, model in zip(axes[:2], ("storage", "loss"), measured,
+                                         (storage, loss), strict=True):
+            pct = 100.0 * (data - model) / magnitude
+            values[f"{t:g}/{name}_pct"] = pct
+            (artists[f"{t:g}/{name}"],) = ax.semilogx(reduced, pct, "o-", ms=2.5, lw=0.6,
+                                                      color=cmap(norm(t)), alpha=0.85)
+    for ax, sym in zip(axes[:2], symbols, strict=True):
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xlabel(f"a_T ω [rad/s] (T_ref = {mc.reference_temperature:g} °C)")
+        ax.set_ylabel(f"{sym}: (data − model) / |model| [%]")
+    fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes[1], label="T [°C]")
+    fit = mc.tts_checks.get("isotherm_fit") or {}
+    ax = axes[2]
+    if fit.get("rms_relative"):
+        rms = 100.0 * np.asarray(fit["rms_relative"], dtype=float)
+        level = ISOTHERM_MISFIT * float(np.median(rms))
+        missed = set(fit.get("misfit") or ())
+        colours = ["#D55E00" if t in missed else "k" for t in fit["temperatures"]]
+        artists["rms"] = ax.scatter(fit["temperatures"], rms, c=colours, s=14, zorder=3)
+        artists["level"] = ax.axhline(level, color="#D55E00", ls="--", lw=0.9,
+                                      label=f"{ISOTHERM_MISFIT:g} × the median isotherm's")
+        ax.set_ylim(0.0, 1.1 * max(float(rms.max()), level))
+        ax.legend(loc="upper left", fontsize=7)
+        values.update(temperature=np.asarray(fit["temperatures"], dtype=float),
+                      rms_relative=rms / 100.0, misfit_level=level / 100.0)
+    ax.set_xlabel("T [°C]")
+    ax.set_ylabel("rms relative residual [%]")
+    ax.set_title("missed isotherms in red" if fit.get("misfit") else
+                 "no isotherm missed", fontsize=8)
+    return Drawn.build(fig, tuple(axes), values, artists)

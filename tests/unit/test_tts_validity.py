@@ -104,3 +104,48 @@ def test_the_van_gurp_palmen_figure_draws_every_isotherm_unshifted():
     import matplotlib.pyplot as plt
 
     plt.close(drawn.figure)
+
+
+def test_the_residual_figure_gives_each_isotherms_misfit_against_a_known_master():
+    """Isotherms made from a springpot master at known shifts: with the true parameters and
+    shifts as the 'posterior', the residuals are 0; an isotherm scaled by 1.1 has residuals
+    of exactly 10 % of each part over |G*| (closed form), and its rms is drawn as missed."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+
+    from bayesfo.plotting.mastercurve import plot_isotherm_residuals
+    from bayesfo.predictions import evaluate
+    from bayesfo.structures import get_structure
+
+    springpot = get_structure("springpot")
+    theta = np.array([2.0e5, 0.4])
+    temps = [0.0, 20.0, 40.0]
+    shifts = np.array([1.5, 0.0, -1.2])
+    data = []
+    for k, s in enumerate(shifts):
+        w = W * 10.0 ** s
+        g = evaluate(springpot, theta, "storage", w)[0] + 1j * evaluate(springpot, theta,
+                                                                          "loss", w)[0]
+        data.append(FrequencyResponse(W, g * (1.1 if k == 2 else 1.0), kind="modulus"))
+    draws = 50
+    mc = SimpleNamespace(
+        temperatures=tuple(temps), isotherms=tuple(data), data=data[0], master=springpot,
+        structure="springpot", reference_temperature=20.0,
+        master_draws=np.tile(theta, (draws, 1)), shift_draws=np.tile(shifts, (draws, 1)),
+        vertical_draws=None, log_shift_mean=shifts,
+        tts_checks={"isotherm_fit": {"temperatures": temps, "rms_relative": [0.01, 0.012, 0.1],
+                                     "misfit": [40.0]}})
+    drawn = plot_isotherm_residuals(mc)
+    for k, t in enumerate(temps):
+        g = data[k].response / (1.1 if k == 2 else 1.0)
+        for name, part in (("storage", g.real), ("loss", g.imag)):
+            expected = (10.0 if k == 2 else 0.0) * part / np.abs(g)
+            np.testing.assert_allclose(drawn.values[f"{t:g}/{name}_pct"], expected, atol=1e-9)
+            line = drawn.artists[f"{t:g}/{name}"]
+            np.testing.assert_allclose(line.get_xdata(), W * 10.0 ** shifts[k])
+    # the level: three times the median isotherm's rms
+    assert drawn.values["misfit_level"] == pytest.approx(3 * 0.012)
+    colours = drawn.artists["rms"].get_facecolors()
+    assert tuple(np.round(colours[2][:3], 3)) != tuple(np.round(colours[0][:3], 3))
+    plt.close(drawn.figure)

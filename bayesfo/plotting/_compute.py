@@ -13,6 +13,13 @@ import numpy as np
 
 from ..errors import InputError
 
+#: The ranking figure draws at most this many structures (the best by the ranking); the rest
+#: are named in a note under it (the report's table and ranking.csv hold every one).
+RANKING_SHOWN = 12
+#: The order figure draws the orders of at most this many structures (the best by the ranking
+#: among those with a free order); the rest are named under it.
+ORDER_STRUCTURES = 8
+
 #: Upper bound on the posterior draws pushed through the model for bands.
 N_DRAWS = 400
 #: Points of the dense frequency grid of response curves.

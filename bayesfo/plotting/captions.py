@@ -16,7 +16,12 @@ from __future__ import annotations
 import math
 import re
 
-from ._compute import NYQUIST_LOG_DECADES, magnitude_decades
+from ._compute import (
+    NYQUIST_LOG_DECADES,
+    ORDER_STRUCTURES,
+    RANKING_SHOWN,
+    magnitude_decades,
+)
 
 #: Convergence targets of the sampler (as :mod:`bayesfo.inference.results`).
 RHAT_TARGET = 1.01
@@ -115,7 +120,8 @@ def _combined_caption(name: str, comparison) -> str | None:
                 "evidence, the largest Pareto k̂ of PSIS-LOO right of the criteria (above "
                 f"{PARETO_K_WARN}: PSIS-LOO unreliable, open marker); red labels: posterior not "
                 "converged. WAIC is not shown: it estimates the same as PSIS-LOO without a "
-                "diagnostic of its own.")
+                f"diagnostic of its own. At most the best {RANKING_SHOWN} structures are "
+                "drawn; the rest are named under the figure and ranked in the table.")
     if name == "bode":
         return ("Magnitude and phase of the data (± 1 sd where σ is known) with each "
                 "structure's posterior median response (one line style per structure) and its "
@@ -146,7 +152,8 @@ def _combined_caption(name: str, comparison) -> str | None:
     if name == "q_posteriors":
         return ("Posterior density of the fractional order per structure (best on top), with "
                 "the prior (dashed), the 94 % HDI (bar) and the mean (tick); orders determined "
-                "too sharply to see at this scale are zoomed in an inset.")
+                "too sharply to see at this scale are zoomed in an inset; the orders of at "
+                f"most the best {ORDER_STRUCTURES} structures with a free order are drawn.")
     return None
 
 

@@ -7,7 +7,14 @@ import numpy as np
 
 from ..errors import InputError
 from ._base import Drawn, axes_or_new
-from ._compute import density_1d, ok_results, order_parameter, prior_density, prior_range
+from ._compute import (
+    ORDER_STRUCTURES,
+    density_1d,
+    ok_results,
+    order_parameter,
+    prior_density,
+    prior_range,
+)
 from .style import COLUMN_WIDTH, FLAG_COLOR, comparison_styles, style
 
 #: The prior of an order when the results do not state it (the cards' prior of q).
@@ -19,7 +26,8 @@ ZOOM_FRACTION = 0.06
 OUTLINE_FLOOR = 2e-3
 
 
-def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Drawn:
+def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85,
+                      limit: int | None = ORDER_STRUCTURES) -> Drawn:
     """Posterior density of every fractional order of every structure, one ridge per order.
 
     Structures are ordered as in the ranking (best on top); a structure's first order is
@@ -45,6 +53,9 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     ax : matplotlib.axes.Axes, optional
     ridge_height : float
         Height of the highest point of each ridge, in units of the ridge spacing.
+    limit : int or None
+        The orders of how many structures to draw, the best by the ranking (None: all); the
+        structures beyond are named under the axis (``values["not_shown"]``).
 
     Returns
     -------
@@ -72,11 +83,14 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
 
     # One ridge per fractional order: a structure's first order (q, else β, else α) under its
     # name, its other orders (the second springpot's) under "<name>:<order>".
+    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int)
+                              or limit < 1):
+        raise InputError(f"argument 'limit' must be a positive integer or None, got {limit!r}")
     results, keys = [], []
-    for r in ok_results(comparison):
+    with_orders = [r for r in ok_results(comparison) if order_parameter(r) is not None]
+    left = [] if limit is None else with_orders[limit:]
+    for r in with_orders[:limit]:
         first = order_parameter(r)
-        if first is None:
-            continue
         names = r.posterior.param_names if r.posterior is not None else r.structure.param_names
         for p in [first] + [k for k in order_parameters(names) if k != first]:
             results.append((r, p))
@@ -86,7 +100,7 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
                          "(q, beta or alpha)")
     styles = comparison_styles(comparison)
     n = len(results)
-    values, artists = {"structures": np.array(keys)}, {}
+    values, artists = {"structures": np.array(keys), "not_shown": [r.name for r in left]}, {}
     rows = []
     for i, (r, p) in enumerate(results):
         post = r.posterior
@@ -102,6 +116,7 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
     insets = []
     with style():
         row_height = 0.62 if any(tight) else 0.42
+        own_figure = ax is None
         fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 0.75 + row_height * n))
         text_at = blended_transform_factory(ax.transAxes, ax.transData)
         for i, (r, p, x, prior, _, grid, dens) in enumerate(rows):
@@ -152,11 +167,31 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85) -> Dra
         ax.set_xlim(x_lo, x_hi)
         ax.grid(axis="y", visible=False)
         others = sorted({p for _, p in results if p != "q"}, key=list(_ORDER_SYMBOLS).index)
-        ax.set_xlabel("fractional order" + (" $q$" if any(p == "q" for _, p in results) else "")
-                      + (" (" + ", ".join(f"${_ORDER_SYMBOLS[p]}$" for p in others)
-                         + " where named)" if others else "")
-                      + f"\nbar: {HDI_LABEL}, tick: mean; dashed: prior")
+        label = ("fractional order" + (" $q$" if any(p == "q" for _, p in results) else "")
+                 + (" (" + ", ".join(f"${_ORDER_SYMBOLS[p]}$" for p in others)
+                    + " where named)" if others else ""))
+        key_text = f"bar: {HDI_LABEL}, tick: mean; dashed: prior" + _not_shown(left)
+        if own_figure:
+            # Under the whole figure, centred on it: under the axes (pushed right by long
+            # structure names) a line this long would run past the figure's right edge.
+            ax.set_xlabel(label)
+            artists["key"] = fig.supxlabel(key_text, fontsize=ax.xaxis.label.get_fontsize())
+        else:
+            ax.set_xlabel(label + "\n" + key_text)
     return Drawn.build(fig, (ax, *insets), values, artists)
+
+
+def _not_shown(left) -> str:
+    """The lines naming the structures whose orders are not drawn ('' for none)."""
+    if not left:
+        return ""
+    import textwrap
+
+    names = ", ".join(r.name for r in left[:4]) + (f" and {len(left) - 4} more"
+                                                   if len(left) > 4 else "")
+    text = (f"not drawn: the orders of {len(left)} more structure"
+            f"{'s' if len(left) > 1 else ''} ({names}; in the report)")
+    return "\n" + "\n".join(textwrap.wrap(text, 50, break_on_hyphens=False))
 
 
 #: Symbols of the fractional orders (:data:`bayesfo.comparison.table.ORDER_PARAMS`).

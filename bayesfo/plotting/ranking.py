@@ -6,6 +6,7 @@ import numpy as np
 
 from ..errors import InputError
 from ._base import Drawn, new_figure
+from ._compute import RANKING_SHOWN
 from .style import COLUMN_WIDTH, FLAG_COLOR, comparison_styles, style
 
 #: Below this Δ (nats) the Δ axes switch to a symmetric-log scale, linear within ±SYMLOG_LINEAR.
@@ -23,6 +24,11 @@ PARETO_K_WARN = 0.7
 WAIC_NOTE = ("WAIC not shown: it estimates the same as PSIS-LOO, whose Pareto k̂\n"
              f"(right: largest per structure; > {PARETO_K_WARN:g}, open marker) says where "
              "LOO is unreliable")
+
+
+#: A structure whose ln Z trails the best by more than this many nats is listed in the note,
+#: not drawn: its tick labels (−10,000,000,000,000) would run together on the axis.
+HOPELESS_NATS = 1.0e6
 
 
 def _nan(v) -> float:
@@ -77,7 +83,47 @@ def _right_labels(ax, y, labels):
     return right
 
 
-def plot_ranking(comparison, fig=None) -> Drawn:
+def _split_rows(rows: list, limit: int | None) -> tuple[list, list, list]:
+    """The rows drawn, the rows left out for the limit, and the hopeless ones (Δln Z below
+    −:data:`HOPELESS_NATS`), each in the order of the ranking."""
+    hopeless = [r for r in rows if r.get("delta_log_evidence") is not None
+                and r["delta_log_evidence"] < -HOPELESS_NATS]
+    kept = [r for r in rows if r not in hopeless]
+    if limit is None:
+        return kept, [], hopeless
+    return kept[:limit], kept[limit:], hopeless
+
+
+def _not_shown_note(left: list, hopeless: list) -> str:
+    """What the figure leaves out, in words (empty when nothing)."""
+    import textwrap
+
+    def span(rows):
+        d = [r["delta_log_evidence"] for r in rows if r.get("delta_log_evidence") is not None]
+        if not d:
+            return ""
+        text = f"{max(d):,.3g}" + ("" if max(d) == min(d) else f" to {min(d):,.3g}")
+        return f" (Δln Z {text})".replace("-", "−")
+
+    def names(rows):
+        shown = ", ".join(r["structure"] for r in rows[:4])
+        return shown + (f" and {len(rows) - 4} more" if len(rows) > 4 else "")
+
+    parts = []
+    if left:
+        parts.append(f"{len(left)} more structure{'s' if len(left) > 1 else ''}{span(left)}: "
+                     f"{names(left)}")
+    if hopeless:
+        parts.append(f"{names(hopeless)}, ln Z over {HOPELESS_NATS:,.0f} nats below the best"
+                     f"{span(hopeless)}")
+    if not parts:
+        return ""
+    text = ("Not drawn: " + "; ".join(parts)
+            + "; every structure is in the report's ranking table and ranking.csv")
+    return "\n".join(textwrap.wrap(text, 68, break_on_hyphens=False))
+
+
+def plot_ranking(comparison, fig=None, *, limit: int | None = RANKING_SHOWN) -> Drawn:
     """The structures' log-evidence and information criteria relative to the best.
 
     Top: Δln Z ± its error (bridge sampling) to the structure with the highest ln Z, with the
@@ -98,11 +144,18 @@ def plot_ranking(comparison, fig=None) -> Drawn:
     variance warning on it fires for nearly every structure of real data, so a flag per
     structure would carry no information.
 
+    At most ``limit`` structures are drawn, the best by the ranking; those beyond, and any
+    whose ln Z trails the best by more than :data:`HOPELESS_NATS`, are named in a note under
+    the figure (``values["not_shown"]``), so that the figure stays readable for any number
+    of structures.
+
     Parameters
     ----------
     comparison : bayesfo.comparison.Comparison
     fig : matplotlib.figure.Figure, optional
         Empty figure to draw in; default a new single-column figure.
+    limit : int or None
+        How many structures to draw (None: every one but the hopeless).
 
     Returns
     -------
@@ -110,7 +163,8 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         ``axes`` = (evidence, criteria). ``values`` (one entry per ranked structure, top to
         bottom): ``"structures"``, ``"y"``, ``"delta_log_evidence"``, ``"log_evidence_err"``,
         ``"posterior_probability"``, ``"delta_loo"``, ``"delta_loo_se"``, ``"delta_aic_half"``,
-        ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing), ``"fits"``
+        ``"delta_bic_half"``, ``"converged"`` (NaN where a value is missing), ``"not_shown"``
+        (the structures named in the note instead, in the order of the ranking), ``"fits"``
         (``"yes"``, ``"partly"``, ``"small"``, ``"no"`` from the adequacy checks; labels say
         "misfit hidden by noise", "misfits the data" or "small misfit"), ``"pareto_k_max"``; ``"note"`` (why WAIC is not shown).
         ``artists``: ``"<name>/log_evidence"`` (``ErrorbarContainer``), one
@@ -127,6 +181,11 @@ def plot_ranking(comparison, fig=None) -> Drawn:
     rows = [row for row in comparison.table() if row.get("rank") is not None]
     if not rows:
         raise InputError("the comparison has no structure that ran")
+    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int)
+                              or limit < 1):
+        raise InputError(f"argument 'limit' must be a positive integer or None, got {limit!r}")
+    rows, left, hopeless = _split_rows(rows, limit)
+    left_out = _not_shown_note(left, hopeless)
     n = len(rows)
     names = [row["structure"] for row in rows]
     y = np.arange(n - 1, -1, -1, dtype=float)
@@ -144,12 +203,13 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         "converged": np.array([bool(r["converged"]) for r in rows]),
         "fits": np.array([r.get("fits") or "" for r in rows]),
         "pareto_k_max": np.array([_nan(r.get("pareto_k_max")) for r in rows]),
-        "note": WAIC_NOTE,
+        "note": WAIC_NOTE + ("\n" + left_out if left_out else ""),
+        "not_shown": [r["structure"] for r in left + hopeless],
     }
     styles = comparison_styles(comparison)
     artists = {}
     with style():
-        fig = new_figure(fig, (COLUMN_WIDTH, min(9.0, 1.45 + 0.52 * n)))
+        fig = new_figure(fig, (COLUMN_WIDTH, min(9.5, 1.45 + 0.62 * n)))
         ax_z, ax_c = fig.subplots(2, 1, sharey=True, height_ratios=[1, 1.15])
         for i, name in enumerate(names):
             dz = values["delta_log_evidence"][i]
@@ -187,10 +247,12 @@ def plot_ranking(comparison, fig=None) -> Drawn:
         _set_delta_scale(ax_c, np.concatenate([values[k] for k, *_ in CRITERIA]
                                               + [values["delta_loo"] + values["delta_loo_se"]]))
         ax_c.set_xlabel(r"$\Delta$ to the best [nats], higher is better")
-        artists["note"] = fig.supxlabel(WAIC_NOTE, fontsize=6.0, color="0.25")
+        artists["note"] = fig.supxlabel(values["note"], fontsize=6.0, color="0.25")
         # Posterior probabilities on the right of the evidence (the last axes of the figure).
         _right_labels(ax_z, y, [_format_p(p) for p in values["posterior_probability"]])
-        ax_c.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncols=3, borderaxespad=0.1,
+        # Right-aligned with the axes: their right edge stays inside the figure however long
+        # the structure names on the left are.
+        ax_c.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncols=3, borderaxespad=0.1,
                     handletextpad=0.3, columnspacing=0.8)
         for ax in (ax_z, ax_c):
             ax.set_ylim(-0.6, n - 0.4)

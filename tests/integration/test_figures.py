@@ -595,3 +595,68 @@ def test_every_order_of_a_two_springpot_model_gets_its_ridge():
         grid, dens = drawn.values[f"{key}/grid"], drawn.values[f"{key}/density"]
         mean = np.sum(grid * dens) / np.sum(dens)
         assert mean == pytest.approx(fkv.posterior.samples[:, column].mean(), abs=0.01)
+
+
+# ---------------------------------------------------------------------------------------------
+# Many structures: the ranking and the order figures stay readable
+
+
+def _many(n: int):
+    """A comparison of ``n`` Voigt-like results, ranked in order, the last hopeless."""
+    voigt = get_structure("voigt")
+    results, rows = [], []
+    for i in range(n):
+        name = f"structure-{i:02d}-with-a-long-name"
+        theta = [1.79, 1.66e-5, 0.3 + 0.6 * i / n]
+        results.append(_result(name, voigt, theta, rel_sd=0.01, seed=i))
+        delta = -1.3e13 if i == n - 1 else -2.5 * i
+        rows.append({"rank": i + 1, "structure": name, "delta_log_evidence": delta,
+                     "log_evidence_err": 0.05, "posterior_probability": 0.0 if i else 1.0,
+                     "delta_loo": -2.0 * i, "delta_loo_se": 0.5, "aic": 10.0 + 5 * i,
+                     "bic": 12.0 + 5 * i, "converged": True, "fits": "no",
+                     "pareto_k_max": 0.3})
+    comp = _Comparison(read(DEMO), tuple(results))
+    comp.rows = rows
+    return comp
+
+
+def test_fifty_structures_keep_the_ranking_and_order_figures_readable():
+    from bayesfo.plotting._compute import ORDER_STRUCTURES, RANKING_SHOWN
+
+    comp = _many(50)
+    drawn = plot_ranking(comp)
+    names = list(drawn.values["structures"])
+    assert names == [r["structure"] for r in comp.rows[:RANKING_SHOWN]]
+    # The rest, and the hopeless one, named under the figure rather than drawn.
+    assert list(drawn.values["not_shown"]) == [r["structure"] for r in comp.rows[RANKING_SHOWN:]]
+    note = drawn.artists["note"].get_text().replace("\n", " ")
+    assert f"{50 - RANKING_SHOWN - 1} more structures (Δln Z −30 to −120)" in note
+    assert ("structure-49-with-a-long-name, ln Z over 1,000,000 nats below the best (Δln Z "
+            "−1.3e+13)") in note
+    fig = drawn.figure
+    renderer = _draw(fig)
+    _assert_nothing_clipped(fig, renderer)
+    for ax in drawn.axes:
+        labels = _boxes(ax.get_yticklabels(), renderer)
+        assert len(labels) == RANKING_SHOWN
+        for i, a in enumerate(labels):
+            assert all(_overlap(a, b) < 1.0 for b in labels[i + 1:]), "tick labels overlap"
+    # The Δ axis spans the drawn structures, not the hopeless one.
+    assert drawn.axes[0].get_xlim()[0] > -1e3
+
+    q = plot_q_posteriors(comp)
+    assert len(q.values["structures"]) == ORDER_STRUCTURES
+    assert list(q.values["not_shown"]) == [r.name for r in comp.results[ORDER_STRUCTURES:]]
+    fig = q.figure
+    renderer = _draw(fig)
+    _assert_nothing_clipped(fig, renderer)
+    assert fig.get_size_inches()[1] < 8.0
+    labels = _boxes(q.axes[0].get_yticklabels(), renderer)
+    for i, a in enumerate(labels):
+        assert all(_overlap(a, b) < 1.0 for b in labels[i + 1:]), "tick labels overlap"
+    # All of them, when asked.
+    every = plot_ranking(comp, limit=None)
+    assert len(every.values["structures"]) == 49 and list(every.values["not_shown"]) == [
+        "structure-49-with-a-long-name"]
+    with pytest.raises(InputError, match="limit"):
+        plot_ranking(comp, limit=0)

@@ -128,7 +128,8 @@ def summary_rows(summary: dict) -> list[dict]:
     the rows of ``Comparison.table`` and ``ranking.csv``), with what a batch adds: whether it
     is the best, the order parameter's HDI and MAP, the noise model, the data's kind and size
     and the warnings."""
-    from ..comparison.table import order_parameter, ranking_rows
+    from ..comparison.parameters import natural_block
+    from ..comparison.table import order_parameter, order_parameters, ranking_rows
 
     structures = {s["name"]: s for s in summary["structures"]}
     ranking = list(summary.get("ranking", []))
@@ -153,9 +154,25 @@ def summary_rows(summary: dict) -> list[dict]:
                    warnings="; ".join(s.get("warnings", [])),
                    # For the terminal table (not columns of batch_summary.csv): whether the
                    # structure describes the data, and every order by its symbol.
-                   fits=table_row.get("fits"), orders=table_row.get("orders") or "")
+                   fits=table_row.get("fits"), orders=table_row.get("orders") or "",
+                   # and for the figures, every order of the natural form (as ``orders``).
+                   order_summaries=_order_summaries(s, natural_block, order_parameters))
         rows.append(row)
     return rows
+
+
+def _order_summaries(s: dict, natural_block, order_parameters) -> dict:
+    """``{order: {"mean", "hdi_low", "hdi_high"}}`` of every fractional order of a structure
+    record in the form natural to the data (none for an integer structure)."""
+    if s.get("integer"):
+        return {}
+    block = natural_block(s)
+    out = {}
+    for k in order_parameters(block):
+        p = block[k] or {}
+        if all(p.get(f) is not None for f in ("mean", "hdi_low", "hdi_high")):
+            out[k] = {f: p[f] for f in ("mean", "hdi_low", "hdi_high")}
+    return out
 
 
 def _dataset_rows(ds: DataSet, status: str, error: str | None, rows=()) -> tuple:
@@ -188,7 +205,10 @@ def temperature_rows(rows) -> list[dict]:
         if r.get("status") != OK or r.get("temperature_C") is None or r.get("rank") is None:
             continue
         out.append({k: r.get(k) for k in TEMPERATURE_FIELDS if k in r}
-                   | {"best_structure": best.get(r["dataset"])})
+                   | {"best_structure": best.get(r["dataset"])}
+                   # every order, for the figure (not a column of the csv)
+                   | ({"order_summaries": r["order_summaries"]} if "order_summaries" in r
+                      else {}))
     return sorted(out, key=lambda r: (r["temperature_C"], r["dataset"], r["rank"]))
 
 

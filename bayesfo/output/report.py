@@ -481,16 +481,20 @@ def render_report(comparison, figures: dict | None = None) -> str:
     title = f"bayesfo: which structure do the data '{comparison.data.label}' support?"
     sentences = "".join(f"<p class='flag'>{_e(t)}</p>" if flagged else f"<p>{_e(t)}</p>"
                         for t, flagged in verdict(comparison))
+    # What a reader looks for first comes first: the verdict, the ranking, the figures; the
+    # numbers behind them (parameters, priors, diagnostics) after.
     sections = [
         f"<div class='verdict' id='verdict'>{sentences}</div>",
         f"<h2 id='data'>Data</h2>{_data_section(comparison)}",
         f"<h2 id='ranking'>Ranking</h2>{_ranking_table(comparison)}{_families(comparison)}",
-        f"<h2 id='priors'>Priors</h2>{_priors_section(comparison)}",
-        f"<h2 id='parameters'>Parameters</h2>{_parameters_section(comparison)}",
-        f"<h2 id='diagnostics'>Warnings and convergence</h2>{_diagnostics_section(comparison)}",
     ]
     if figures:
         sections.append(f"<h2 id='figures'>Figures</h2>{_figures_section(figures, comparison)}")
+    sections += [
+        f"<h2 id='parameters'>Parameters</h2>{_parameters_section(comparison)}",
+        f"<h2 id='priors'>Priors</h2>{_priors_section(comparison)}",
+        f"<h2 id='diagnostics'>Warnings and convergence</h2>{_diagnostics_section(comparison)}",
+    ]
     from .. import __version__
 
     return (

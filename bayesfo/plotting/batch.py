@@ -53,17 +53,54 @@ def _has_q(row) -> bool:
     return all(row.get(k) is not None for k in ("q_mean", "q_hdi_low", "q_hdi_high"))
 
 
-def _q_errorbar(ax, x, rows, st, filled_mask):
-    """q means with HDI bars in the style ``st`` of the structure; filled markers where
-    ``filled_mask`` (the best structure), a cross where the posterior did not converge."""
-    mean = np.array([r["q_mean"] for r in rows], dtype=float)
-    low = np.array([r["q_hdi_low"] for r in rows], dtype=float)
-    high = np.array([r["q_hdi_high"] for r in rows], dtype=float)
+#: Markers of a structure's second and further orders (its first has the structure's marker).
+ORDER_MARKERS = ("D", "v", "P", "X")
+
+
+def _order_series(rows, name: str, marker: str) -> list[tuple]:
+    """Every fractional order of structure ``name`` across the rows: ``(label, marker, rows,
+    mean, low, high)`` per order, from the rows' ``order_summaries`` (every order, as the
+    batch's table gives them) or, for rows read back from ``batch_summary.csv``, its one
+    ``q_*`` columns. The first order has the structure's marker, the others
+    :data:`ORDER_MARKERS`; the label names the order by its symbol unless it is a plain q."""
+    from ..comparison.table import ORDER_SYMBOLS
+
+    sel = [r for r in rows if r.get("structure") == name]
+    keys = list(dict.fromkeys(k for r in sel for k in (r.get("order_summaries") or {})))
+    if keys:
+        found = [(k, [r for r in sel if k in (r.get("order_summaries") or {})]) for k in keys]
+        stats = [[[r["order_summaries"][k][f] for r in rs] for f in ("mean", "hdi_low",
+                                                                     "hdi_high")]
+                 for k, rs in found]
+    else:
+        rs = [r for r in sel if _has_q(r)]
+        if not rs:
+            return []
+        found = [(rs[0].get("q_parameter") or "q", rs)]
+        stats = [[[r[f] for r in rs] for f in ("q_mean", "q_hdi_low", "q_hdi_high")]]
+    out = []
+    for i, ((k, rs), (mean, low, high)) in enumerate(zip(found, stats, strict=True)):
+        label = name if (k == "q" and len(found) == 1) else f"{name} ({ORDER_SYMBOLS.get(k, k)})"
+        out.append((label, marker if i == 0 else ORDER_MARKERS[(i - 1) % len(ORDER_MARKERS)],
+                    rs, *(np.asarray(v, dtype=float) for v in (mean, low, high))))
+    return out
+
+
+def _q_errorbar(ax, x, rows, st, filled_mask, series=None):
+    """Order means with HDI bars in the colour of the structure's style ``st`` (``series``:
+    one of :func:`_order_series`; default the rows' q columns with the style's marker);
+    filled markers where ``filled_mask`` (the best structure), a cross where the posterior
+    did not converge."""
+    if series is None:
+        series = (None, st.marker, rows,
+                  *(np.array([r[k] for r in rows], dtype=float)
+                    for k in ("q_mean", "q_hdi_low", "q_hdi_high")))
+    _, marker, rows, mean, low, high = series
     yerr = np.vstack([np.clip(mean - low, 0, None), np.clip(high - mean, 0, None)])
     ax.errorbar(x, mean, yerr=yerr, fmt="none", ecolor=st.color, elinewidth=1.2, capsize=2.5)
     filled = np.asarray(filled_mask, dtype=bool)
-    ax.plot(x[filled], mean[filled], st.marker, color=st.color, markersize=6, linestyle="none")
-    ax.plot(x[~filled], mean[~filled], st.marker, markerfacecolor="white", color=st.color,
+    ax.plot(x[filled], mean[filled], marker, color=st.color, markersize=6, linestyle="none")
+    ax.plot(x[~filled], mean[~filled], marker, markerfacecolor="white", color=st.color,
             markersize=6, linestyle="none")
     unconverged = np.array([r.get("converged") is False for r in rows], dtype=bool)
     if unconverged.any():
@@ -71,13 +108,15 @@ def _q_errorbar(ax, x, rows, st, filled_mask):
                 linestyle="none")
 
 
-def _q_legend(ax, labels, styles, **kwargs):
-    """One entry per structure, and what filled and hollow markers mean (``ax`` may be the
-    figure: a legend beside the axes)."""
+def _q_legend(ax, labels, styles, markers=None, **kwargs):
+    """One entry per structure's order (``markers``: of each entry, default the styles'), and
+    what filled and hollow markers mean (``ax`` may be the figure: a legend beside the
+    axes)."""
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], marker=st.marker, color=st.color, linestyle="none", markersize=6)
-               for st in styles]
+    markers = markers or [st.marker for st in styles]
+    handles = [Line2D([], [], marker=m, color=st.color, linestyle="none", markersize=6)
+               for st, m in zip(styles, markers, strict=True)]
     handles += [Line2D([], [], marker="o", color="0.3", linestyle="none", markersize=6),
                 Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
                        linestyle="none", markersize=6),
@@ -86,15 +125,30 @@ def _q_legend(ax, labels, styles, **kwargs):
                      frameon=False, **kwargs)
 
 
+def _common_prefix(names: list[str]) -> str:
+    """The start every name shares, up to and including its last separator (``-``, ``_``,
+    space, ``:``, ``/``); empty for one name or none shared."""
+    import os
+
+    if len(names) < 2:
+        return ""
+    common = os.path.commonprefix(names)
+    cut = max(common.rfind(c) for c in "-_ :/")
+    return common[:cut + 1] if cut >= 0 and all(len(n) > cut + 1 for n in names) else ""
+
+
 def plot_batch_summary(rows, structures=None, fig=None):
-    """Best structure and posterior q per data set.
+    """Best structure and posterior orders per data set.
 
     Top: the posterior model probabilities of the structures on each data set, stacked (equal
-    prior odds; the name of the best structure above each bar). Bottom: the posterior mean of
-    q (``beta`` for the generalised Maxwell model) with its 94 % HDI for every fractional
-    structure, filled where the structure is the best on that data set, crossed where its
-    posterior did not converge. Data sets that failed are marked on the axis. Data sets are in
-    the order given, or in order of temperature when every one has a temperature.
+    prior odds; the legend names the structures by colour and hatch, and up to eight data sets
+    the name of the best is written above its bar). Bottom: the posterior mean of every
+    fractional order of every fractional structure (q; α, β, δ by symbol where a structure
+    has several) with its 94 % HDI, filled where the structure is the best on that data set,
+    crossed where its posterior did not converge. Data sets that failed are marked on the
+    axis; the start all their names share is said once under the axis, not repeated in every
+    label. Data sets are in the order given, or in order of temperature when every one has a
+    temperature.
 
     Parameters
     ----------
@@ -135,54 +189,58 @@ def plot_batch_summary(rows, structures=None, fig=None):
         ax_p.bar(x, p, bottom=bottom, color=st.color, width=0.75, label=name,
                  hatch=HATCHES.get(st.linestyle, ""), edgecolor="white", linewidth=0.4)
         bottom += p
-    for r in rows:
-        if r.get("best"):
-            ax_p.annotate(r["structure"], (index[r["dataset"]], 1.0), xytext=(0, 3),
-                          textcoords="offset points", ha="center", va="bottom", fontsize=7,
-                          rotation=90 if n > 8 else 0)
+    if n <= 8:  # beyond, the names would run into each other (and vertical, into the title)
+        for r in rows:
+            if r.get("best"):
+                ax_p.annotate(r["structure"], (index[r["dataset"]], 1.0), xytext=(0, 3),
+                              textcoords="offset points", ha="center", va="bottom", fontsize=7)
     for d in failed:
         ax_p.annotate("failed", (index[d], 0.5), ha="center", va="center", fontsize=7,
                       color="tab:red", rotation=90)
-    ax_p.set_ylim(0, 1.3 if n > 8 else 1.15)
+    ax_p.set_ylim(0, 1.15 if n <= 8 else 1.02)
     ax_p.set_yticks([0, 0.5, 1])
     ax_p.set_ylabel("posterior probability")
-    ax_p.set_title("Best structure (equal prior odds) and posterior of q per data set",
-                   fontsize=10)
+    ax_p.set_title("Best structure (equal prior odds) and posterior of the fractional orders "
+                   "per data set", fontsize=10)
 
-    with_q = [s for s in structures if any(r.get("structure") == s and _has_q(r) for r in rows)]
+    series = [(name, sr) for name in structures
+              for sr in _order_series(rows, name, styles[name].marker)]
     width = 0.6
-    offsets = (np.linspace(-width / 2, width / 2, len(with_q)) if len(with_q) > 1
-               else np.zeros(len(with_q)))
-    labels = []
-    for name, off in zip(with_q, offsets):
-        sel = [r for r in rows if r.get("structure") == name and _has_q(r)]
-        xs = np.array([index[r["dataset"]] + off for r in sel])
-        qname = sel[0].get("q_parameter") or "q"
-        labels.append(name if qname == "q" else f"{name} ({qname})")
-        _q_errorbar(ax_q, xs, sel, styles[name], [bool(r.get("best")) for r in sel])
-    ax_q.set_ylabel(f"q: posterior mean, {HDI_LABEL}")
+    offsets = (np.linspace(-width / 2, width / 2, len(series)) if len(series) > 1
+               else np.zeros(len(series)))
+    for (name, sr), off in zip(series, offsets):
+        xs = np.array([index[r["dataset"]] + off for r in sr[2]])
+        _q_errorbar(ax_q, xs, sr[2], styles[name], [bool(r.get("best")) for r in sr[2]], sr)
+    ax_q.set_ylabel(f"order: posterior mean, {HDI_LABEL}")
+    prefix = _common_prefix(datasets)
     ax_q.set_xticks(x)
-    ax_q.set_xticklabels([d + (" (failed)" if d in failed else "") for d in datasets],
+    ax_q.set_xticklabels([d[len(prefix):] + (" (failed)" if d in failed else "")
+                          for d in datasets],
                          rotation=45 if n > 4 else 0, ha="right" if n > 4 else "center",
                          fontsize=8)
+    if prefix:
+        ax_q.set_xlabel(f"data set ({prefix}…)")
     for label, d in zip(ax_q.get_xticklabels(), datasets):
         if d in failed:
             label.set_color("tab:red")
     handles = [ax_p.containers[i] for i in range(len(structures))]
     fig.legend(handles, structures, loc="outside right upper", fontsize=8, frameon=False,
                title="structure", title_fontsize=8)
-    if with_q:
-        _q_legend(fig, labels, [styles[s] for s in with_q], fontsize=7,
-                  loc="outside right lower", title="q of", title_fontsize=8)
+    if series:
+        _q_legend(fig, [sr[0] for _, sr in series], [styles[name] for name, _ in series],
+                  [sr[1] for _, sr in series], fontsize=7, loc="outside right lower",
+                  title="order of", title_fontsize=8)
     ax_q.set_xlim(-0.7, n - 0.3)
     return fig
 
 
 def plot_q_temperature(rows, structures=None, fig=None):
-    """Posterior q against temperature per structure, and the best structure per temperature.
+    """Posterior orders against temperature per structure, and the best structure per
+    temperature.
 
-    Top: the posterior mean of q (``beta`` for the generalised Maxwell model) with its 94 % HDI
-    against temperature, one colour per structure, filled where the structure is the best at
+    Top: the posterior mean of every fractional order of every structure (q; α, β, δ by
+    symbol where a structure has several; the rows' ``order_summaries``, else their ``q_*``
+    columns) with its 94 % HDI against temperature, one colour per structure, filled where the structure is the best at
     that temperature, crossed where its posterior did not converge. Bottom: the posterior
     probability of each structure against temperature (equal prior odds), so the best structure
     per temperature is the top curve. With a single temperature the axis is
@@ -210,28 +268,27 @@ def plot_q_temperature(rows, structures=None, fig=None):
     temps = sorted({float(r["temperature_C"]) for r in rows})
     one = len(temps) == 1
     span = (temps[-1] - temps[0]) if not one else ONE_TEMPERATURE_WIDTH
-    with_q = [s for s in structures if any(r.get("structure") == s and _has_q(r) for r in rows)]
+    by_t = sorted(rows, key=lambda r: float(r["temperature_C"]))
+    series = [(name, sr) for name in structures
+              for sr in _order_series(by_t, name, styles[name].marker)]
     # Points of the structures side by side at each temperature: wider apart on the axis of a
     # single temperature, where nothing else needs the room.
     spread = 0.08 if one else 0.006
-    offsets = (np.linspace(-spread, spread, len(with_q)) * span if len(with_q) > 1
-               else np.zeros(len(with_q)))
-    labels = []
-    for name, off in zip(with_q, offsets):
-        sel = sorted((r for r in rows if r.get("structure") == name and _has_q(r)),
-                     key=lambda r: r["temperature_C"])
+    offsets = (np.linspace(-spread, spread, len(series)) * span if len(series) > 1
+               else np.zeros(len(series)))
+    for (name, sr), off in zip(series, offsets):
+        sel = sr[2]
         t = np.array([float(r["temperature_C"]) for r in sel]) + off
         st = styles[name]
         if len(sel) > 1:
-            ax_q.plot(t, [r["q_mean"] for r in sel], color=st.color, linestyle=st.linestyle,
-                      linewidth=0.8, alpha=0.6)
-        qname = sel[0].get("q_parameter") or "q"
-        labels.append(name if qname == "q" else f"{name} ({qname})")
-        _q_errorbar(ax_q, t, sel, st, [bool(r.get("best")) for r in sel])
-    ax_q.set_ylabel(f"q: posterior mean, {HDI_LABEL}")
-    if with_q:
-        _q_legend(fig, labels, [styles[s] for s in with_q], fontsize=8,
-                  loc="outside right upper", title="q of", title_fontsize=8)
+            ax_q.plot(t, sr[3], color=st.color, linestyle=st.linestyle, linewidth=0.8,
+                      alpha=0.6)
+        _q_errorbar(ax_q, t, sel, st, [bool(r.get("best")) for r in sel], sr)
+    ax_q.set_ylabel(f"order: posterior mean, {HDI_LABEL}")
+    if series:
+        _q_legend(fig, [sr[0] for _, sr in series], [styles[name] for name, _ in series],
+                  [sr[1] for _, sr in series], fontsize=8, loc="outside right upper",
+                  title="order of", title_fontsize=8)
     ax_q.set_title("Posterior of the fractional order against temperature", fontsize=10)
 
     # At a single temperature the probabilities sit side by side too.

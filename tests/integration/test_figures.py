@@ -660,3 +660,49 @@ def test_fifty_structures_keep_the_ranking_and_order_figures_readable():
         "structure-49-with-a-long-name"]
     with pytest.raises(InputError, match="limit"):
         plot_ranking(comp, limit=0)
+
+
+def test_batch_figures_give_every_order_and_name_the_data_sets_once():
+    # 20 isotherms of one file: the ids share the file's stem, said once under the axis; the
+    # two-springpot model's α and β each drawn; no structure name written over the bars.
+    temps = list(range(-40, 160, 10))
+    ids = [f"test_frequency_sweep_tts_ARES-T{'m' if t < 0 else 'p'}{abs(t):03d}C" for t in temps]
+    rows = []
+    for d, t in zip(ids, temps, strict=True):
+        a, b = 0.6 + 0.001 * t, 0.1 + 0.0005 * t
+        rows.append({"dataset": d, "temperature_C": float(t), "status": "ok",
+                     "structure": "fractional_kelvin_voigt", "rank": 1, "best": True,
+                     "posterior_probability": 0.9, "converged": True, "q_parameter": "beta",
+                     "q_mean": b, "q_hdi_low": b - 0.01, "q_hdi_high": b + 0.01,
+                     "order_summaries": {"alpha": {"mean": a, "hdi_low": a - 0.02,
+                                                   "hdi_high": a + 0.02},
+                                         "beta": {"mean": b, "hdi_low": b - 0.01,
+                                                  "hdi_high": b + 0.01}}})
+        rows.append({"dataset": d, "temperature_C": float(t), "status": "ok",
+                     "structure": "zener", "rank": 2, "best": False,
+                     "posterior_probability": 0.1, "converged": True, "q_parameter": "q",
+                     "q_mean": 0.5, "q_hdi_low": 0.48, "q_hdi_high": 0.52,
+                     "order_summaries": {"q": {"mean": 0.5, "hdi_low": 0.48,
+                                               "hdi_high": 0.52}}})
+    fig = plot_batch_summary(rows, ["zener", "fractional_kelvin_voigt"])
+    renderer = _draw(fig)
+    ax_p, ax_q = fig.axes[:2]
+    assert [t.get_text() for t in ax_q.get_xticklabels()] == [d.split("-")[-1] for d in ids]
+    assert ax_q.get_xlabel() == "data set (test_frequency_sweep_tts_ARES-…)"
+    legend = [t.get_text() for t in fig.legends[-1].get_texts()]
+    assert legend[:3] == ["zener", "fractional_kelvin_voigt (α)", "fractional_kelvin_voigt (β)"]
+    # α's means at every data set, in order of temperature
+    means = sorted({round(float(y), 6) for line in ax_q.get_lines()
+                    for y in np.atleast_1d(line.get_ydata())})
+    for t in temps:
+        assert round(0.6 + 0.001 * t, 6) in means and round(0.1 + 0.0005 * t, 6) in means
+    assert not ax_p.texts  # no names over the bars of 20 data sets
+    title = ax_p.title.get_window_extent(renderer)
+    for text in fig.findobj(matplotlib.text.Text):
+        if text is not ax_p.title and text.get_visible() and text.get_text():
+            assert _overlap(text.get_window_extent(renderer), title) < 1.0, text.get_text()
+    _assert_nothing_clipped(fig, renderer)
+    # The temperature figure: both orders against temperature too.
+    fig = plot_q_temperature(rows, ["zener", "fractional_kelvin_voigt"])
+    legend = [t.get_text() for t in fig.legends[-1].get_texts()]
+    assert "fractional_kelvin_voigt (α)" in legend and "fractional_kelvin_voigt (β)" in legend

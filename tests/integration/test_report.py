@@ -189,6 +189,14 @@ def test_figures_are_embedded_and_nothing_is_external(comparison, figures):
     assert "<script" not in text and "<link" not in text
 
 
+def test_sections_come_in_the_order_a_reader_needs_them(comparison, figures):
+    # Verdict (adequacy first), ranking, figures; then parameters, priors and diagnostics.
+    text = render_report(comparison, figures)
+    ids = ["verdict", "data", "ranking", "figures", "parameters", "priors", "diagnostics"]
+    at = [text.index(f"id='{i}'") for i in ids]
+    assert at == sorted(at)
+
+
 def test_text_is_escaped(comparison):
     data = replace(comparison.data, name="<b>bold & 'quoted'</b>")
     text = render_report(replace(comparison, data=data))

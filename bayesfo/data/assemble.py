@@ -12,7 +12,7 @@ import numpy as np
 from .._io import show
 from ..errors import InputError
 from .columns import Choice, Column
-from .csv_reader import MAX_FREQUENCIES, _from_columns, _too_many
+from .csv_reader import DUPLICATE_ADVICE, MAX_FREQUENCIES, _from_columns, _too_many
 from .frequency_response import FREQUENCY_RTOL
 from .reading import Isotherm, Reading
 from .tables import Table, number_like, to_number
@@ -361,10 +361,7 @@ def _duplicates(values, omega, lines, extra, how, where, fcol, kind):
         raise InputError(
             f"{where}, line {lines[g[1]]}, column '{fcol}': the frequency {shown} "
             f"repeats line {lines[g[0]]} ({sum(len(d) - 1 for d in dups)} repeated row(s) in "
-            "all); several sweeps in one table, or overlapping isotherms of a master curve? "
-            "Split them with a block or temperature column (--columns block=NAME), or keep the "
-            "first row of each frequency with duplicates='first' (--duplicates first) or "
-            "average them with duplicates='mean'")
+            f"all); {DUPLICATE_ADVICE}")
     firsts = np.array(sorted(g[0] for g in groups))
     dropped = [int(lines[i]) for g in dups for i in g[1:]]
     if how == "first":

@@ -446,6 +446,15 @@ def _check_rows(bad: np.ndarray, where: str, linenos, col: str, message: str, va
         raise InputError(f"{where}, line {linenos[idx[0]]}, column '{col}': {message}")
 
 
+#: What to do about rows that repeat a frequency: the one piece of advice of every reader.
+DUPLICATE_ADVICE = (
+    "several sweeps in one table, replicate measurements, or overlapping isotherms of a "
+    "master curve? Split them with a block or temperature column (--columns block=NAME; "
+    "replicates in a bayesfo CSV: a 'series' column, averaged per frequency), or keep the "
+    "first row of each frequency with duplicates='first' (--duplicates first) or average them "
+    "with duplicates='mean'")
+
+
 def _check_duplicates(omega, linenos, where: str, col: str) -> None:
     order = np.argsort(omega, kind="stable")
     w = omega[order]
@@ -453,8 +462,8 @@ def _check_duplicates(omega, linenos, where: str, col: str) -> None:
     if dup.size:
         a, b = sorted((linenos[order[dup[0]]], linenos[order[dup[0] + 1]]))
         raise InputError(
-            f"{where}, line {b}, column '{col}': duplicate frequency (same as line {a}); "
-            "mark replicate measurements with a 'series' column"
+            f"{where}, line {b}, column '{col}': the frequency {w[dup[0]]:g} rad/s repeats "
+            f"line {a} ({dup.size} repeated row(s) in all); {DUPLICATE_ADVICE}"
         )
 
 

@@ -279,7 +279,10 @@ def read_isotherms(path: str | os.PathLike, *, kind: str | None = None,
                           for sheet, sets in per_sheet for iso in sets])
     text, encoding = decode(path, MAX_FILE_BYTES)
     lines_text = split_lines(text)
-    if not mapping and delimiter is None and decimal is None and _is_contract(lines_text, where):
+    # A bayesfo CSV is read by the contract's reader, which refuses repeated frequencies; asked
+    # to keep the first or average them, the general reader takes it (it knows its columns).
+    if (not mapping and delimiter is None and decimal is None and duplicates == "error"
+            and _is_contract(lines_text, where)):
         return [_contract(path, kind, units, name, lines_text)]
     lines, delim = split_file(lines_text, where, delimiter=delimiter)
     return _renumber(_read_lines(path, where, lines, DELIMITERS[delim], encoding, decimal,

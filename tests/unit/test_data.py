@@ -174,11 +174,11 @@ BAD_CSV = [
     ("omega,real,imag\n1,1,1\n2,inf,1\n", "line 3, column 'real': value is inf"),
     ("omega,real,imag\n1,1,1\n0,1,1\n", "line 3, column 'omega': frequency must be positive"),
     ("freq,real,imag\n-1,1,1\n", "line 2, column 'freq': frequency must be positive"),
-    ("omega,real,imag\n1,1,1\n2,1,1\n1,3,3\n", "line 4, column 'omega': duplicate frequency \\(same as line 2\\)"),
+    ("omega,real,imag\n1,1,1\n2,1,1\n1,3,3\n", "line 4, column 'omega': the frequency 1 rad/s repeats line 2"),
     ("omega,real,imag\n1,1,1\n2,1\n", "line 3: expected 3 cells"),
     ("omega,magnitude,phase_deg\n1,-1,0\n", "line 2, column 'magnitude': magnitude is negative"),
     ("omega,real,imag,sigma\n1,1,1,0\n", "line 2, column 'sigma': sigma must be positive"),
-    ("omega,real,imag,series\n1,1,1,1\n1,1,1,1\n", "line 3, column 'omega': duplicate frequency"),
+    ("omega,real,imag,series\n1,1,1,1\n1,1,1,1\n", "line 3, column 'omega': the frequency 1 rad/s repeats line 2"),
     ("# kind: viscous\nomega,real,imag\n1,1,1\n", "kind must be one of"),
 ]
 

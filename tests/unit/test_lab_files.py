@@ -750,3 +750,27 @@ def test_a_sheet_of_numbers_without_a_frequency_is_left_out_beside_the_data(tmp_
     book.save(path)
     with pytest.raises(InputError, match="sheet 'Data header'"):
         read_isotherms(path)
+
+
+def test_repeated_frequencies_get_one_piece_of_advice_from_every_reader(tmp_path):
+    from bayesfo.data.csv_reader import DUPLICATE_ADVICE
+
+    contract = tmp_path / "contract.csv"
+    contract.write_text("# kind: modulus\n# units: Pa\nomega,storage,loss\n1,100,30\n2,150,40\n"
+                        "1,80,35\n", encoding="utf-8")
+    lab = tmp_path / "lab.txt"
+    lab.write_text("Angular frequency (rad/s)\tStorage modulus (Pa)\tLoss modulus (Pa)\n"
+                   "1\t100\t30\n2\t150\t40\n1\t80\t35\n", encoding="utf-8")
+    for path, line in ((contract, 6), (lab, 4)):
+        with pytest.raises(InputError) as info:
+            read(path)
+        message = str(info.value)
+        assert f"line {line}, column" in message and "the frequency 1 rad/s repeats" in message
+        assert message.endswith(DUPLICATE_ADVICE)
+    # ... and --duplicates works on both: the contract file read as the lab file is.
+    for how, storage, loss in (("first", [100.0, 150.0], [30.0, 40.0]),
+                               ("mean", [90.0, 150.0], [32.5, 40.0])):
+        a, b = read(contract, duplicates=how), read(lab, duplicates=how)
+        for d in (a, b):
+            _assert_data(d, [1.0, 2.0], np.array(storage) + 1j * np.array(loss), "modulus")
+        assert a.units == b.units == "Pa"

@@ -6,7 +6,12 @@ sets of log10 a_T at 20 °C and their differences.
 
 ``mastercurves`` is not a dependency of bayesfo: ``pip install mastercurves`` to time it.
 
-Usage: python benchmarks/bench_mastercurve.py [--structure zener]
+With ``--command``: the wall time of ``bayesfo mastercurve`` as a process on the same files with
+its defaults (three master structures, the shift laws inside the posterior, figures, report),
+with ``--workers 1`` (one after the other) and the default ``--workers 0`` (one process per
+CPU), interleaved over ``--rounds`` rounds.
+
+Usage: python benchmarks/bench_mastercurve.py [--structure zener] [--command [--rounds N]]
 """
 
 from __future__ import annotations
@@ -14,6 +19,9 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import subprocess
+import sys
+import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -30,9 +38,13 @@ T_REF = 20.0
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--structure", default="zener")
+    parser.add_argument("--command", action="store_true")
+    parser.add_argument("--rounds", type=int, default=1)
     args = parser.parse_args()
     print(f"machine: {platform.machine()}, {os.cpu_count()} CPUs, python "
           f"{platform.python_version()}")
+    if args.command:
+        return command(args.rounds)
     files = sorted(ADHESIVE.glob("T*.csv"))
     iso = sorted(((bf.read(f), temperature_of_file(f)) for f in files), key=lambda p: p[1])
     bf.inference  # the libraries loaded before the clock starts
@@ -78,6 +90,29 @@ def main():
     steps = np.diff(a)
     print(f"mastercurves steps at its bound of 2 decades: "
           f"{int(np.sum(np.isclose(np.abs(steps), 2.0, atol=1e-3)))}")
+
+
+def command(rounds: int) -> None:
+    """``bayesfo mastercurve`` as a process, one worker against one per CPU."""
+    workers = {"--workers 1": "1", "--workers 0 (default)": "0"}
+    times = {label: [] for label in workers}
+    with tempfile.TemporaryDirectory() as tmp:
+        for r in range(rounds):
+            for label, n in workers.items():
+                out = Path(tmp) / f"mc-{r}-{n}"
+                cmd = [sys.executable, "-m", "bayesfo.cli", "mastercurve", str(ADHESIVE),
+                       "--out", str(out), "--workers", n]
+                t0 = time.perf_counter()
+                done = subprocess.run(cmd, capture_output=True, text=True,
+                                      env=dict(os.environ, MPLBACKEND="Agg"))
+                times[label].append(time.perf_counter() - t0)
+                if done.returncode != 0:
+                    raise RuntimeError(done.stderr)
+                print(f"round {r + 1}, {label}: {times[label][-1]:.1f} s (load "
+                      f"{os.getloadavg()[0]:.1f})", flush=True)
+    for label, t in times.items():
+        print(f"{label}: median {np.median(t):.1f} s over {len(t)} (range {min(t):.1f}–"
+              f"{max(t):.1f})")
 
 
 if __name__ == "__main__":

@@ -49,6 +49,10 @@ def add_parser(subparsers):
                         "posterior, the highest ln Z kept), free (one log10 a_T per isotherm), "
                         "wlf or arrhenius (the law's parameters sampled)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--workers", type=int, default=0, metavar="N",
+                   help="processes fitting the master structures, then the shift laws, side by "
+                        "side (default 0: one per CPU; 1: one after the other here); the "
+                        "numbers do not depend on it")
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default bayesfo-mastercurve)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
@@ -96,13 +100,17 @@ def run(args) -> int:
     from ..tts.joint import _master_names
     from ._libraries import load_libraries
 
+    if args.workers < 0:
+        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got "
+                         f"{args.workers}")
     structures = _master_names(args.structures)  # an unknown name fails before reading
     isotherms = read_isotherm_files(args.data)
     target = Path(args.out or "bayesfo-mastercurve")
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
-                     noise=args.noise, vertical=args.vertical, law=args.law, seed=args.seed)
+                     noise=args.noise, vertical=args.vertical, law=args.law, seed=args.seed,
+                     workers=args.workers)
     from ..output.write import _finite
     from ..tts.stored import summary_fields
 

@@ -424,7 +424,7 @@ def excel_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
 
     ``.xlsx`` workbooks are streamed (at most :data:`EXCEL_MAX_LINES` rows and
     :data:`EXCEL_MAX_CELLS` cells per sheet); ``.xls`` workbooks (at most 65 536 × 256 cells
-    by their format) are read through pandas and xlrd.
+    by their format) are read with xlrd.
 
     Raises
     ------
@@ -438,19 +438,23 @@ def excel_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
     except ImportError:
         raise InputError(f"file '{path}': reading Excel workbooks needs the package {engine} "
                          f"(pip install {engine}"
-                         + ("" if engine == "xlrd" else ", or pip install 'bayesfo[excel]'")
+                         + ", or pip install 'bayesfo[excel]'"
                          + "); or save the sheet as CSV or text") from None
     if engine == "openpyxl":
         return _openpyxl_sheets(path)
-    import pandas as pd
+    import xlrd
 
+    # xlrd itself rather than pandas' read_excel, whose xlrd engine pandas deprecates.
     try:
-        book = pd.read_excel(path, sheet_name=None, header=None, dtype=object, engine=engine)
+        book = xlrd.open_workbook(str(path), on_demand=True)
+        try:
+            return [(sheet.name, [[_cell_text(v) for v in sheet.row_values(i)]
+                                  for i in range(sheet.nrows)])
+                    for sheet in book.sheets()]
+        finally:
+            book.release_resources()
     except Exception as exc:  # noqa: BLE001 - any failure of the workbook library is bad input
         raise InputError(f"file '{path}' cannot be read as an Excel workbook: {exc}") from None
-    return [(str(name), [[_cell_text(v) for v in values]
-                         for values in frame.itertuples(index=False)])
-            for name, frame in book.items()]
 
 
 def classify_rows(rows: list[list[str]]) -> list[Line]:

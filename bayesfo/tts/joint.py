@@ -58,7 +58,7 @@ ISOTHERM_MISFIT = 3.0
 # ---------------------------------------------------------------------------- the fit
 def mastercurve(isotherms, structures="zener", *, reference_temperature: float | None = None,
                 noise: str = "proportional", vertical: str = "none", law: str = "auto",
-                seed: int = 0) -> MasterCurve:
+                seed: int = 0, workers: int = 1) -> MasterCurve:
     """One joint posterior of a master structure and the isotherms' shifts; with several
     structures, each is fitted and the one of highest ln Z is returned, with the ranking.
 
@@ -88,6 +88,10 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         the three compare. With fewer than :data:`AUTO_LAWS_MIN` isotherms, ``"auto"`` is
         ``"free"``.
     seed : int
+    workers : int
+        Processes fitting the master structures side by side, and then the best one under
+        each shift law: 1 (default) fits them one after the other in this process; 0 one
+        process per CPU. The numbers do not depend on it.
 
     Returns
     -------
@@ -106,7 +110,22 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     names = _master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
     first = "free" if law == "auto" else law
-    fits = [_fit_one(iso, s, noise, seed, vertical, first) for s in names]
+    auto_laws = law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN
+    from ..parallel import executor
+
+    with executor(workers, max(len(names), 2 if auto_laws else 1)) as pool:
+        fits = [f.result() for f in [pool.submit(_fit_one, iso, s, noise, seed, vertical, first)
+                                     for s in names]]
+        return _conclude(iso, fits, "auto" if auto_laws else first, vertical,
+                         lambda best, hows: [f.result() for f in [
+                             pool.submit(_fit_one, iso, names[best], noise, seed, vertical, how)
+                             for how in hows]])
+
+
+def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
+    """The ranking of the master structures (``fits``, free shifts or the law asked for),
+    the best one's shift law chosen by evidence where ``law`` is ``"auto"`` (its fits under
+    the laws from ``fit_laws(best, hows)``), and the model-free tests of superposition."""
     z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
     best = int(np.argmax(z))
     p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
@@ -123,10 +142,9 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
 
     chosen = fits[best]
     law_evidence, law_notes = {}, []
-    if law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN:
+    if law == "auto":
         chosen, law_evidence, law_notes = _choose_law(
-            iso, names[best], chosen, lambda how: _fit_one(iso, names[best], noise, seed,
-                                                           vertical, how))
+            chosen, dict(zip(LAW_FITS, fit_laws(best, LAW_FITS), strict=True)))
     vgp = van_gurp_palmen(iso.data, iso.temperatures)
     parts = shifts_by_part(iso.data, iso.temperatures)
     checks = {"van_gurp_palmen": vgp, "shift_parts": parts,
@@ -160,11 +178,15 @@ def _master_names(structures) -> list:
     return [structures] if not isinstance(structures, (list, tuple)) else list(structures)
 
 
-def _choose_law(iso: _Isotherms, structure, free: MasterCurve, fit) -> tuple:
-    """The model of highest ln Z among free shifts (``free``, fitted) and the WLF and
-    Arrhenius laws (``fit(law)``), a law only where its posterior is certified; with
+#: The shift laws that ``law="auto"`` fits the best master structure with, beside free shifts.
+LAW_FITS = ("wlf", "arrhenius")
+
+
+def _choose_law(free: MasterCurve, laws: dict) -> tuple:
+    """The model of highest ln Z among free shifts (``free``) and the WLF and Arrhenius laws
+    (``laws``: ``{law: MasterCurve}``), a law only where its posterior is certified; with
     ``law_evidence`` and a note."""
-    fits = {"free": free, **{how: fit(how) for how in ("wlf", "arrhenius")}}
+    fits = {"free": free, **laws}
     z = {k: f.log_evidence if math.isfinite(f.log_evidence) and f.posterior.converged
          else -np.inf for k, f in fits.items()}
     z["free"] = free.log_evidence if math.isfinite(free.log_evidence) else -np.inf

@@ -345,7 +345,7 @@ def test_a_shift_law_inside_the_posterior_is_stored_and_loaded(tmp_path, run_cli
     assert status == 0, err
     assert "shift factors (WLF) of zener" in out and "report.html" in out
     report = (tmp_path / "mc" / "report.html").read_text()
-    assert "Superposition holds by the van Gurp" in report and report.count("<img") == 2
+    assert "Superposition holds by the van Gurp" in report and report.count("<img") == 3
     status, _, err = run_cli("design", tmp_path / "mc")
     assert status == 2 and "holds a master curve: design chooses frequencies" in err
     mc = bf.load(tmp_path / "mc")
@@ -537,3 +537,19 @@ def test_the_shift_prior_widens_where_the_seeds_reach_past_it():
     plain = ShiftedStructure(z, tuple(TEMPS), 2, np.zeros(1, int))
     assert plain.parameters[-1].prior.bounds == (-SHIFT_RANGE, SHIFT_RANGE)
     assert (SHIFT_RANGE, SHIFT_MARGIN) == (15.0, 5.0)
+
+
+def test_two_workers_give_the_numbers_of_one():
+    # Two master structures side by side, then the best one under the WLF and Arrhenius laws
+    # side by side: the same ranking, law evidence and draws as one after the other.
+    data = isotherms(wlf(np.array(TEMPS), 20.0, 8.0, 80.0), seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one, two = (bf.mastercurve(data, "zener,voigt", reference_temperature=20.0, workers=w)
+                    for w in (1, 2))
+    assert one.ranking == two.ranking and one.law == two.law
+    assert one.law_evidence == two.law_evidence and set(one.law_evidence) == {
+        "free", "wlf", "arrhenius"}
+    np.testing.assert_array_equal(one.shift_draws, two.shift_draws)
+    np.testing.assert_array_equal(one.master_draws, two.master_draws)
+    assert one.log_evidence == two.log_evidence

@@ -6,8 +6,8 @@
    T_ref = −5 °C; pyvisco's verification notebook loads them as the user's a_T, its own
    ``master.get_aT`` left commented out; every value is a multiple of 0.06 decade) are read from
    the bare git mirror of github:NREL/pyvisco (BSD-3-Clause, commit 252a4b8) into ``tmp_path``;
-   skipped without the mirror, and without ``xlrd`` (the .xls needs it). bayesfo cannot read the
-   workbook itself (see ``_eplexor_isotherms``), so its "Exported Data" sheet is written as CSV.
+   skipped without the mirror, and without ``xlrd`` (the .xls needs it; the test extra installs
+   it). bayesfo reads the workbook directly.
 
    What the data fix: from −50 to 32 °C the isotherms are glassy (E′ 2–5.6 GPa, tan δ ≤ 0.091)
    and neighbours barely overlap: up to 17.5 °C the model-free overlays of a pair's G″ or tan δ
@@ -70,7 +70,6 @@ import pytest
 
 import bayesfo as bf
 from bayesfo.data import read_isotherms
-from bayesfo.errors import InputError
 from bayesfo.tts.validity import shifts_by_part
 
 pytestmark = pytest.mark.slow
@@ -121,41 +120,20 @@ def _git_show(path: str, target: Path) -> Path:
     return target
 
 
-def _eplexor_isotherms(xls: Path, tmp: Path) -> tuple[list, str]:
-    """The isotherms of the Eplexor workbook, and how they were read.
-
-    bayesfo reads .xls through pandas and xlrd, but not this workbook: its second sheet, "Data
-    header" (the test settings: 'Values: 0.1 0.05 1.6 ...'), holds numbers without a frequency
-    column, and ``read_isotherms`` raises for that sheet instead of skipping it
-    (``bayesfo/data/lab.py``, the loop over ``excel_sheets``); under warnings-as-errors, pandas
-    3's deprecation of the xlrd engine also turns into "cannot be read as an Excel workbook".
-    Where it fails, the "Exported Data" sheet is written as CSV (its two header rows, name and
-    unit, joined as 'f [Hz]') and read with its temperature column.
-    """
-    try:
-        return quiet(read_isotherms, xls), "read_isotherms(.xls)"
-    except InputError:
-        pass
-    import pandas as pd
-
-    sheet = quiet(pd.read_excel, xls, sheet_name="Exported Data", header=[0, 1],
-                  na_values="---", engine="xlrd")
-    sheet.columns = [f"{name} [{unit}]" if isinstance(unit, str) and unit.strip()
-                     and not unit.startswith("Unnamed") else name for name, unit in sheet.columns]
-    csv = tmp / "freq_Eplexor_raw.csv"
-    sheet[["f [Hz]", "E' [MPa]", "E'' [MPa]", "T [°C]"]].to_csv(csv, index=False)
-    return quiet(read_isotherms, csv), "Exported Data sheet as CSV"
+def _eplexor_isotherms(xls: Path) -> tuple[list, str]:
+    """The isotherms of the Eplexor workbook, and how they were read: by ``read_isotherms``
+    itself (xlrd), its "Data header" sheet of test settings left out with a DataWarning."""
+    return quiet(read_isotherms, xls), "read_isotherms(.xls)"
 
 
 @pytest.fixture(scope="module")
 def nrel(tmp_path_factory):
-    pytest.importorskip("xlrd", reason="the Eplexor .xls needs xlrd (pip install xlrd); bayesfo "
-                        "has no other route to .xls workbooks")
+    pytest.importorskip("xlrd", reason="the Eplexor .xls needs xlrd (pip install 'bayesfo[excel]')")
     tmp = tmp_path_factory.mktemp("pyvisco")
     xls = _git_show(EPLEXOR, tmp / "freq_Eplexor_raw.xls")
     shifts = _git_show(EPLEXOR_SHIFTS, tmp / "shift_factors.csv")
     table = np.loadtxt(shifts, delimiter=",", skiprows=2, encoding="utf-8-sig")
-    isotherms, how = _eplexor_isotherms(xls, tmp)
+    isotherms, how = _eplexor_isotherms(xls)
     return {"isotherms": isotherms, "how": how, "file": {float(t): a for t, a in table}}
 
 

@@ -774,3 +774,33 @@ def test_repeated_frequencies_get_one_piece_of_advice_from_every_reader(tmp_path
         for d in (a, b):
             _assert_data(d, [1.0, 2.0], np.array(storage) + 1j * np.array(loss), "modulus")
         assert a.units == b.units == "Pa"
+
+
+def test_an_eplexor_xls_workbook_is_read_directly():
+    # The Eplexor's Excel 97 export (.xls): 21 tensile isotherms of 10 frequencies; its "Data
+    # header" sheet of test settings (numbers, no frequency column) is left out, said once.
+    pytest.importorskip("xlrd")
+    import xlrd
+
+    path = LAB / "eplexor_raw.xls"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sets = read_isotherms(path)
+    from bayesfo.errors import DataWarning
+
+    notes = [str(w.message) for w in caught if issubclass(w.category, DataWarning)]
+    assert len(notes) == 1 and "sheet 'Data header'" in notes[0]
+    assert len(sets) == 21 and all(s.data.n_frequencies == 10 for s in sets)
+    assert all(s.data.symbol == "E" and s.data.kind == "modulus" and s.data.units == "Pa"
+               for s in sets)
+    # Against the sheet's cells read by xlrd alone: f [Hz], T [°C], E', E'' [MPa].
+    sheet = xlrd.open_workbook(str(path)).sheet_by_name("Exported Data")
+    head = sheet.row_values(0)
+    rows = np.array([[float(sheet.cell_value(i, head.index(c))) for c in ("f", "T", "E'", "E''")]
+                     for i in range(2, sheet.nrows)])
+    first = sets[0]
+    assert first.temperature == pytest.approx(rows[:10, 1].mean(), abs=0.05)
+    np.testing.assert_allclose(first.data.omega, 2 * np.pi * rows[:10, 0], rtol=1e-12)
+    np.testing.assert_allclose(first.data.response, 1e6 * (rows[:10, 2] + 1j * rows[:10, 3]),
+                               rtol=1e-12)
+    assert sets[-1].temperature == pytest.approx(100.0, abs=0.1)

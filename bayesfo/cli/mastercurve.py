@@ -172,7 +172,12 @@ def _print(mc, out) -> None:
     if mc.law_evidence:
         print(f"shifts of {mc.structure} ranked by ln Z (free, or by a law inside the posterior)")
         for how, r in sorted(mc.law_evidence.items(),
-                             key=lambda kv: -(kv[1]["log_evidence"] or -math.inf)):
+                             key=lambda kv: -(kv[1]["log_evidence"]
+                                              or kv[1].get("log_evidence_upper") or -math.inf)):
+            if r.get("log_evidence_upper") is not None:  # not sampled: bounded from above
+                print(f"   {how:<22} ln Z {'≤ ' + format(r['log_evidence_upper'], '.2f'):>20}  "
+                      f"P ≤ {r['probability']:.1e}  not sampled (its best fit bounds ln Z)")
+                continue
             z = "-" if r["log_evidence"] is None else (f"{r['log_evidence']:.2f} ± "
                                                         f"{r['log_evidence_err']:.2f}")
             print(f"   {how:<22} ln Z {z:>20}  P {r['probability']:6.3f}  "

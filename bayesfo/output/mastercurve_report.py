@@ -74,11 +74,15 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     ev = mc.law_evidence
     if ev:
         order = sorted(ev, key=lambda k: -(ev[k]["log_evidence"] if ev[k]["log_evidence"]
-                                           is not None else -math.inf))
+                                           is not None else ev[k].get("log_evidence_upper")
+                                           or -math.inf))
         top, second = order[0], order[1]
         z1, z2 = ev[top]["log_evidence"], ev[second]["log_evidence"]
-        gap = f"ln Z {z1 - z2:.1f} above {_LAW_NAMES[second]}" if z2 is not None else \
-            f"{_LAW_NAMES[second]} gave no certified ln Z"
+        upper = ev[second].get("log_evidence_upper")
+        gap = (f"ln Z {z1 - z2:.1f} above {_LAW_NAMES[second]}" if z2 is not None else
+               f"ln Z at least {z1 - upper:.1f} above {_LAW_NAMES[second]}, whose best fit "
+               "bounds its ln Z" if upper is not None else
+               f"{_LAW_NAMES[second]} gave no certified ln Z")
         if top == "free":
             out.append((f"The shifts follow neither shift law over all isotherms: free shifts "
                         f"are supported ({gap}).", True))
@@ -133,6 +137,13 @@ def _shifts_table(mc) -> str:
     return "<table>" + head + "".join(rows) + "</table>"
 
 
+def _law_log_z(evidence: dict) -> str:
+    """A law's ln Z in the table: the estimate, or '≤ bound' for a law not sampled."""
+    if evidence.get("log_evidence") is None and evidence.get("log_evidence_upper") is not None:
+        return f"≤ {_num(evidence['log_evidence_upper'])} (not sampled)"
+    return _num(evidence.get("log_evidence"))
+
+
 def _laws_table(mc) -> str:
     rows = []
     for name, law in mc.laws.items():
@@ -142,7 +153,7 @@ def _laws_table(mc) -> str:
         rows.append(f"<tr><td class='text'>{_e(_LAW_NAMES[name])}</td>"
                     f"<td class='text'>{_e(params)}</td><td>{law['chi2_per_dof']:.3g}</td>"
                     f"<td>{_num(law['probability'], '.3f')}</td>"
-                    f"<td>{_num(evidence.get('log_evidence'))}</td></tr>")
+                    f"<td>{_law_log_z(evidence)}</td></tr>")
     if "free" in mc.law_evidence:
         rows.append(f"<tr><td class='text'>free shifts</td><td class='text'>one per isotherm"
                     f"</td><td>–</td><td>–</td>"

@@ -27,6 +27,7 @@ the joint fit name those the master structure misses.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -53,6 +54,21 @@ AUTO_LAWS_MIN = 4
 #: An isotherm whose relative residuals under the joint fit (rms) exceed this many times the
 #: median isotherm's is named as one the master structure misses.
 ISOTHERM_MISFIT = 3.0
+#: A shift law whose best joint fit lies this many nats below the free shifts' ln Z is not
+#: sampled (``law="auto"``): ln Z ≤ max ln L for any normalised prior, so its posterior
+#: probability is below e^-LAW_BOUND_MARGIN, and certifying a posterior that far behind (often
+#: by the tempered ladder: the law pulls its parameters against their bounds) would cost more
+#: than all the rest.
+LAW_BOUND_MARGIN = 10.0
+
+
+@dataclass(frozen=True)
+class _Bounded:
+    """A shift law not sampled: its best joint fit's log-likelihood (maximum-likelihood noise),
+    which bounds its ln Z from above."""
+
+    law: str
+    log_likelihood: float
 
 
 # ---------------------------------------------------------------------------- the fit
@@ -117,15 +133,16 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         fits = [f.result() for f in [pool.submit(_fit_one, iso, s, noise, seed, vertical, first)
                                      for s in names]]
         return _conclude(iso, fits, "auto" if auto_laws else first, vertical,
-                         lambda best, hows: [f.result() for f in [
-                             pool.submit(_fit_one, iso, names[best], noise, seed, vertical, how)
-                             for how in hows]])
+                         lambda best, hows, ceiling: [f.result() for f in [
+                             pool.submit(_fit_one, iso, names[best], noise, seed, vertical, how,
+                                         ceiling) for how in hows]])
 
 
 def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
     """The ranking of the master structures (``fits``, free shifts or the law asked for),
     the best one's shift law chosen by evidence where ``law`` is ``"auto"`` (its fits under
-    the laws from ``fit_laws(best, hows)``), and the model-free tests of superposition."""
+    the laws from ``fit_laws(best, hows, ceiling)``: a law whose best fit stays below
+    ``ceiling`` comes back :class:`_Bounded`), and the model-free tests of superposition."""
     z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
     best = int(np.argmax(z))
     p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
@@ -143,8 +160,10 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
     chosen = fits[best]
     law_evidence, law_notes = {}, []
     if law == "auto":
+        ceiling = (chosen.log_evidence - LAW_BOUND_MARGIN if math.isfinite(chosen.log_evidence)
+                   else None)
         chosen, law_evidence, law_notes = _choose_law(
-            chosen, dict(zip(LAW_FITS, fit_laws(best, LAW_FITS), strict=True)))
+            chosen, dict(zip(LAW_FITS, fit_laws(best, LAW_FITS, ceiling), strict=True)))
     vgp = van_gurp_palmen(iso.data, iso.temperatures)
     parts = shifts_by_part(iso.data, iso.temperatures)
     checks = {"van_gurp_palmen": vgp, "shift_parts": parts,
@@ -184,9 +203,13 @@ LAW_FITS = ("wlf", "arrhenius")
 
 def _choose_law(free: MasterCurve, laws: dict) -> tuple:
     """The model of highest ln Z among free shifts (``free``) and the WLF and Arrhenius laws
-    (``laws``: ``{law: MasterCurve}``), a law only where its posterior is certified; with
-    ``law_evidence`` and a note."""
-    fits = {"free": free, **laws}
+    (``laws``: ``{law: MasterCurve or _Bounded}``), a law only where its posterior is
+    certified; with ``law_evidence`` and a note. A :class:`_Bounded` law enters with its
+    upper bound: ``log_evidence`` None, ``log_evidence_upper`` and a ``probability`` that is
+    an upper bound (``probability_upper`` true)."""
+    sampled = {k: f for k, f in laws.items() if not isinstance(f, _Bounded)}
+    bounded = {k: f for k, f in laws.items() if isinstance(f, _Bounded)}
+    fits = {"free": free, **sampled}
     z = {k: f.log_evidence if math.isfinite(f.log_evidence) and f.posterior.converged
          else -np.inf for k, f in fits.items()}
     z["free"] = free.log_evidence if math.isfinite(free.log_evidence) else -np.inf
@@ -200,22 +223,38 @@ def _choose_law(free: MasterCurve, laws: dict) -> tuple:
                     "probability": p[k] / total, "certified": bool(fits[k].posterior.converged),
                     "sampler": fits[k].posterior.sampler} for k in fits}
     name = {"free": "free shifts", "wlf": "the WLF law", "arrhenius": "the Arrhenius law"}
-    runner = max((k for k in z if k != top), key=z.get)
-    gap = z[top] - z[runner]
-    how = f"ln Z {gap:.1f} above {name[runner]}" if np.isfinite(gap) else \
-        f"{name[runner]} gave no certified ln Z"
+    notes = []
+    for k, b in bounded.items():
+        evidence[k] = {"log_evidence": None, "log_evidence_err": None,
+                       "log_evidence_upper": _num(b.log_likelihood),
+                       "probability": math.exp(min(0.0, b.log_likelihood - z[top])) / total,
+                       "probability_upper": True, "certified": False, "sampler": "not sampled"}
+        notes.append(f"{name[k]} was not sampled: its best joint fit reaches a log-likelihood "
+                     f"of {b.log_likelihood:.1f}, which bounds its ln Z from above, "
+                     f"{z[top] - b.log_likelihood:.0f} nats below the ln Z of {name[top]}")
+    evidence = {k: evidence[k] for k in ("free", *LAW_FITS) if k in evidence}
+    if len(z) < 2:  # every law bounded
+        runner = max(bounded, key=lambda k: bounded[k].log_likelihood)
+        how = f"ln Z over {z[top] - bounded[runner].log_likelihood:.0f} above {name[runner]}"
+    else:
+        runner = max((k for k in z if k != top), key=z.get)
+        gap = z[top] - z[runner]
+        how = f"ln Z {gap:.1f} above {name[runner]}" if np.isfinite(gap) else \
+            f"{name[runner]} gave no certified ln Z"
     if top == "free":
         note = (f"the shifts follow neither shift law over all isotherms: free shifts are "
                 f"supported ({how}); the shift factors are each isotherm's own")
     else:
         note = (f"the shifts follow {name[top]} ({how}): the shift factors are the law's, "
                 "sampled with the master structure")
-    return fits[top], evidence, [note]
+    return fits[top], evidence, [note, *notes]
 
 
 def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
-             vertical: str = "none", law: str = "free") -> MasterCurve:
-    """The joint posterior with one master structure."""
+             vertical: str = "none", law: str = "free",
+             ceiling: float | None = None) -> MasterCurve | _Bounded:
+    """The joint posterior with one master structure; :class:`_Bounded` instead where the
+    best joint fit's log-likelihood (maximum-likelihood noise) stays below ``ceiling``."""
     from scipy.optimize import least_squares
 
     from ..identify.optimize import fit_structure
@@ -282,6 +321,13 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
     if best is None:
         raise InputError(f"no admissible joint fit of {master.name} to the isotherms; try "
                          "another structure")
+    if ceiling is not None:
+        theta = best[0][None, :]
+        if lik.noise_param:
+            theta = np.column_stack([theta, lik.noise_estimate(theta)])
+        log_l = float(lik(theta)[0])
+        if log_l < ceiling:
+            return _Bounded(law, log_l)
     found = certified_posterior(lik, best[0][None, :], sampler="auto", seed=seed)
     notes.extend(found.notes)
     post = found.posterior

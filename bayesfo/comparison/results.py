@@ -221,7 +221,8 @@ class StructureResult:
             block = self.sampled_parameters
         if block:
             width = max(len(n) for n in block)
-            lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI (on a log scale for quantities with a unit)")
+            lines.append(f"  {'parameter':<{width}}  {'median':>11}  {HDI_PROB:.0%} HDI "
+                         "(on a log scale for quantities with a unit)")
             for n, v in block.items():
                 unit = f" {v['unit']}" if v.get("unit") else ""
                 flags = ([f"not determined: {v['not_determined_reason']}"]

@@ -86,15 +86,10 @@ def _order_series(rows, name: str, marker: str) -> list[tuple]:
     return out
 
 
-def _q_errorbar(ax, x, rows, st, filled_mask, series=None):
-    """Order means with HDI bars in the colour of the structure's style ``st`` (``series``:
-    one of :func:`_order_series`; default the rows' q columns with the style's marker);
-    filled markers where ``filled_mask`` (the best structure), a cross where the posterior
-    did not converge."""
-    if series is None:
-        series = (None, st.marker, rows,
-                  *(np.array([r[k] for r in rows], dtype=float)
-                    for k in ("q_mean", "q_hdi_low", "q_hdi_high")))
+def _q_errorbar(ax, x, st, filled_mask, series):
+    """One order's means with HDI bars (``series``: one of :func:`_order_series`) in the colour
+    of the structure's style ``st``; filled markers where ``filled_mask`` (the best
+    structure), a cross where the posterior did not converge."""
     _, marker, rows, mean, low, high = series
     yerr = np.vstack([np.clip(mean - low, 0, None), np.clip(high - mean, 0, None)])
     ax.errorbar(x, mean, yerr=yerr, fmt="none", ecolor=st.color, elinewidth=1.2, capsize=2.5)
@@ -210,7 +205,7 @@ def plot_batch_summary(rows, structures=None, fig=None):
                else np.zeros(len(series)))
     for (name, sr), off in zip(series, offsets):
         xs = np.array([index[r["dataset"]] + off for r in sr[2]])
-        _q_errorbar(ax_q, xs, sr[2], styles[name], [bool(r.get("best")) for r in sr[2]], sr)
+        _q_errorbar(ax_q, xs, styles[name], [bool(r.get("best")) for r in sr[2]], sr)
     ax_q.set_ylabel(f"order: posterior mean, {HDI_LABEL}")
     prefix = _common_prefix(datasets)
     ax_q.set_xticks(x)
@@ -240,8 +235,9 @@ def plot_q_temperature(rows, structures=None, fig=None):
 
     Top: the posterior mean of every fractional order of every structure (q; α, β, δ by
     symbol where a structure has several; the rows' ``order_summaries``, else their ``q_*``
-    columns) with its 94 % HDI against temperature, one colour per structure, filled where the structure is the best at
-    that temperature, crossed where its posterior did not converge. Bottom: the posterior
+    columns) with its 94 % HDI against temperature, one colour per structure, filled where
+    the structure is the best at that temperature, crossed where its posterior did not
+    converge. Bottom: the posterior
     probability of each structure against temperature (equal prior odds), so the best structure
     per temperature is the top curve. With a single temperature the axis is
     :data:`ONE_TEMPERATURE_WIDTH` °C wide around it, with that temperature as its only tick and
@@ -283,7 +279,7 @@ def plot_q_temperature(rows, structures=None, fig=None):
         if len(sel) > 1:
             ax_q.plot(t, sr[3], color=st.color, linestyle=st.linestyle, linewidth=0.8,
                       alpha=0.6)
-        _q_errorbar(ax_q, t, sel, st, [bool(r.get("best")) for r in sel], sr)
+        _q_errorbar(ax_q, t, st, [bool(r.get("best")) for r in sel], sr)
     ax_q.set_ylabel(f"order: posterior mean, {HDI_LABEL}")
     if series:
         _q_legend(fig, [sr[0] for _, sr in series], [styles[name] for name, _ in series],

@@ -143,3 +143,66 @@ def test_calibration_of_springpot_cards_by_the_default_route(name):
     print(name, cov)
     assert abs(cov[0.5] - 0.5) <= 0.05, cov
     assert abs(cov[0.9] - 0.9) <= 0.05, cov
+
+
+# ------------------------------------------------------------------ master-curve shift factors
+#: Isotherms of the master-curve calibration: six temperatures, the reference in the middle.
+MC_TEMPS = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0]
+MC_W = np.logspace(-1, 2, 12)
+
+
+def mastercurve_shift_coverage(n_sets: int, seed: int) -> dict:
+    """Coverage of the central 50 % and 90 % intervals of the shifts log10 a_T of the joint
+    master-curve posterior (``bayesfo.mastercurve``, Zener master, free shifts, proportional
+    noise as fitted): over ``n_sets`` simulated sets of six isotherms, each from a random Zener
+    (q ~ U(0.3, 0.8), log10 a1 ~ U(0, 2), b0 = 1, b1 ~ 10^U(-2.5, -1)) shifted by a
+    random WLF law (C1 ~ U(6, 12), C2 ~ U(60, 150) °C at 20 °C) plus an independent N(0, 0.1)
+    departure per isotherm, with 1 % or 3 % complex proportional noise. The shifts' prior is
+    flat over ±15 decades around data that fix them to a few hundredths, so the intervals'
+    frequentist coverage at these truths is their nominal level if the posterior is right."""
+    import bayesfo as bf
+    from bayesfo.tts import wlf
+
+    rng = np.random.default_rng(seed)
+    zener = get_structure("zener")
+    hits = {0.5: [], 0.9: []}
+    routes, uncertified = {}, 0
+    for _ in range(n_sets):
+        # compliance (b0 + b1 s^q)/(1 + a1 s^q): b1/a1 < b0, a passive Zener, always here
+        theta = np.array([10.0 ** rng.uniform(0, 2), 1.0, 10.0 ** rng.uniform(-2.5, -1),
+                          rng.uniform(0.3, 0.8)])
+        truth = (wlf(np.array(MC_TEMPS), 20.0, rng.uniform(6, 12), rng.uniform(60, 150))
+                 + rng.normal(0.0, 0.1, len(MC_TEMPS)))
+        truth -= truth[MC_TEMPS.index(20.0)]
+        rel = rng.choice([0.01, 0.03])
+        data = []
+        for t, a in zip(MC_TEMPS, truth, strict=True):
+            g = zener.response([theta], MC_W * 10.0**a, "modulus")[0]
+            sd = rel * np.abs(g)
+            y = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
+            data.append((FrequencyResponse(MC_W, y, kind="modulus", units="Pa"), t))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            mc = bf.mastercurve(data, "zener", reference_temperature=20.0, law="free", seed=0)
+        sampler = mc.posterior.sampler
+        routes[sampler] = routes.get(sampler, 0) + 1
+        uncertified += not mc.posterior.converged
+        keep = [i for i, t in enumerate(MC_TEMPS) if t != 20.0]
+        for level in hits:
+            lo, hi = np.quantile(mc.shift_draws[:, keep], [(1 - level) / 2, (1 + level) / 2],
+                                 axis=0)
+            hits[level].extend((truth[keep] >= lo) & (truth[keep] <= hi))
+    out = {level: float(np.mean(h)) for level, h in hits.items()}
+    out.update(routes=routes, uncertified=uncertified, n=len(hits[0.5]))
+    return out
+
+
+@pytest.mark.slow
+def test_master_curve_shift_intervals_are_calibrated():
+    # 60 sets × 5 shifts: a coverage's binomial sd is 0.02-0.03 (shifts of one set are
+    # correlated through the master function), so ±0.07 is about 3 sd.
+    cov = mastercurve_shift_coverage(60, seed=21)
+    print(cov)
+    assert cov["uncertified"] == 0
+    assert abs(cov[0.5] - 0.5) <= 0.07, cov
+    assert abs(cov[0.9] - 0.9) <= 0.07, cov

@@ -10,6 +10,7 @@ from functools import cached_property
 import numpy as np
 
 from ..data import FrequencyResponse
+from ..data.frequency_response import FREQUENCY_RTOL
 from ..errors import InputError
 
 
@@ -160,7 +161,9 @@ def _reduced(iso: _Isotherms, log_shifts, log_vertical=None) -> FrequencyRespons
     scale = b if j.kind == "modulus" else 1.0 / b
     order = np.argsort(omega)
     omega, response = omega[order], (j.response * scale)[order]
-    keep = np.r_[True, np.diff(omega) > 1e-12 * omega[1:]]
+    # The same frequency as FrequencyResponse counts it (a shift that is a whole number of
+    # the grid's steps lands points within rounding of each other).
+    keep = np.r_[True, ~np.isclose(omega[1:], omega[:-1], rtol=FREQUENCY_RTOL, atol=0.0)]
     groups = np.cumsum(keep) - 1
     n = groups[-1] + 1
     r = np.zeros(n, complex)

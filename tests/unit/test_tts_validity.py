@@ -149,3 +149,25 @@ def test_the_residual_figure_gives_each_isotherms_misfit_against_a_known_master(
     colours = drawn.artists["rms"].get_facecolors()
     assert tuple(np.round(colours[2][:3], 3)) != tuple(np.round(colours[0][:3], 3))
     plt.close(drawn.figure)
+
+
+def test_isotherms_shifted_by_whole_grid_steps_merge_their_common_frequencies():
+    # Two isotherms on one log grid, the second shifted by exactly three of its steps: three
+    # reduced frequencies coincide up to rounding (1e-10 relative here); they are averaged into
+    # one point each, never refused as a frequency given twice.
+    from bayesfo.tts.isotherms import _isotherms, _reduced
+
+    w = np.logspace(-1, 2, 12)
+    step = 3.0 / 11.0
+    g = (1.0 + 0.5j) * w**0.3
+    a = FrequencyResponse(w, g, kind="modulus")
+    b = FrequencyResponse(w, 2.0 * g, kind="modulus")
+    iso = _isotherms([(a, 0.0), (b, 10.0)], 0.0)
+    shifts = np.array([0.0, 3 * step * (1 + 1e-10)])
+    reduced = _reduced(iso, shifts)
+    assert reduced.n_frequencies == 2 * 12 - 9
+    # each common frequency: the mean of the two isotherms' values there (a at w[3], b at its
+    # own w[0], shifted onto w[3])
+    common = np.isclose(reduced.omega, w[3], rtol=1e-8)
+    assert common.sum() == 1
+    assert np.isclose(reduced.response[common][0], (g[3] + 2.0 * g[0]) / 2)

@@ -553,7 +553,7 @@ def test_two_workers_give_the_numbers_of_one():
     data = isotherms(wlf(np.array(TEMPS), 20.0, 8.0, 80.0), seed=3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        one, two = (bf.mastercurve(data, "zener,voigt", reference_temperature=20.0, workers=w)
+        one, two = (bf.mastercurve(data, "zener,springpot", reference_temperature=20.0, workers=w)
                     for w in (1, 2))
     assert one.ranking == two.ranking and one.law == two.law
     assert one.law_evidence == two.law_evidence and set(one.law_evidence) == {

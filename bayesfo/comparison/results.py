@@ -271,7 +271,11 @@ class StructureResult:
             log_evidence_err=None if ev is None else ev.log_z_err,
             evidence_method=None if ev is None else ev.method,
             log_prior_support=None if ev is None else ev.log_support,
-            evidence_check=None if check is None else check.to_dict(),
+            # the nested ln Z, and the one it was checked against: under the chosen noise
+            # model alone (log_evidence is marginalised over the noise models where there were
+            # several)
+            evidence_check=None if check is None else check.to_dict() | {
+                "compared_with": None if ev is None else float(ev.conditional.log_z)},
             evidence_agree=self.criteria.evidence_agree,
             posterior_probability=self.criteria.posterior_probability,
             delta_loo_se=self.criteria.delta_loo_se,

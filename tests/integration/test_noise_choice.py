@@ -135,3 +135,20 @@ def test_q_coverage_with_half_a_decade_and_relative_noise():
         q = _compare(zener_data(seed, "proportional"))["zener"].posterior.summary["q"]
         covered.append(q.hdi_low <= ZENER[3] <= q.hdi_high)
     assert sum(covered) >= 17, covered
+
+
+@pytest.mark.slow  # dynesty: about a minute
+def test_the_nested_check_is_compared_with_the_chosen_noise_models_own_ln_z():
+    # The reported ln Z is marginalised over the noise models; dynesty runs under the chosen
+    # one, so the check compares with that model's ln Z and summary.json says which.
+    result = _compare(zener_data(1, "proportional", level=0.04, theta=WIDE),
+                      evidence_check=True)["zener"]
+    ev, nested = result.criteria.evidence, result.criteria.evidence_check
+    record = result.to_dict()
+    chosen = record["noise_models"]["models"][record["noise_models"]["chosen"]]
+    assert record["evidence_check"]["compared_with"] == ev.conditional.log_z
+    assert ev.conditional.log_z == pytest.approx(chosen["log_evidence"])
+    assert ev.log_z == pytest.approx(ev.conditional.log_z - np.log(2.0), abs=0.01)
+    combined = np.hypot(ev.conditional.log_z_err, nested.log_z_err)
+    assert result.criteria.evidence_agree == (
+        abs(ev.conditional.log_z - nested.log_z) <= 2 * combined)

@@ -66,11 +66,13 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85,
         ``"<name>/baseline"`` and, for a zoomed ridge, ``"<name>/zoom"`` (the inset's x
         range), where ``<name>`` is the structure for its first order and
         ``<structure>:<order>`` for the others (``"fractional_kelvin_voigt:alpha"``);
-        ``"structures"`` (these keys, top to bottom). ``artists``: ``"<name>/ridge"``
+        ``"structures"`` (these keys, top to bottom); ``"not_shown"`` (the structures beyond
+        ``limit``, named under the axis). ``artists``: ``"<name>/ridge"``
         (``PolyCollection``), ``"<name>/outline"``, ``"<name>/prior"``, ``"<name>/hdi"``
         (``Line2D``), ``"<name>/label"`` (``Text``) and for a zoomed ridge ``"<name>/inset"``
         (``Axes``), ``"<name>/inset_ridge"``, ``"<name>/inset_prior"``, ``"<name>/inset_hdi"``
-        and ``"<name>/inset_note"``.
+        and ``"<name>/inset_note"``; ``"key"`` (``Text``: what bar, tick and dashes mean,
+        under the figure) when the function made the figure itself.
 
     Raises
     ------

@@ -188,6 +188,8 @@ class ShiftedStructure(Parametrised):
         return out[0] if np.ndim(theta) == 1 else out
 
     def in_support(self, theta) -> np.ndarray:
+        """True where the master's parameters lie in its prior support and every shift (and
+        law) parameter in its prior range."""
         theta2 = np.atleast_2d(np.asarray(theta, float))
         k = self.master.n_params
         ok = np.atleast_1d(self.master.in_support(theta2[:, :k])).copy()

@@ -128,8 +128,7 @@ def summary_rows(summary: dict) -> list[dict]:
     the rows of ``Comparison.table`` and ``ranking.csv``), with what a batch adds: whether it
     is the best, the order parameter's HDI and MAP, the noise model, the data's kind and size
     and the warnings."""
-    from ..comparison.parameters import natural_block
-    from ..comparison.table import order_parameter, order_parameters, ranking_rows
+    from ..comparison.table import order_parameter, ranking_rows
 
     structures = {s["name"]: s for s in summary["structures"]}
     ranking = list(summary.get("ranking", []))
@@ -156,14 +155,17 @@ def summary_rows(summary: dict) -> list[dict]:
                    # structure describes the data, and every order by its symbol.
                    fits=table_row.get("fits"), orders=table_row.get("orders") or "",
                    # and for the figures, every order of the natural form (as ``orders``).
-                   order_summaries=_order_summaries(s, natural_block, order_parameters))
+                   order_summaries=_order_summaries(s))
         rows.append(row)
     return rows
 
 
-def _order_summaries(s: dict, natural_block, order_parameters) -> dict:
+def _order_summaries(s: dict) -> dict:
     """``{order: {"mean", "hdi_low", "hdi_high"}}`` of every fractional order of a structure
     record in the form natural to the data (none for an integer structure)."""
+    from ..comparison.parameters import natural_block
+    from ..comparison.table import order_parameters
+
     if s.get("integer"):
         return {}
     block = natural_block(s)

@@ -143,11 +143,17 @@ def not_determined(summary: dict, draws=None) -> str | None:
                 return (f"its {percent} HDI runs from {_bound(lo)} to {_bound(hi)}, across 0: "
                         "the data do not fix its sign")
             defined = np.abs(defined[defined > 0] if lo > 0 else defined[defined < 0])
+    return _judged(*_log_hdi(defined), percent)
+
+
+def _log_hdi(x) -> tuple[float, float, float]:
+    """The HDI of ``log10(x)`` (x ≥ 0) as values, 0 or infinity where a draw underflowed or
+    overflowed, and its width in decades (infinite then)."""
     with np.errstate(divide="ignore"):
-        lo, hi = (float(v) for v in _hdi(np.log10(defined)))
-    return _judged(10.0 ** lo if math.isfinite(lo) else (0.0 if lo < 0 else math.inf),
-                   10.0 ** hi if math.isfinite(hi) else (0.0 if hi < 0 else math.inf),
-                   hi - lo if math.isfinite(lo) and math.isfinite(hi) else math.inf, percent)
+        lo, hi = (float(v) for v in _hdi(np.log10(x)))
+    return (10.0 ** lo if math.isfinite(lo) else (0.0 if lo < 0 else math.inf),
+            10.0 ** hi if math.isfinite(hi) else (0.0 if hi < 0 else math.inf),
+            hi - lo if math.isfinite(lo) and math.isfinite(hi) else math.inf)
 
 
 def log_scale_hdi(summary: dict, draws) -> tuple[float, float] | None:
@@ -156,14 +162,19 @@ def log_scale_hdi(summary: dict, draws) -> tuple[float, float] | None:
     :func:`not_determined` judges, which reports show in place of the HDI of the values (that
     one leans towards small values). None for a pure number, a quantity with draws below 0,
     undefined (NaN) draws, or no draws."""
+    judged = _positive_log_hdi(summary, draws)
+    return None if judged is None else judged[:2]
+
+
+def _positive_log_hdi(summary: dict, draws) -> tuple[float, float, float] | None:
+    """:func:`_log_hdi` of the draws of a positive quantity with a unit; None otherwise (see
+    :func:`log_scale_hdi`)."""
     if not summary.get("unit") or draws is None:
         return None
     x = np.asarray(draws, dtype=float).ravel()
     if x.size < 2 or np.isnan(x).any() or np.any(x < 0):
         return None
-    with np.errstate(divide="ignore"):
-        lo, hi = (float(v) for v in _hdi(np.log10(x)))
-    return 10.0 ** lo, 10.0 ** hi
+    return _log_hdi(x)
 
 
 def shown_hdi(summary: dict) -> tuple[float, float]:
@@ -219,13 +230,17 @@ def with_determination(block: dict, poorly_determined=None, draws=None) -> dict:
     poorly_determined = poorly_determined or {}
     draws = draws or {}
     out = {}
+    percent = f"{100 * HDI_PROB:g} %"
     for name, s in block.items():
-        reason = not_determined(s, draws.get(name))
+        # A positive quantity with a unit: its log-scale HDI, computed once, is both what is
+        # shown and what is judged (as not_determined judges it).
+        judged = _positive_log_hdi(s, draws.get(name))
+        reason = (not_determined(s, draws.get(name)) if judged is None
+                  else _judged(*judged, percent))
         out[name] = dict(s) | {"not_determined": reason is not None,
                                "not_determined_reason": reason}
-        judged = log_scale_hdi(s, draws.get(name))
         if judged is not None:
-            out[name]["hdi_log_low"], out[name]["hdi_log_high"] = judged
+            out[name]["hdi_log_low"], out[name]["hdi_log_high"] = judged[:2]
         if name in poorly_determined:
             out[name]["poorly_determined"] = bool(poorly_determined[name])
     return out

@@ -11,7 +11,10 @@ The routes, in order, with ``sampler="auto"``:
    of the weights is below 0.7, their ESS at least 1000, and every fractional order
    determined (its 94 % interval within a quarter of its prior range: an undetermined order
    allows configurations, springpots exchanged or vanishing, that a proposal built at the
-   optima can miss); ln Z from the same weights where k̂ < 0.5;
+   optima can miss), and no ridge found along which the posterior holds mass that the
+   proposal does not reach (the ridge probe); ln Z from the same weights where k̂ < 0.5
+   (where it is 0.5 or more, from a later round, adapted to the weighted draws or a normal
+   mixture fitted to them, if its k̂ is below 0.5, else from a tempered ladder);
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
    tempered ladder guided by the proposal's draws: their final particles are the posterior
    when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence;
@@ -140,7 +143,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
             x0 = modes if starts is None or not np.size(starts) else np.vstack([modes, starts])
             post = sample_posterior(lik, x0, seed=seed, progress=False,
                                     **{"give_up": True, **sampler_options})
-        if post.sampler == "ladder" and info and info.get("undetermined"):
+        if post.sampler == "ladder" and info and (info.get("undetermined") or info.get("ridge")):
             notes.append(f"{name}: {info['reason']}; the tempered ladder, started from the "
                          "prior, gave the posterior")
         if post.sampler == "emcee" and tried:

@@ -28,6 +28,9 @@ cover the posterior's and the estimates converge at the usual rate, and their ef
 size says how many independent draws they are worth. Where the first round's weights do not
 certify, a second round adds to the proposal a Student-t matched to their weighted mean and
 covariance (one step of population Monte Carlo), which reaches skewed and bounded directions.
+The same second round follows a first that certifies the posterior but whose weights are too
+heavy-tailed for ln Z (0.5 ≤ k̂ < 0.7, typical of a structure that misfits): where its k̂ is
+below 0.5 it gives ln Z (and the posterior), and the tempered ladder is not run for ln Z alone.
 Where either still fails (a ridge, a boundary,
 a mode the optimiser did not find, an unidentified parameter), the result is None and the
 structure goes to the samplers (emcee, then the tempered ladder).
@@ -44,8 +47,16 @@ The certificate therefore has a second part: where the weighted draws leave a fr
 undetermined (its central 94 % interval spans more than :data:`UNDETERMINED` of its prior
 range), the proposal built at the optima is not trusted to cover the configurations this allows,
 and the structure goes to the tempered ladder, whose independent runs start from the prior
-(and whose agreement certifies them). A posterior whose orders are determined keeps the fast
-route at no extra cost.
+(and whose agreement certifies them).
+
+Its third part looks for ridges: a coefficient free up to its prior bound, with the other
+parameters following it along a curved crest (both elements of a Voigt growing together on a
+misfitting isotherm), holds posterior mass that a proposal built at the optima never visits,
+though the log posterior there stays within a few nats of the peak. The ridge probe
+(:func:`_ridge_probe`) follows the profile of the log posterior outwards along each coordinate
+from each mode and estimates the mass the draws do not represent; where it exceeds
+:data:`PROBE_MISSED`, the tempered ladder takes over. ``info["probe"]`` of a certified
+posterior says what was checked (profile points, the share found).
 """
 
 from __future__ import annotations
@@ -80,9 +91,16 @@ UNDETERMINED = 0.25
 NEWTON = 4
 #: Rounds of importance sampling: the Laplace mixture, then one adapted to the weighted draws
 #: of the first (see _adapted). A second round certifies posteriors that the first alone does
-#: not; further rounds did not certify what two left uncertified, so they are not run
-#: (BENCHMARKS.md, "Measurements behind design choices").
+#: not; further rounds of the same kind did not certify what two left uncertified, so they are
+#: not run (BENCHMARKS.md, "Measurements behind design choices"). A third round, a normal
+#: mixture fitted to certified draws (:func:`_fitted`), is run for ln Z alone.
 MAX_ROUNDS = 2
+#: The third round (:func:`_fitted`): draws resampled from the certified weights to fit the
+#: mixture to (k ≤ 4 components by BIC), and the scale of its Student-t components relative
+#: to the fitted covariances (broad: on misfitting structures of real isotherms, 1.6 gave
+#: k̂ < 0.5 where 1.0 and 1.3 often did not; BENCHMARKS.md, fourteenth session).
+FIT_DRAWS = 4000
+FIT_SCALE = 1.6
 DF = 5.0        # Student-t degrees of freedom: heavier tails than the Laplace approximation
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
 
@@ -198,6 +216,234 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
     return f0, u, (w, v)
 
 
+#: The ridge probe (:func:`_ridge_probe`): profile steps of 2, 4, ..., 2^PROBE_STEPS marginal
+#: proposal standard deviations along each coordinate, from each mode, and once on a ridge that
+#: holds mass the proposal misses (a tenth of PROBE_MISSED at one point), up to PROBE_FINER
+#: steps of a quarter of the distance reached; a profile
+#: point deeper than PROBE_DEPTH nats below the mode ends a direction (no mass worth having lies
+#: there).
+PROBE_STEPS = 8
+PROBE_FINER = 16
+PROBE_DEPTH = 15.0
+#: Newton steps of a profile point before it falls back to L-BFGS-B.
+PROFILE_NEWTON = 8
+#: The share of the posterior that the ridge probe may find beyond the proposal's reach for
+#: the weights to certify it. The probe's estimate is from above (on the 74 certified posteriors
+#: of the bundled isotherms, 2-3 times the share of an unguided ladder's draws outside the
+#: reported draws' range); 3 % keeps every posterior that misses 5 % or more off the fast route
+#: (BENCHMARKS.md, fourteenth session).
+PROBE_MISSED = 0.03
+
+
+def _profile_point(f, start: np.ndarray, i: int, value: float, lo: np.ndarray,
+                   hi: np.ndarray):
+    """The maximum of ``f`` over every coordinate but ``i``, which is held at ``value``, near
+    ``start`` within the box (``start``: a point, or rows of them tried in turn until one is in
+    the support), and the curvature of the cross-section there (the precision of
+    its Laplace approximation in the other coordinates; None where it is not peaked).
+
+    Newton steps with a central-difference Hessian (each one vectorised call of ``f``, as
+    :func:`_laplace`), halved until they improve; where the Hessian is not negative definite or
+    the stencil leaves the support, L-BFGS-B (as :func:`_polish`) instead. Returns (point,
+    value, the eigenvalues and eigenvectors of the cross-section's precision or None); the
+    value is −inf where every start leaves the support."""
+    from scipy.optimize import minimize
+
+    start = np.atleast_2d(start)
+    d = start.shape[1]
+    rest = np.delete(np.arange(d), i)
+    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(start[0]))[rest]
+    lo_r, hi_r = lo[rest] + 3e-4 * span, hi[rest] - 3e-4 * span
+
+    def full(r):
+        u = np.empty((len(r), d))
+        u[:, rest] = r
+        u[:, i] = value
+        return u
+
+    def g(r):
+        return f(full(r))
+
+    # The first of the starts given that lies in the support (a start on the line the crest
+    # led to can leave it where a card inequality, such as β ≤ α, cuts across).
+    starts = np.clip(start[:, rest], lo_r, hi_r)
+    values = g(starts)
+    inside = np.flatnonzero(np.isfinite(values))
+    if not inside.size:
+        return full(starts[:1])[0], -math.inf, None
+    r, here = starts[inside[0]], float(values[inside[0]])
+    h = 1e-4 * span
+    for _ in range(PROFILE_NEWTON):
+        out = _hessian(g, r, h)
+        if out is None:
+            break
+        _, grad, hess = out
+        eig = np.linalg.eigvalsh(-hess)
+        if not np.all(np.isfinite(eig)) or eig.min() <= 0:
+            break
+        step = np.linalg.solve(-hess, grad)
+        gain = 0.5 * float(grad @ step)  # the rise the quadratic model promises
+        if gain < 1e-6:
+            return full(r[None, :])[0], here, np.linalg.eigh(-hess)
+        for t in (1.0, 0.5, 0.25, 0.125):
+            cand = np.clip(r + t * step, lo_r, hi_r)
+            value_c = float(g(cand[None, :])[0])
+            if value_c > here:
+                r, here = cand, value_c
+                break
+        else:
+            break
+    # Newton did not settle: L-BFGS-B from where it got, and the volume at its end.
+    hf = 1e-6 * span
+    stencil = np.vstack([np.zeros(d - 1), np.diag(hf), -np.diag(hf)])
+
+    def neg(x):
+        v = g(x[None, :] + stencil)
+        if not np.all(np.isfinite(v)):
+            return (-v[0] if np.isfinite(v[0]) else 1e300), np.zeros(d - 1)
+        return -v[0], -(v[1:d] - v[d:]) / (2 * hf)
+
+    bounds = [(a_ if np.isfinite(a_) else None, b_ if np.isfinite(b_) else None)
+              for a_, b_ in zip(lo_r, hi_r, strict=True)]
+    res = minimize(neg, r, jac=True, method="L-BFGS-B", bounds=bounds,
+                   options={"maxiter": 60, "ftol": 1e-10})
+    if np.isfinite(res.fun) and -res.fun > here:
+        r, here = res.x, float(-res.fun)
+    out = _hessian(g, r, h)
+    cross = None
+    if out is not None:
+        eig = np.linalg.eigh(-out[2])
+        if np.all(np.isfinite(eig[0])) and eig[0].min() > 0:
+            cross = eig
+    return full(r[None, :])[0], here, cross
+
+
+def _ridge_probe(out) -> dict:
+    """Posterior mass that the proposal of a round does not reach, along a ridge.
+
+    The weights certify the posterior only where the proposal's draws land. A ridge along which
+    the posterior stays high while it curves away from the modes (a coefficient free up to its
+    prior bound with the others following it, as where both elements of a Voigt grow together)
+    holds mass that no draw visits, and k̂ cannot see it. From each mode of the proposal, each
+    coordinate is stepped outwards, 2, 4, ... marginal standard deviations of the proposal (and
+    in finer steps once on a ridge that holds mass the proposal misses), and the log posterior
+    maximised over the other coordinates at each step (the profile, which follows the ridge's
+    crest; the first step starts on the line of the mode's conditional means, each later one
+    where the last two profile points lead). Where a profile point's importance weight exceeds the largest of the draws' (the proposal under-represents the
+    posterior there), the mass that the draws do not represent around it is estimated from the
+    profile's height less the proposal's density times that largest weight, the Laplace volume
+    of the cross-section there and the step; the sum of those, over the evidence that the draws
+    give, estimates the share of the posterior that the proposal misses (roughly, and from
+    above where the cross-section is not peaked: the crest's height stands for all of it).
+
+    Returns ``{"points": profile points evaluated, "missed": that share, "coordinate": the
+    coordinate of the profile that holds most of it (None if none), "components": a normal
+    for each such profile point, ``(mean, (w, v), ln mass)`` in the form of the proposal's
+    factors (the cross-section's Laplace covariance, and the square of the step from the
+    profile point before along the crest's direction)}``."""
+    x, log_w, finite, _, prop = out
+    log_target = prop["log_target"]
+    d = prop["means"].shape[1]
+    lo = prop.get("lo", np.full(d, -np.inf))
+    hi = prop.get("hi", np.full(d, np.inf))
+    log_q = _mixture_log_pdf(prop["factors"], prop["means"], prop["log_weights"])
+    top = float(np.max(log_w[finite]))
+    log_z = float(logsumexp(log_w[finite]) - math.log(len(log_w)))
+    base = prop.get("base", prop)
+    masses = {}  # coordinate -> ln of the mass found beyond the proposal's reach
+    components = []
+    points = 0
+    for mean, (w, v) in zip(base["means"], base["factors"], strict=True):
+        peak = float(log_target(mean[None, :])[0])
+        if not np.isfinite(peak):
+            continue
+        cov = (v / w[None, :]) @ v.T
+        sd = np.sqrt(np.diag(cov))  # marginal sd of each coordinate
+        for i in range(d):
+            rest = np.delete(np.arange(d), i)
+            for sign in (1.0, -1.0):
+                u, before = mean, mean - cov[:, i] / cov[i, i] * sd[i]
+                reach, finer = 2.0, None  # in marginal sds; finer: the step once on a ridge
+                for _ in range(PROBE_STEPS + PROBE_FINER):
+                    value = mean[i] + sign * reach * sd[i]
+                    if not lo[i] < value < hi[i]:
+                        break
+                    start = u + (u - before) * (value - u[i]) / (u[i] - before[i])
+                    before = u
+                    u, lp, cross = _profile_point(log_target, np.array([start, u, mean]), i,
+                                                  value, lo, hi)
+                    step = abs(u[i] - before[i])
+                    tangent = (u - before) / (u[i] - before[i])  # the crest's direction
+                    points += 1
+                    if not np.isfinite(lp) or lp < peak - PROBE_DEPTH:
+                        break
+                    covered = float(log_q(u[None, :])[0]) + top - lp
+                    if covered >= 0 or cross is None:
+                        reach = 2 * reach if finer is None else reach + finer
+                        continue  # the draws weigh this region at least as much
+                    # The density beyond what the draws' largest weight represents here.
+                    eig, vec = cross
+                    volume = 0.5 * (d - 1) * math.log(2 * math.pi) - 0.5 * float(np.sum(np.log(eig)))
+                    mass = lp + math.log1p(-math.exp(covered)) + volume + math.log(step)
+                    masses[i] = float(np.logaddexp(masses.get(i, -math.inf), mass))
+                    if finer is None and mass - log_z > math.log(PROBE_MISSED / 10):
+                        # On a ridge that holds mass the proposal misses: from here, steps of
+                        # a quarter of the way so far, which follow its crest where it bends.
+                        finer = reach / 4
+                    reach = 2 * reach if finer is None else reach + finer
+                    # The cross-section's covariance, and the step along the crest.
+                    full = np.zeros((d, d))
+                    full[np.ix_(rest, rest)] = (vec / eig[None, :]) @ vec.T
+                    full += step**2 * np.outer(tangent, tangent)
+                    e, V = np.linalg.eigh(full)
+                    components.append((u.copy(), (1.0 / e, V), mass))
+    if not masses:
+        return {"points": points, "missed": 0.0, "coordinate": None, "components": []}
+    where = max(masses, key=masses.get)
+    missed = float(np.exp(logsumexp(list(masses.values())) - log_z))
+    return {"points": points, "missed": missed, "coordinate": where, "components": components}
+
+
+def _with_ridge(out, probe: dict, n_proposals: int, rng: np.random.Generator):
+    """A round whose proposal adds to a round's the normals of the ridge probe (Student-t of the
+    same scale), so that its draws reach the ridge: the round's proposal keeps 1 − s of the
+    weight, the ridge's components s (the share the probe found, between 0.1 and 0.5),
+    divided as the masses the probe estimated. None where too few draws are in the support."""
+    _, _, _, n_modes, prop = out
+    comps = probe["components"]
+    share = min(0.5, max(0.1, probe["missed"]))
+    masses = np.array([c[2] for c in comps])
+    lw_old = prop["log_weights"] - logsumexp(prop["log_weights"]) + math.log1p(-share)
+    lw_new = masses - logsumexp(masses) + math.log(share)
+    proposal = {**prop, "factors": list(prop["factors"]) + [c[1] for c in comps],
+                "means": np.vstack([prop["means"], [c[0] for c in comps]]),
+                "log_weights": np.concatenate([lw_old, lw_new]),
+                "base": prop.get("base", prop)}
+    drawn = _draw(proposal, n_proposals, rng)
+    if drawn is None:
+        return None
+    x, log_w, finite, z = drawn
+    return x, log_w, finite, n_modes, {**proposal, "z": z}
+
+
+def _mixture_log_pdf(factors, means, log_weights):
+    """The log density of the Student-t mixture of :func:`_mvt` at any points."""
+    d = means.shape[1]
+    norm = log_weights - logsumexp(log_weights)
+    const = gammaln((DF + d) / 2) - gammaln(DF / 2) - 0.5 * d * math.log(DF * math.pi)
+
+    def log_pdf(y):
+        terms = []
+        for lw, mean, (w, v) in zip(norm, means, factors, strict=True):
+            proj = (y - mean) @ v  # coordinates along the eigenvectors
+            maha = np.sum(proj * proj * w, axis=1)
+            log_det = -0.5 * np.sum(np.log(w))  # log sqrt(det covariance)
+            terms.append(lw + const - log_det - 0.5 * (DF + d) * np.log1p(maha / DF))
+        return logsumexp(np.array(terms), axis=0)
+
+    return log_pdf
+
+
 def _mvt(factors, means, log_weights, n: int, rng: np.random.Generator):
     """Draws from a mixture of multivariate t (``DF``) and the log density of any points.
 
@@ -211,19 +457,7 @@ def _mvt(factors, means, log_weights, n: int, rng: np.random.Generator):
     g = rng.chisquare(DF, size=n) / DF
     a = np.array([v / np.sqrt(w) for w, v in factors])
     x = means[which] + np.einsum("nij,nj->ni", a[which], z) / np.sqrt(g)[:, None]
-
-    def log_pdf(y):
-        terms = []
-        const = gammaln((DF + d) / 2) - gammaln(DF / 2) - 0.5 * d * math.log(DF * math.pi)
-        for lw, mean, (w, v) in zip(log_weights - logsumexp(log_weights), means, factors,
-                                    strict=True):
-            proj = (y - mean) @ v  # coordinates along the eigenvectors
-            maha = np.sum(proj * proj * w, axis=1)
-            log_det = -0.5 * np.sum(np.log(w))  # log sqrt(det covariance)
-            terms.append(lw + const - log_det - 0.5 * (DF + d) * np.log1p(maha / DF))
-        return logsumexp(np.array(terms), axis=0)
-
-    return x, log_pdf
+    return x, _mixture_log_pdf(factors, means, log_weights)
 
 
 #: Proposal draws handed on as the guide of the tempered ladder where the weights do not certify
@@ -254,11 +488,19 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     -------
     (PosteriorResult, Evidence or None, dict) or (None, None, dict)
         The dict states the certificate (``k_hat``, ``ess`` of the weights, ``n_modes``,
-        ``seconds``) or, when the route does not apply, ``reason`` (and, where the weights
-        were computed but do not certify, ``proposal_draws``: up to :data:`GUIDE_DRAWS` draws
-        of the proposal in the sampling coordinates, a guide for the tempered ladder). The evidence is None when
-        0.5 ≤ k̂ < 0.7 (see :data:`K_HAT_EVIDENCE`). The posterior's ESS is that of the
-        resampled draws, 1/(1/ESS_weights + 1/n_draws).
+        ``rounds`` run and ``k_hat_rounds``, the k̂ of each, ``widest`` order, ``probe``: the
+        ridge probe's profile ``points`` and the share of the posterior it found ``missed``,
+        with the ``ridge`` coordinate and the share ``covered`` where a round widened along it
+        gives the posterior, ``seconds``) or, when the route does not apply, ``reason`` (with
+        ``undetermined`` or ``ridge`` where those parts of the certificate failed, and, where
+        the weights were computed but do not certify,
+        ``proposal_draws``: up to :data:`GUIDE_DRAWS` draws of the proposal in the sampling
+        coordinates, a guide for the tempered ladder). A first round that does not certify
+        ln Z (k̂ ≥ 0.5 or too few effective draws) is followed by the adapted round, and where
+        no round certifies ln Z but one certifies the posterior, by a round fitted to its draws
+        (:func:`_fitted`); the certified round with the smallest k̂ gives the posterior, and ln Z
+        where its k̂ < 0.5 (see :data:`K_HAT_EVIDENCE`; else the evidence is None). The
+        posterior's ESS is that of the resampled draws, 1/(1/ESS_weights + 1/n_draws).
     """
     from .evidence import Evidence, log_support_fraction
     from .results import result_from_draws
@@ -270,20 +512,30 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)
     if isinstance(out, dict):
         return None, None, out
-    rounds = 1
-    while True:
-        x, log_w, finite, n_modes, _ = out
-        smoothed, k_hat = psis(log_w[finite])
-        w = np.exp(smoothed - logsumexp(smoothed))
-        ess = float(1.0 / np.sum(w**2))
-        if (k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE) or rounds == MAX_ROUNDS:
-            break
+    rounds = [_assessed(out)]
+    if not _certifies(rounds[0], evidence=True):
+        # Not certified, or certified with weights too heavy-tailed for ln Z (0.5 ≤ k̂ < 0.7,
+        # typical of a structure that misfits): a round adapted to the weighted draws.
         adapted = _adapted(out, n_proposals, rng)
-        if adapted is None:
-            break
-        out, rounds = adapted, rounds + 1
+        if adapted is not None:
+            rounds.append(_assessed(adapted))
+    certified = [r for r in rounds if _certifies(r)]
+    if certified and not any(_certifies(r, evidence=True) for r in certified):
+        # The posterior is certified, its ln Z not: a round whose proposal is a normal
+        # mixture fitted to the certified draws usually has lighter tails; where its k̂ is
+        # below 0.5 it gives ln Z, which would otherwise take a tempered ladder.
+        fitted = _fitted(min(certified, key=lambda r: r[2]), n_proposals, rng)
+        if fitted is not None:
+            rounds.append(_assessed(fitted))
+            certified = [r for r in rounds if _certifies(r)]
+    # The certified round with the lightest tail (the smallest k̂) gives the posterior and,
+    # where k̂ < 0.5, ln Z; with none certified, the last round says why.
+    best = min(certified, key=lambda r: r[2]) if certified else rounds[-1]
+    out, smoothed, k_hat, w, ess = best
+    x, log_w, finite, n_modes, _ = out
+    k_hats = [float(r[2]) for r in rounds]
     info = {"k_hat": k_hat, "ess": ess, "n_modes": n_modes, "n_proposals": n_proposals,
-            "rounds": rounds}
+            "rounds": len(rounds), "k_hat_rounds": k_hats}
     certified = k_hat < K_HAT_MAX and ess >= ESS_MIN_IMPORTANCE
     if not certified:
         info["reason"] = (f"importance weights not certified (Pareto k {k_hat:.2f}, ESS "
@@ -297,6 +549,34 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
             info["reason"] = (f"the order {name} is undetermined (its 94 % interval spans "
                               f"{100 * share:.0f} % of its prior range), so the proposal at the "
                               "optima may miss configurations the data allow")
+        else:
+            probe = _ridge_probe(out)
+            info["probe"] = {"points": probe["points"], "missed": probe["missed"]}
+            if probe["missed"] > PROBE_MISSED:
+                # A round whose proposal reaches along the ridge: it gives the posterior where
+                # its weights certify it and its own probe finds nothing more.
+                ridge = lik.param_names[probe["coordinate"]]
+                info["probe"]["ridge"] = ridge
+                widened = _with_ridge(out, probe, n_proposals, rng)
+                again = None
+                if widened is not None:
+                    assessed = _assessed(widened)
+                    k_hats.append(assessed[2])
+                    if _certifies(assessed):
+                        again = _ridge_probe(widened)
+                if again is not None and again["missed"] <= PROBE_MISSED:
+                    out, smoothed, k_hat, w, ess = assessed
+                    x, log_w, finite, n_modes, _ = out
+                    info.update(k_hat=k_hat, ess=ess, rounds=len(k_hats))
+                    info["probe"].update(points=probe["points"] + again["points"],
+                                         missed=again["missed"], covered=probe["missed"])
+                else:
+                    certified = False
+                    info["rounds"] = len(k_hats)
+                    info["ridge"] = ridge
+                    info["reason"] = (f"a ridge of the posterior along {ridge} holds about "
+                                      f"{100 * probe['missed']:.0f} % of its mass where the "
+                                      "proposal at the optima does not reach")
     if not certified:
         # The proposal's draws cover every optimum: they guide the samplers that take over
         # (an array, so only on this path: a certified run's info goes into summary.json).
@@ -335,6 +615,23 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
                             method="importance", log_support=log_s,
                             n_likelihood=int(n_proposals), seconds=info["seconds"])
     return post, evidence, info
+
+
+def _assessed(out):
+    """A round of importance sampling with its Pareto-smoothed log weights, k̂, normalised
+    smoothed weights and their ESS: ``(out, smoothed, k_hat, w, ess)``."""
+    _, log_w, finite, _, _ = out
+    smoothed, k_hat = psis(log_w[finite])
+    w = np.exp(smoothed - logsumexp(smoothed))
+    return out, smoothed, float(k_hat), w, float(1.0 / np.sum(w**2))
+
+
+def _certifies(assessed, *, evidence: bool = False) -> bool:
+    """Whether a round's weights certify the posterior (k̂ < 0.7, ESS ≥ 1000), and with
+    ``evidence`` its ln Z too (k̂ < 0.5)."""
+    _, _, k_hat, _, ess = assessed
+    limit = K_HAT_EVIDENCE if evidence else K_HAT_MAX
+    return k_hat < limit and ess >= ESS_MIN_IMPORTANCE
 
 
 def _widest(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray) -> tuple[str, float]:
@@ -421,8 +718,9 @@ def _proposal(log_prob, tr, u_modes, polished: dict, n_proposals: int,
     factors = [(w / SCALE**2, v) for _, _, (w, v) in peaks]
     # Each mode weighted by its Laplace mass: height × sqrt(det covariance).
     log_weights = np.array([p[0] - 0.5 * np.sum(np.log(p[2][0])) for p in peaks])
+    box = free if unbounded else (tr.lo_u, tr.hi_u)
     proposal = {"factors": factors, "means": means, "log_weights": log_weights,
-                "log_target": log_target, "to_u": to_u}
+                "log_target": log_target, "to_u": to_u, "lo": box[0], "hi": box[1]}
     out = _draw(proposal, n_proposals, rng)
     if out is None:
         return {"reason": LEAVE}
@@ -446,6 +744,46 @@ def _draw(proposal: dict, n_proposals: int, rng: np.random.Generator):
     if finite.sum() < 0.1 * n_proposals:
         return None
     return proposal["to_u"](z), log_w, finite, z
+
+
+def _fitted(assessed, n_proposals: int, rng: np.random.Generator):
+    """A round for ln Z where a certified round's weights are too heavy-tailed for it
+    (0.5 ≤ k̂ < 0.7): half the first proposal (its coverage of every optimum), half a normal
+    mixture (:class:`~._mixture._GaussianMixture`, k ≤ 4 by BIC) fitted to :data:`FIT_DRAWS`
+    draws resampled from the certified weights, each of its components a Student-t of scale
+    :data:`FIT_SCALE` times the component's covariance, in the coordinates of the certified
+    round's proposal. The mixture follows a skewed or curved posterior that one Laplace
+    approximation or one matched component does not. None where the fit fails."""
+    from ._mixture import _GaussianMixture
+
+    out, _, _, w, _ = assessed
+    _, _, finite, n_modes, prop = out
+    zs = prop["z"][finite]
+    picked = zs[rng.choice(len(zs), size=FIT_DRAWS, p=w)]
+    try:
+        mix = _GaussianMixture.fit(picked, rng)
+    except np.linalg.LinAlgError:
+        return None
+    if mix is None:
+        return None
+    factors = []
+    for chol in mix.chols:
+        eig, vec = np.linalg.eigh(FIT_SCALE**2 * (chol @ chol.T))
+        if not np.all(np.isfinite(eig)) or eig.min() <= 0:
+            return None
+        factors.append((1.0 / eig, vec))
+    base = prop.get("base", prop)
+    lw0 = base["log_weights"] - logsumexp(base["log_weights"])
+    proposal = {**prop, "factors": list(base["factors"]) + factors,
+                "means": np.vstack([base["means"], mix.means]),
+                "log_weights": np.concatenate([lw0 + math.log(0.5),
+                                               np.log(mix.weights) + math.log(0.5)]),
+                "base": base}
+    drawn = _draw(proposal, n_proposals, rng)
+    if drawn is None:
+        return None
+    x, log_w, finite, z = drawn
+    return x, log_w, finite, n_modes, {**proposal, "z": z}
 
 
 def _adapted(first, n_proposals: int, rng: np.random.Generator):

@@ -66,10 +66,31 @@ def invisible():
 def test_weights_alone_certify_a_posterior_that_misses_a_configuration(invisible, monkeypatch):
     data, reference = invisible
     monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)  # the first part alone
+    monkeypatch.setattr(importance_module, "PROBE_MISSED", np.inf)
     r = _compare(data, 24)
     assert r.posterior.sampler == "importance" and r.posterior.converged
     assert r.criteria.importance["k_hat"] < importance_module.K_HAT_MAX
     assert _outside(r.posterior, reference) > 0.2
+
+
+def test_the_ridge_probe_alone_finds_what_the_proposal_misses(invisible, monkeypatch):
+    """Without the rule on orders, the ridge probe finds the mass the proposal misses (the
+    invisible springpot's coefficient free towards its bound, its order following); the round
+    widened along it, or else the tempered ladder, gives a posterior that covers the
+    reference."""
+    data, reference = invisible
+    monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)
+    r = _compare(data, 24)
+    assert r.posterior.converged
+    if r.posterior.sampler == "importance":
+        probe = r.criteria.importance["probe"]
+        assert probe["covered"] > importance_module.PROBE_MISSED
+        assert probe["missed"] <= importance_module.PROBE_MISSED
+    else:
+        assert r.posterior.sampler == "ladder"
+        assert any("ridge of the posterior" in n for n in r.criteria.warnings)
+    outside = _outside(r.posterior, reference)
+    assert outside < 0.05
 
 
 def test_an_undetermined_order_sends_the_structure_to_the_ladder(invisible):

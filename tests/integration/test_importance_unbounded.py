@@ -156,14 +156,20 @@ def test_the_undetermined_order_rule_still_guards_the_unbounded_proposal(maxwell
     """The z proposal's weights alone pass on the demo's Maxwell (k̂ < 0.7, ESS ≥ 1000) but
     miss the configuration with a1 ≈ b1 large and β near 1 (about two fifths of the reference's
     draws lie outside their range); α spans half its prior, so the route is not certified and
-    the ladder gives the posterior."""
+    the ladder gives the posterior. Without that rule, the ridge probe finds the same
+    configuration; without both, the weights alone certify the posterior that misses it."""
     _, _, runs = maxwell
     lik, modes, _, ref = runs["constant"]
     post, _, info = importance_module.importance_posterior(lik, modes, seed=0)
     assert post is None and info["undetermined"] == "alpha", info
     assert info["k_hat"] < importance_module.K_HAT_MAX
     assert info["ess"] >= importance_module.ESS_MIN_IMPORTANCE
-    monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)  # the weights alone
+    monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)
+    # Without the rule, the ridge probe finds the missed configuration on its own.
+    post, _, info = importance_module.importance_posterior(lik, modes, seed=0)
+    assert post is None and "ridge" in info, info
+    assert info["probe"]["missed"] > importance_module.PROBE_MISSED
+    monkeypatch.setattr(importance_module, "PROBE_MISSED", math.inf)  # the weights alone
     post, _, info = importance_module.importance_posterior(lik, modes, seed=0)
     assert post is not None
     k = lik.structure.n_params

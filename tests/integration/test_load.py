@@ -39,6 +39,9 @@ def written(tmp_path_factory):
     out = tmp_path_factory.mktemp("voigt")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", bf.errors.PredictiveWarning)  # Pareto k, if above 0.7
+        # q under constant and proportional noise: 94 % intervals that meet at their ends
+        # (0.23-0.244 and 0.244-0.258), which the comparison reports; not what is tested here.
+        warnings.simplefilter("ignore", bf.errors.NoiseWarning)
         result = bf.compare(bf.read(DATA), "voigt", workers=1, progress=False, seed=1)
     bf.write_outputs(result, out, figures=False)
     return result, out

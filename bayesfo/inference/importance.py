@@ -225,6 +225,9 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
 PROBE_STEPS = 8
 PROBE_FINER = 16
 PROBE_DEPTH = 15.0
+#: At most this many profile points per probe (a bound on its cost: a typical posterior of
+#: four to six parameters takes 10-30, one with a long ridge about 50).
+PROBE_POINTS = 200
 #: Newton steps of a profile point before it falls back to L-BFGS-B.
 PROFILE_NEWTON = 8
 #: The share of the posterior that the ridge probe may find beyond the proposal's reach for
@@ -366,7 +369,7 @@ def _ridge_probe(out) -> dict:
                 reach, finer = 2.0, None  # in marginal sds; finer: the step once on a ridge
                 for _ in range(PROBE_STEPS + PROBE_FINER):
                     value = mean[i] + sign * reach * sd[i]
-                    if not lo[i] < value < hi[i]:
+                    if not lo[i] < value < hi[i] or points >= PROBE_POINTS:
                         break
                     start = u + (u - before) * (value - u[i]) / (u[i] - before[i])
                     before = u

@@ -378,6 +378,19 @@ def _diagnostics_section(comparison) -> str:
                 how += (f"; every fractional order determined (the widest, "
                         f"{widest['parameter']}, spans {100 * widest['share_of_prior']:.0f} % of "
                         "its prior range)")
+            probe = info.get("probe") or {}
+            if probe:
+                how += (f"; ridge probe: {probe.get('points', 0)} profile points, "
+                        f"{_num(100 * probe.get('missed', 0.0), '.1f')} % of the posterior "
+                        "beyond the proposal's reach")
+                if probe.get("ridge"):
+                    how += (f" (after widening it along a ridge in {_e(probe['ridge'])}, where "
+                            f"the first proposal missed an estimated "
+                            f"{_num(100 * probe.get('covered', 0.0), '.0f')} %)")
+            rounds = info.get("k_hat_rounds") or []
+            if len(rounds) > 1:
+                how += (f"; {len(rounds)} rounds of importance sampling (k̂ "
+                        + " → ".join(_num(k, ".2f") for k in rounds) + ")")
         else:
             how = (f"{post.n_walkers} walkers × {post.n_steps} steps, τ max "
                    f"{_num(tau, '.0f')}, acceptance {_num(post.acceptance, '.2f')}")

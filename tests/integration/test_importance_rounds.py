@@ -16,6 +16,7 @@ ln Z.
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from pathlib import Path
 from types import SimpleNamespace
@@ -246,3 +247,16 @@ def test_a_ridge_the_widened_round_does_not_certify_goes_to_the_ladder(voigt_150
     assert post is None and ev is None
     assert info["ridge"] == "a1" and "ridge of the posterior along a1" in info["reason"]
     assert len(info["proposal_draws"]) > 0  # the guide of the ladder that takes over
+
+
+def test_the_report_says_what_the_certificate_checked():
+    """The report's diagnostics name the ridge probe, the widening and the rounds."""
+    from bayesfo.output.report import _diagnostics_section
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        comparison = bf.compare(bf.read(SWEEP / "Tp150C.csv"), "voigt", noise="constant",
+                                workers=1, progress=False)
+    text = _diagnostics_section(comparison)
+    assert "ridge probe:" in text and "after widening it along a ridge in a1" in text
+    assert re.search(r"4 rounds of importance sampling \(k̂ (-?[0-9.]+ → ){3}-?[0-9.]+\)", text)

@@ -228,6 +228,12 @@ PROBE_DEPTH = 15.0
 #: At most this many profile points per probe (a bound on its cost: a typical posterior of
 #: four to six parameters takes 10-30, one with a long ridge about 50).
 PROBE_POINTS = 200
+#: Posteriors of more parameters are not probed: each profile point maximises over all the
+#: other coordinates, so the cost grows with the square of the dimension (on the joint
+#: posterior of a Zener master and 19 shifts, 19 s against 3 s for the rest of the route). The
+#: joint master-curve posteriors are such; their shifts' intervals are calibrated
+#: (BENCHMARKS.md, thirteenth session), and ``info["probe"]["skipped"]`` says why.
+PROBE_MAX_DIM = 12
 #: Newton steps of a profile point before it falls back to L-BFGS-B.
 PROFILE_NEWTON = 8
 #: The share of the posterior that the ridge probe may find beyond the proposal's reach for
@@ -494,7 +500,8 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
         ``rounds`` run and ``k_hat_rounds``, the k̂ of each, ``widest`` order, ``probe``: the
         ridge probe's profile ``points`` and the share of the posterior it found ``missed``,
         with the ``ridge`` coordinate and the share ``covered`` where a round widened along it
-        gives the posterior, ``seconds``) or, when the route does not apply, ``reason`` (with
+        gives the posterior, or why it was ``skipped`` (more than :data:`PROBE_MAX_DIM`
+        parameters), ``seconds``) or, when the route does not apply, ``reason`` (with
         ``undetermined`` or ``ridge`` where those parts of the certificate failed, and, where
         the weights were computed but do not certify,
         ``proposal_draws``: up to :data:`GUIDE_DRAWS` draws of the proposal in the sampling
@@ -552,6 +559,9 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
             info["reason"] = (f"the order {name} is undetermined (its 94 % interval spans "
                               f"{100 * share:.0f} % of its prior range), so the proposal at the "
                               "optima may miss configurations the data allow")
+        elif lik.ndim > PROBE_MAX_DIM:
+            info["probe"] = {"points": 0, "missed": None,
+                             "skipped": f"{lik.ndim} parameters, more than {PROBE_MAX_DIM}"}
         else:
             probe = _ridge_probe(out)
             info["probe"] = {"points": probe["points"], "missed": probe["missed"]}

@@ -379,7 +379,9 @@ def _diagnostics_section(comparison) -> str:
                         f"{widest['parameter']}, spans {100 * widest['share_of_prior']:.0f} % of "
                         "its prior range)")
             probe = info.get("probe") or {}
-            if probe:
+            if probe.get("skipped"):
+                how += f"; ridge probe not run ({_e(probe['skipped'])})"
+            elif probe:
                 how += (f"; ridge probe: {probe.get('points', 0)} profile points, "
                         f"{_num(100 * probe.get('missed', 0.0), '.1f')} % of the posterior "
                         "beyond the proposal's reach")

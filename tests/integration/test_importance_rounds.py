@@ -260,3 +260,17 @@ def test_the_report_says_what_the_certificate_checked():
     text = _diagnostics_section(comparison)
     assert "ridge probe:" in text and "after widening it along a ridge in a1" in text
     assert re.search(r"4 rounds of importance sampling \(k̂ (-?[0-9.]+ → ){3}-?[0-9.]+\)", text)
+
+
+def test_a_posterior_of_many_parameters_is_not_probed_and_says_so(fkv, monkeypatch):
+    """Above PROBE_MAX_DIM parameters (the joint master-curve posteriors) the probe is skipped,
+    and the certificate says so; the posterior is that of the rounds alone."""
+    lik, modes, _, _ = fkv
+    monkeypatch.setattr(importance_module, "PROBE_MAX_DIM", lik.ndim - 1)
+    post, _, info = importance_module.importance_posterior(lik, modes, seed=0)
+    assert post is not None
+    assert info["probe"]["points"] == 0 and "more than" in info["probe"]["skipped"]
+    monkeypatch.setattr(importance_module, "PROBE_MAX_DIM", lik.ndim)
+    probed, _, info = importance_module.importance_posterior(lik, modes, seed=0)
+    assert info["probe"]["points"] > 0
+    np.testing.assert_array_equal(post.samples_scaled, probed.samples_scaled)

@@ -89,12 +89,12 @@ K_HAT_EVIDENCE = 0.5
 UNDETERMINED = 0.25
 
 NEWTON = 4
-#: Rounds of importance sampling: the Laplace mixture, then one adapted to the weighted draws
-#: of the first (see _adapted). A second round certifies posteriors that the first alone does
-#: not; further rounds of the same kind did not certify what two left uncertified, so they are
-#: not run (BENCHMARKS.md, "Measurements behind design choices"). A third round, a normal
-#: mixture fitted to certified draws (:func:`_fitted`), is run for ln Z alone.
-MAX_ROUNDS = 2
+# Rounds of importance sampling: the Laplace mixture, then one adapted to the weighted draws
+# of the first (see _adapted). A second round certifies posteriors that the first alone does
+# not; further rounds of the same kind did not certify what two left uncertified, so they are
+# not run (BENCHMARKS.md, "Measurements behind design choices"). A third round, a normal
+# mixture fitted to certified draws (_fitted), is run for ln Z; a fourth, widened along a
+# ridge (_with_ridge), where the ridge probe finds one.
 #: The third round (:func:`_fitted`): draws resampled from the certified weights to fit the
 #: mixture to (k ≤ 4 components by BIC), and the scale of its Student-t components relative
 #: to the fitted covariances (broad: on misfitting structures of real isotherms, 1.6 gave
@@ -338,8 +338,9 @@ def _ridge_probe(out) -> dict:
     in finer steps once on a ridge that holds mass the proposal misses), and the log posterior
     maximised over the other coordinates at each step (the profile, which follows the ridge's
     crest; the first step starts on the line of the mode's conditional means, each later one
-    where the last two profile points lead). Where a profile point's importance weight exceeds the largest of the draws' (the proposal under-represents the
-    posterior there), the mass that the draws do not represent around it is estimated from the
+    where the last two profile points lead). Where a profile point's importance weight exceeds
+    the largest of the draws' (the proposal under-represents the posterior there), the mass
+    that the draws do not represent around it is estimated from the
     profile's height less the proposal's density times that largest weight, the Laplace volume
     of the cross-section there and the step; the sum of those, over the evidence that the draws
     give, estimates the share of the posterior that the proposal misses (roughly, and from
@@ -583,6 +584,15 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
                     info.update(k_hat=k_hat, ess=ess, rounds=len(k_hats))
                     info["probe"].update(points=probe["points"] + again["points"],
                                          missed=again["missed"], covered=probe["missed"])
+                    name, share = _widest(lik, tr, x[finite], w)
+                    info["widest"] = {"parameter": name, "share_of_prior": share}
+                    if share > UNDETERMINED:  # the ridge runs along an order
+                        certified = False
+                        info["undetermined"] = name
+                        info["reason"] = (f"the order {name} is undetermined (its 94 % interval "
+                                          f"spans {100 * share:.0f} % of its prior range along "
+                                          f"a ridge in {ridge}), so the proposal at the optima "
+                                          "may miss configurations the data allow")
                 else:
                     certified = False
                     info["rounds"] = len(k_hats)

@@ -65,10 +65,12 @@ import math
 import time
 
 import numpy as np
-from scipy.special import gammaln, logsumexp
+from scipy.special import logsumexp
 
 from ..errors import InputError
 from ._arviz import psis
+from ._peaks import DF, _hessian, _mixture_log_pdf, _polish
+from ._ridge import PROBE_MAX_DIM, PROBE_MISSED, _ridge_probe
 from .likelihood import Likelihood
 from .transform import _Unbounded
 
@@ -101,69 +103,7 @@ NEWTON = 4
 #: k̂ < 0.5 where 1.0 and 1.3 often did not; BENCHMARKS.md, fourteenth session).
 FIT_DRAWS = 4000
 FIT_SCALE = 1.6
-DF = 5.0        # Student-t degrees of freedom: heavier tails than the Laplace approximation
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
-
-
-def _hessian(f, u0: np.ndarray, h: np.ndarray):
-    """Gradient and Hessian of ``f`` (vectorised over rows) at ``u0`` by central differences,
-    in one call of ``f``; None if a point of the stencil leaves the support."""
-    d = u0.size
-    eye = np.eye(d) * h
-    pts = [u0]
-    for i in range(d):
-        pts += [u0 + eye[i], u0 - eye[i]]
-    pairs = [(i, j) for i in range(d) for j in range(i + 1, d)]
-    for i, j in pairs:
-        pts += [u0 + eye[i] + eye[j], u0 + eye[i] - eye[j], u0 - eye[i] + eye[j],
-                u0 - eye[i] - eye[j]]
-    v = f(np.array(pts))
-    if not np.all(np.isfinite(v)):
-        return None
-    f0 = v[0]
-    grad = np.empty(d)
-    hess = np.empty((d, d))
-    for i in range(d):
-        fp, fm = v[1 + 2 * i], v[2 + 2 * i]
-        grad[i] = (fp - fm) / (2 * h[i])
-        hess[i, i] = (fp - 2 * f0 + fm) / h[i] ** 2
-    base = 1 + 2 * d
-    for k, (i, j) in enumerate(pairs):
-        pp, pm, mp, mm = v[base + 4 * k: base + 4 * k + 4]
-        hess[i, j] = hess[j, i] = (pp - pm - mp + mm) / (4 * h[i] * h[j])
-    return f0, grad, hess
-
-
-def _polish(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """The maximum of the log posterior ``f`` near ``u0`` within the box, by L-BFGS-B.
-
-    The optima come from least squares weighted by the data's magnitude; under another noise
-    model (a constant σ) the posterior's mode lies elsewhere, much higher (BENCHMARKS.md,
-    "Measurements behind design choices"), beyond the reach of a few Newton steps that must
-    stay inside the box where a coefficient sits on its prior bound."""
-    from scipy.optimize import minimize
-
-    f0 = f(u0[None, :])[0]
-    if not np.isfinite(f0):
-        return u0
-
-    d = u0.size
-    h = 1e-6 * np.where(np.isfinite(hi - lo), hi - lo, 1.0)
-    stencil = np.vstack([np.zeros(d), np.diag(h), -np.diag(h)])
-
-    def neg(u):
-        # Value and central-difference gradient in one vectorised call.
-        v = f(u[None, :] + stencil)
-        if not np.all(np.isfinite(v)):
-            v0 = v[0]
-            return (-v0 if np.isfinite(v0) else 1e300), np.zeros(d)
-        return -v[0], -(v[1:d + 1] - v[d + 1:]) / (2 * h)
-
-    bounds = [(a if np.isfinite(a) else None, b if np.isfinite(b) else None)
-              for a, b in zip(lo + h, hi - h, strict=True)]
-    res = minimize(neg, np.clip(u0, lo + h, hi - h), jac=True, method="L-BFGS-B",
-                   bounds=bounds, options={"maxiter": 200, "ftol": 1e-12})
-    return res.x if np.isfinite(res.fun) and -res.fun > f0 else u0
 
 
 def _polished(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -216,204 +156,6 @@ def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: in
     return f0, u, (w, v)
 
 
-#: The ridge probe (:func:`_ridge_probe`): profile steps of 2, 4, ..., 2^PROBE_STEPS marginal
-#: proposal standard deviations along each coordinate, from each mode, and once on a ridge that
-#: holds mass the proposal misses (a tenth of PROBE_MISSED at one point), up to PROBE_FINER
-#: steps of a quarter of the distance reached; a profile
-#: point deeper than PROBE_DEPTH nats below the mode ends a direction (no mass worth having lies
-#: there).
-PROBE_STEPS = 8
-PROBE_FINER = 16
-PROBE_DEPTH = 15.0
-#: At most this many profile points per probe (a bound on its cost: a typical posterior of
-#: four to six parameters takes 10-30, one with a long ridge about 50).
-PROBE_POINTS = 200
-#: Posteriors of more parameters are not probed: each profile point maximises over all the
-#: other coordinates, so the cost grows with the square of the dimension (on the joint
-#: posterior of a Zener master and 19 shifts, 19 s against 3 s for the rest of the route). The
-#: joint master-curve posteriors are such; their shifts' intervals are calibrated
-#: (BENCHMARKS.md, thirteenth session), and ``info["probe"]["skipped"]`` says why.
-PROBE_MAX_DIM = 12
-#: Newton steps of a profile point before it falls back to L-BFGS-B.
-PROFILE_NEWTON = 8
-#: The share of the posterior that the ridge probe may find beyond the proposal's reach for
-#: the weights to certify it. The probe's estimate is from above (on the 74 certified posteriors
-#: of the bundled isotherms, 2-3 times the share of an unguided ladder's draws outside the
-#: reported draws' range); 3 % keeps every posterior that misses 5 % or more off the fast route
-#: (BENCHMARKS.md, fourteenth session).
-PROBE_MISSED = 0.03
-
-
-def _profile_point(f, start: np.ndarray, i: int, value: float, lo: np.ndarray,
-                   hi: np.ndarray):
-    """The maximum of ``f`` over every coordinate but ``i``, which is held at ``value``, near
-    ``start`` within the box (``start``: a point, or rows of them tried in turn until one is in
-    the support), and the curvature of the cross-section there (the precision of
-    its Laplace approximation in the other coordinates; None where it is not peaked).
-
-    Newton steps with a central-difference Hessian (each one vectorised call of ``f``, as
-    :func:`_laplace`), halved until they improve; where the Hessian is not negative definite or
-    the stencil leaves the support, L-BFGS-B (as :func:`_polish`) instead. Returns (point,
-    value, the eigenvalues and eigenvectors of the cross-section's precision or None); the
-    value is −inf where every start leaves the support."""
-    from scipy.optimize import minimize
-
-    start = np.atleast_2d(start)
-    d = start.shape[1]
-    rest = np.delete(np.arange(d), i)
-    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(start[0]))[rest]
-    lo_r, hi_r = lo[rest] + 3e-4 * span, hi[rest] - 3e-4 * span
-
-    def full(r):
-        u = np.empty((len(r), d))
-        u[:, rest] = r
-        u[:, i] = value
-        return u
-
-    def g(r):
-        return f(full(r))
-
-    # The first of the starts given that lies in the support (a start on the line the crest
-    # led to can leave it where a card inequality, such as β ≤ α, cuts across).
-    starts = np.clip(start[:, rest], lo_r, hi_r)
-    values = g(starts)
-    inside = np.flatnonzero(np.isfinite(values))
-    if not inside.size:
-        return full(starts[:1])[0], -math.inf, None
-    r, here = starts[inside[0]], float(values[inside[0]])
-    h = 1e-4 * span
-    for _ in range(PROFILE_NEWTON):
-        out = _hessian(g, r, h)
-        if out is None:
-            break
-        _, grad, hess = out
-        eig = np.linalg.eigvalsh(-hess)
-        if not np.all(np.isfinite(eig)) or eig.min() <= 0:
-            break
-        step = np.linalg.solve(-hess, grad)
-        gain = 0.5 * float(grad @ step)  # the rise the quadratic model promises
-        if gain < 1e-6:
-            return full(r[None, :])[0], here, np.linalg.eigh(-hess)
-        for t in (1.0, 0.5, 0.25, 0.125):
-            cand = np.clip(r + t * step, lo_r, hi_r)
-            value_c = float(g(cand[None, :])[0])
-            if value_c > here:
-                r, here = cand, value_c
-                break
-        else:
-            break
-    # Newton did not settle: L-BFGS-B from where it got, and the volume at its end.
-    hf = 1e-6 * span
-    stencil = np.vstack([np.zeros(d - 1), np.diag(hf), -np.diag(hf)])
-
-    def neg(x):
-        v = g(x[None, :] + stencil)
-        if not np.all(np.isfinite(v)):
-            return (-v[0] if np.isfinite(v[0]) else 1e300), np.zeros(d - 1)
-        return -v[0], -(v[1:d] - v[d:]) / (2 * hf)
-
-    bounds = [(a_ if np.isfinite(a_) else None, b_ if np.isfinite(b_) else None)
-              for a_, b_ in zip(lo_r, hi_r, strict=True)]
-    res = minimize(neg, r, jac=True, method="L-BFGS-B", bounds=bounds,
-                   options={"maxiter": 60, "ftol": 1e-10})
-    if np.isfinite(res.fun) and -res.fun > here:
-        r, here = res.x, float(-res.fun)
-    out = _hessian(g, r, h)
-    cross = None
-    if out is not None:
-        eig = np.linalg.eigh(-out[2])
-        if np.all(np.isfinite(eig[0])) and eig[0].min() > 0:
-            cross = eig
-    return full(r[None, :])[0], here, cross
-
-
-def _ridge_probe(out) -> dict:
-    """Posterior mass that the proposal of a round does not reach, along a ridge.
-
-    The weights certify the posterior only where the proposal's draws land. A ridge along which
-    the posterior stays high while it curves away from the modes (a coefficient free up to its
-    prior bound with the others following it, as where both elements of a Voigt grow together)
-    holds mass that no draw visits, and k̂ cannot see it. From each mode of the proposal, each
-    coordinate is stepped outwards, 2, 4, ... marginal standard deviations of the proposal (and
-    in finer steps once on a ridge that holds mass the proposal misses), and the log posterior
-    maximised over the other coordinates at each step (the profile, which follows the ridge's
-    crest; the first step starts on the line of the mode's conditional means, each later one
-    where the last two profile points lead). Where a profile point's importance weight exceeds
-    the largest of the draws' (the proposal under-represents the posterior there), the mass
-    that the draws do not represent around it is estimated from the
-    profile's height less the proposal's density times that largest weight, the Laplace volume
-    of the cross-section there and the step; the sum of those, over the evidence that the draws
-    give, estimates the share of the posterior that the proposal misses (roughly, and from
-    above where the cross-section is not peaked: the crest's height stands for all of it).
-
-    Returns ``{"points": profile points evaluated, "missed": that share, "coordinate": the
-    coordinate of the profile that holds most of it (None if none), "components": a normal
-    for each such profile point, ``(mean, (w, v), ln mass)`` in the form of the proposal's
-    factors (the cross-section's Laplace covariance, and the square of the step from the
-    profile point before along the crest's direction)}``."""
-    x, log_w, finite, _, prop = out
-    log_target = prop["log_target"]
-    d = prop["means"].shape[1]
-    lo = prop.get("lo", np.full(d, -np.inf))
-    hi = prop.get("hi", np.full(d, np.inf))
-    log_q = _mixture_log_pdf(prop["factors"], prop["means"], prop["log_weights"])
-    top = float(np.max(log_w[finite]))
-    log_z = float(logsumexp(log_w[finite]) - math.log(len(log_w)))
-    base = prop.get("base", prop)
-    masses = {}  # coordinate -> ln of the mass found beyond the proposal's reach
-    components = []
-    points = 0
-    for mean, (w, v) in zip(base["means"], base["factors"], strict=True):
-        peak = float(log_target(mean[None, :])[0])
-        if not np.isfinite(peak):
-            continue
-        cov = (v / w[None, :]) @ v.T
-        sd = np.sqrt(np.diag(cov))  # marginal sd of each coordinate
-        for i in range(d):
-            rest = np.delete(np.arange(d), i)
-            for sign in (1.0, -1.0):
-                u, before = mean, mean - cov[:, i] / cov[i, i] * sd[i]
-                reach, finer = 2.0, None  # in marginal sds; finer: the step once on a ridge
-                for _ in range(PROBE_STEPS + PROBE_FINER):
-                    value = mean[i] + sign * reach * sd[i]
-                    if not lo[i] < value < hi[i] or points >= PROBE_POINTS:
-                        break
-                    start = u + (u - before) * (value - u[i]) / (u[i] - before[i])
-                    before = u
-                    u, lp, cross = _profile_point(log_target, np.array([start, u, mean]), i,
-                                                  value, lo, hi)
-                    step = abs(u[i] - before[i])
-                    tangent = (u - before) / (u[i] - before[i])  # the crest's direction
-                    points += 1
-                    if not np.isfinite(lp) or lp < peak - PROBE_DEPTH:
-                        break
-                    covered = float(log_q(u[None, :])[0]) + top - lp
-                    if covered >= 0 or cross is None:
-                        reach = 2 * reach if finer is None else reach + finer
-                        continue  # the draws weigh this region at least as much
-                    # The density beyond what the draws' largest weight represents here.
-                    eig, vec = cross
-                    volume = 0.5 * (d - 1) * math.log(2 * math.pi) - 0.5 * float(np.sum(np.log(eig)))
-                    mass = lp + math.log1p(-math.exp(covered)) + volume + math.log(step)
-                    masses[i] = float(np.logaddexp(masses.get(i, -math.inf), mass))
-                    if finer is None and mass - log_z > math.log(PROBE_MISSED / 10):
-                        # On a ridge that holds mass the proposal misses: from here, steps of
-                        # a quarter of the way so far, which follow its crest where it bends.
-                        finer = reach / 4
-                    reach = 2 * reach if finer is None else reach + finer
-                    # The cross-section's covariance, and the step along the crest.
-                    full = np.zeros((d, d))
-                    full[np.ix_(rest, rest)] = (vec / eig[None, :]) @ vec.T
-                    full += step**2 * np.outer(tangent, tangent)
-                    e, V = np.linalg.eigh(full)
-                    components.append((u.copy(), (1.0 / e, V), mass))
-    if not masses:
-        return {"points": points, "missed": 0.0, "coordinate": None, "components": []}
-    where = max(masses, key=masses.get)
-    missed = float(np.exp(logsumexp(list(masses.values())) - log_z))
-    return {"points": points, "missed": missed, "coordinate": where, "components": components}
-
-
 def _with_ridge(out, probe: dict, n_proposals: int, rng: np.random.Generator):
     """A round whose proposal adds to a round's the normals of the ridge probe (Student-t of the
     same scale), so that its draws reach the ridge: the round's proposal keeps 1 − s of the
@@ -429,29 +171,7 @@ def _with_ridge(out, probe: dict, n_proposals: int, rng: np.random.Generator):
                 "means": np.vstack([prop["means"], [c[0] for c in comps]]),
                 "log_weights": np.concatenate([lw_old, lw_new]),
                 "base": prop.get("base", prop)}
-    drawn = _draw(proposal, n_proposals, rng)
-    if drawn is None:
-        return None
-    x, log_w, finite, z = drawn
-    return x, log_w, finite, n_modes, {**proposal, "z": z}
-
-
-def _mixture_log_pdf(factors, means, log_weights):
-    """The log density of the Student-t mixture of :func:`_mvt` at any points."""
-    d = means.shape[1]
-    norm = log_weights - logsumexp(log_weights)
-    const = gammaln((DF + d) / 2) - gammaln(DF / 2) - 0.5 * d * math.log(DF * math.pi)
-
-    def log_pdf(y):
-        terms = []
-        for lw, mean, (w, v) in zip(norm, means, factors, strict=True):
-            proj = (y - mean) @ v  # coordinates along the eigenvectors
-            maha = np.sum(proj * proj * w, axis=1)
-            log_det = -0.5 * np.sum(np.log(w))  # log sqrt(det covariance)
-            terms.append(lw + const - log_det - 0.5 * (DF + d) * np.log1p(maha / DF))
-        return logsumexp(np.array(terms), axis=0)
-
-    return log_pdf
+    return _draw(proposal, n_modes, n_proposals, rng)
 
 
 def _mvt(factors, means, log_weights, n: int, rng: np.random.Generator):
@@ -551,55 +271,41 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     if not certified:
         info["reason"] = (f"importance weights not certified (Pareto k {k_hat:.2f}, ESS "
                           f"{ess:.0f})")
+    elif not _orders_determined(lik, tr, x[finite], w, info):
+        certified = False
+    elif lik.ndim > PROBE_MAX_DIM:
+        info["probe"] = {"points": 0, "missed": None,
+                         "skipped": f"{lik.ndim} parameters, more than {PROBE_MAX_DIM}"}
     else:
-        name, share = _widest(lik, tr, x[finite], w)
-        info["widest"] = {"parameter": name, "share_of_prior": share}
-        if share > UNDETERMINED:
-            certified = False
-            info["undetermined"] = name
-            info["reason"] = (f"the order {name} is undetermined (its 94 % interval spans "
-                              f"{100 * share:.0f} % of its prior range), so the proposal at the "
-                              "optima may miss configurations the data allow")
-        elif lik.ndim > PROBE_MAX_DIM:
-            info["probe"] = {"points": 0, "missed": None,
-                             "skipped": f"{lik.ndim} parameters, more than {PROBE_MAX_DIM}"}
-        else:
-            probe = _ridge_probe(out)
-            info["probe"] = {"points": probe["points"], "missed": probe["missed"]}
-            if probe["missed"] > PROBE_MISSED:
-                # A round whose proposal reaches along the ridge: it gives the posterior where
-                # its weights certify it and its own probe finds nothing more.
-                ridge = lik.param_names[probe["coordinate"]]
-                info["probe"]["ridge"] = ridge
-                widened = _with_ridge(out, probe, n_proposals, rng)
-                again = None
-                if widened is not None:
-                    assessed = _assessed(widened)
-                    k_hats.append(assessed[2])
-                    if _certifies(assessed):
-                        again = _ridge_probe(widened)
-                if again is not None and again["missed"] <= PROBE_MISSED:
-                    out, smoothed, k_hat, w, ess = assessed
-                    x, log_w, finite, n_modes, _ = out
-                    info.update(k_hat=k_hat, ess=ess, rounds=len(k_hats))
-                    info["probe"].update(points=probe["points"] + again["points"],
-                                         missed=again["missed"], covered=probe["missed"])
-                    name, share = _widest(lik, tr, x[finite], w)
-                    info["widest"] = {"parameter": name, "share_of_prior": share}
-                    if share > UNDETERMINED:  # the ridge runs along an order
-                        certified = False
-                        info["undetermined"] = name
-                        info["reason"] = (f"the order {name} is undetermined (its 94 % interval "
-                                          f"spans {100 * share:.0f} % of its prior range along "
-                                          f"a ridge in {ridge}), so the proposal at the optima "
-                                          "may miss configurations the data allow")
-                else:
-                    certified = False
-                    info["rounds"] = len(k_hats)
-                    info["ridge"] = ridge
-                    info["reason"] = (f"a ridge of the posterior along {ridge} holds about "
-                                      f"{100 * probe['missed']:.0f} % of its mass where the "
-                                      "proposal at the optima does not reach")
+        probe = _ridge_probe(out)
+        info["probe"] = {"points": probe["points"], "missed": probe["missed"]}
+        if probe["missed"] > PROBE_MISSED:
+            # A round whose proposal reaches along the ridge: it gives the posterior where
+            # its weights certify it and its own probe finds nothing more.
+            ridge = lik.param_names[probe["coordinate"]]
+            info["probe"]["ridge"] = ridge
+            widened = _with_ridge(out, probe, n_proposals, rng)
+            again = None
+            if widened is not None:
+                assessed = _assessed(widened)
+                k_hats.append(assessed[2])
+                if _certifies(assessed):
+                    again = _ridge_probe(widened)
+            if again is not None and again["missed"] <= PROBE_MISSED:
+                out, smoothed, k_hat, w, ess = assessed
+                x, log_w, finite, n_modes, _ = out
+                info.update(k_hat=k_hat, ess=ess, rounds=len(k_hats))
+                info["probe"].update(points=probe["points"] + again["points"],
+                                     missed=again["missed"], covered=probe["missed"])
+                # A ridge along an order is the undetermined case: checked again.
+                certified = _orders_determined(lik, tr, x[finite], w, info)
+            else:
+                certified = False
+                info["rounds"] = len(k_hats)
+                info["ridge"] = ridge
+                info["reason"] = (f"a ridge of the posterior along {ridge} holds about "
+                                  f"{100 * probe['missed']:.0f} % of its mass where the "
+                                  "proposal at the optima does not reach")
     if not certified:
         # The proposal's draws cover every optimum: they guide the samplers that take over
         # (an array, so only on this path: a certified run's info goes into summary.json).
@@ -655,6 +361,21 @@ def _certifies(assessed, *, evidence: bool = False) -> bool:
     _, _, k_hat, _, ess = assessed
     limit = K_HAT_EVIDENCE if evidence else K_HAT_MAX
     return k_hat < limit and ess >= ESS_MIN_IMPORTANCE
+
+
+def _orders_determined(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray, info: dict) -> bool:
+    """The second part of the certificate: whether every fractional order's 94 % interval under
+    the weights spans at most :data:`UNDETERMINED` of its prior range; records ``widest`` in
+    ``info``, and ``undetermined`` and the ``reason`` where it does not."""
+    name, share = _widest(lik, tr, x, w)
+    info["widest"] = {"parameter": name, "share_of_prior": share}
+    if share <= UNDETERMINED:
+        return True
+    info["undetermined"] = name
+    info["reason"] = (f"the order {name} is undetermined (its 94 % interval spans "
+                      f"{100 * share:.0f} % of its prior range), so the proposal at the "
+                      "optima may miss configurations the data allow")
+    return False
 
 
 def _widest(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray) -> tuple[str, float]:
@@ -744,21 +465,19 @@ def _proposal(log_prob, tr, u_modes, polished: dict, n_proposals: int,
     box = free if unbounded else (tr.lo_u, tr.hi_u)
     proposal = {"factors": factors, "means": means, "log_weights": log_weights,
                 "log_target": log_target, "to_u": to_u, "lo": box[0], "hi": box[1]}
-    out = _draw(proposal, n_proposals, rng)
-    if out is None:
-        return {"reason": LEAVE}
-    x, log_w, finite, z = out
-    return x, log_w, finite, len(peaks), {**proposal, "z": z}
+    out = _draw(proposal, len(peaks), n_proposals, rng)
+    return {"reason": LEAVE} if out is None else out
 
 
 def _identity(u):
     return u
 
 
-def _draw(proposal: dict, n_proposals: int, rng: np.random.Generator):
-    """Draws of the mixture ``proposal`` and their log importance weights: (draws in u, log
-    weights, finite, draws in the proposal's coordinates, u or z); None where fewer than a tenth
-    are in the support."""
+def _draw(proposal: dict, n_modes: int, n_proposals: int, rng: np.random.Generator):
+    """A round of importance sampling: draws of the mixture ``proposal`` and their log
+    importance weights, ``(draws in u, log weights, finite, n_modes, the proposal with its draws
+    in its own coordinates, u or z, as "z")``; None where fewer than a tenth are in the
+    support."""
     z, log_q = _mvt(proposal["factors"], proposal["means"], proposal["log_weights"],
                     n_proposals, rng)
     lp = proposal["log_target"](z)
@@ -766,7 +485,7 @@ def _draw(proposal: dict, n_proposals: int, rng: np.random.Generator):
     finite = np.isfinite(log_w)
     if finite.sum() < 0.1 * n_proposals:
         return None
-    return proposal["to_u"](z), log_w, finite, z
+    return proposal["to_u"](z), log_w, finite, n_modes, {**proposal, "z": z}
 
 
 def _fitted(assessed, n_proposals: int, rng: np.random.Generator):
@@ -802,11 +521,7 @@ def _fitted(assessed, n_proposals: int, rng: np.random.Generator):
                 "log_weights": np.concatenate([lw0 + math.log(0.5),
                                                np.log(mix.weights) + math.log(0.5)]),
                 "base": base}
-    drawn = _draw(proposal, n_proposals, rng)
-    if drawn is None:
-        return None
-    x, log_w, finite, z = drawn
-    return x, log_w, finite, n_modes, {**proposal, "z": z}
+    return _draw(proposal, n_modes, n_proposals, rng)
 
 
 def _adapted(first, n_proposals: int, rng: np.random.Generator):
@@ -835,11 +550,7 @@ def _adapted(first, n_proposals: int, rng: np.random.Generator):
     proposal = {**prop, "factors": list(base["factors"]) + [(1.0 / eig, vec)],
                 "means": np.vstack([base["means"], mean]),
                 "log_weights": np.append(lw0 + math.log(0.5), math.log(0.5)), "base": base}
-    out = _draw(proposal, n_proposals, rng)
-    if out is None:
-        return None
-    x2, log_w2, finite2, z2 = out
-    return x2, log_w2, finite2, n_modes, {**proposal, "z": z2}
+    return _draw(proposal, n_modes, n_proposals, rng)
 
 
 def _log_support(lik, rng):

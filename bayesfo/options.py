@@ -18,7 +18,7 @@ from .data.frequency_response import KINDS  # noqa: F401  (the kinds an option m
 from .errors import InputError
 
 DEFAULT_STRUCTURES = "voigt,zener,maxwell,fractional_kelvin_voigt,voigt-int,zener-int,maxwell-int"
-#: Structures that get their own corner and trace figures by default: the leading ones by the
+#: Structures that get their own corner (and trace) figures by default: the leading ones by the
 #: ranking (the combined figures show every structure).
 STRUCTURE_FIGURES = 3
 

@@ -36,8 +36,9 @@ def add_parser(subparsers):
                    help="file formats of the figures (default png, which report.html embeds; "
                         "png,pdf adds vector figures for publication, at about twice the time)")
     p.add_argument("--structure-figures", default=str(STRUCTURE_FIGURES), metavar="N|all",
-                   help="how many structures, the best by the ranking, get corner and trace "
-                        f"figures (default {STRUCTURE_FIGURES}; 'all' for every one)")
+                   help="how many structures, the best by the ranking, get corner figures (and "
+                        "trace figures of walkers or ladder runs) (default "
+                        f"{STRUCTURE_FIGURES}; 'all' for every one)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
     return p
 

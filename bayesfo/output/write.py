@@ -140,7 +140,7 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         and in one forked from it, which starts drawing while this one writes the NetCDF files
         (:func:`bayesfo.plotting.output.draw_forked`); 1 draws them here.
     structure_figures : int or None
-        How many structures (the best by the ranking) get corner and trace figures (every one
+        How many structures (the best by the ranking) get corner (and trace) figures (every one
         for None).
 
     Returns

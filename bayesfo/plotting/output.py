@@ -93,12 +93,23 @@ def _combined_makers(comparison, seed: int) -> dict:
     return makers
 
 
+def has_trace(result) -> bool:
+    """Whether ``result`` gets a ``trace_`` figure: the walkers of emcee, or the runs of a
+    tempered ladder side by side (they certify the posterior by agreeing). Draws resampled from
+    importance weights have neither: their histograms are the corner plot's diagonal, and
+    the weights' diagnostics are the report's text."""
+    return getattr(result.posterior, "sampler", None) != "importance"
+
+
 def _structure_makers(result, color) -> dict:
     stem = _file_stem(result.name)
-    return {
+    makers = {
         f"corner_{stem}": lambda: plot_corner(result, color=color, linear=result.fit.linear),
         f"trace_{stem}": lambda: plot_trace(result, color=color),
     }
+    if not has_trace(result):
+        del makers[f"trace_{stem}"]
+    return makers
 
 
 
@@ -120,7 +131,8 @@ def figure_jobs(comparison, *, seed: int = 0,
                 structure_figures: int | None = STRUCTURE_FIGURES) -> list[tuple[str, object]]:
     """``(name, make)`` for every figure of a comparison, ``make()`` returning a
     :class:`~bayesfo.plotting.Drawn`; structures that failed are left out, and only the best
-    ``structure_figures`` structures (all for None) get corner and trace figures."""
+    ``structure_figures`` structures (all for None) get corner figures, and trace figures
+    where :func:`has_trace`."""
     jobs = list(_combined_makers(comparison, seed).items())
     styles = comparison_styles(comparison)
     for r in _detailed(comparison, structure_figures):
@@ -172,8 +184,10 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
 
     Figures: ``ranking``, ``bode``, ``moduli`` (modulus or compliance data), ``nyquist``,
     ``residuals``, ``q_posteriors`` (when some structure has a free fractional order), and
-    ``corner_<structure>`` and ``trace_<structure>`` for the best ``structure_figures``
-    structures by the ranking (every one for None; structures with ``error`` are skipped).
+    ``corner_<structure>`` for the best ``structure_figures`` structures by the ranking (every
+    one for None; structures with ``error`` are skipped), with ``trace_<structure>`` where the
+    posterior has walkers or ladder runs to show (:func:`has_trace`; not for draws resampled
+    from importance weights).
     Each file is written through a temporary file and a rename
     (:func:`save_figure`); each figure is closed once written.
 
@@ -201,7 +215,7 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
         Called once in this process before it draws (with two processes: while the forked one
         already draws), e.g. to write other files.
     structure_figures : int or None
-        How many structures (the best by the ranking) get corner and trace figures.
+        How many structures (the best by the ranking) get corner (and trace) figures.
 
     Returns
     -------

@@ -155,8 +155,11 @@ def test_figure_formats_png_alone(run_cli, tmp_path):
                              "--figure-formats", "PNG", "--quiet")
     assert status == 0, err
     names = sorted(p.name for p in (out / "figures").iterdir())
-    assert names == ["bode.png", "corner_voigt.png", "moduli.png", "nyquist.png", "q_posteriors.png",
-                     "ranking.png", "residuals.png", "time_functions.png", "trace_voigt.png"]
+    route = json.loads((out / "summary.json").read_text())["structures"][0]["sampler"]
+    traced = ["trace_voigt.png"] if route != "importance" else []  # walkers or ladder runs
+    assert names == sorted(["bode.png", "corner_voigt.png", "moduli.png", "nyquist.png",
+                            "q_posteriors.png", "ranking.png", "residuals.png",
+                            "time_functions.png", *traced])
     assert (out / "report.html").read_text().count("data:image/png;base64,") == len(names)
 
 

@@ -436,14 +436,20 @@ def test_corner_marks_the_linear_methods(comparison):
     plt.close(drawn.figure)
 
 
-def test_trace_shows_every_walker(comparison):
-    # The walkers of emcee (the default route may take importance sampling for this structure,
-    # whose draws are drawn as one histogram per parameter instead).
+@pytest.fixture(scope="module")
+def walkers(comparison):
+    """The Voigt of ``comparison`` by emcee (the default route takes importance sampling)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PredictiveWarning)
         warnings.simplefilter("ignore", DataWarning)  # as in the fixture
-        r = compare(comparison.data, [get_structure("voigt")], seed=0, progress=False,
-                    sampler="emcee")["voigt"]
+        return compare(comparison.data, [get_structure("voigt")], seed=0, progress=False,
+                       sampler="emcee")["voigt"]
+
+
+def test_trace_shows_every_walker(walkers):
+    # The walkers of emcee (draws resampled from importance weights are drawn as one
+    # histogram per parameter instead).
+    r = walkers
     assert r.posterior.sampler == "emcee"
     drawn = plot_trace(r)
     post = r.posterior
@@ -475,7 +481,9 @@ def test_write_figures_skips_failed_structures_and_closes_figures(comparison, tm
     expected = ["ranking", "bode", "moduli", "time_functions", "nyquist", "residuals",
                 "q_posteriors"]
     for name in comparison.ranking:
-        expected += [f"corner_{name}", f"trace_{name}"]
+        expected += [f"corner_{name}"]
+        if comparison[name].posterior.sampler != "importance":  # walkers or ladder runs
+            expected += [f"trace_{name}"]
     assert list(written) == expected
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{n}.png" for n in expected)
     width, height = _png_size(written["bode"][0])
@@ -483,13 +491,27 @@ def test_write_figures_skips_failed_structures_and_closes_figures(comparison, tm
     assert width < height
 
 
+def test_trace_figures_where_walkers_or_runs_have_something_to_show(comparison, walkers,
+                                                                   tmp_path):
+    # emcee's walkers get a trace figure; draws resampled from importance weights do not (their
+    # histograms are the corner plot's diagonal).
+    zener = comparison["zener"]
+    assert zener.posterior.sampler == "importance"
+    mixed = replace(comparison, results=(walkers, zener))
+    written = write_figures(mixed, tmp_path, structure_figures=None)
+    assert {n for n in written if n.startswith(("corner_", "trace_"))} == {
+        "corner_voigt", "trace_voigt", "corner_zener"}
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("trace")) == [
+        "trace_voigt.png"]
+
+
 def test_write_figures_single_structure_and_formats(comparison, tmp_path):
     single = replace(comparison, results=(comparison["zener-int"],))
     written = write_figures(single, tmp_path, formats=("png", "svg"))
     # No free order: no q figure.
+    traced = ["trace_zener-int"] if single.results[0].posterior.sampler != "importance" else []
     assert list(written) == ["ranking", "bode", "moduli", "time_functions", "nyquist", "residuals",
-                             "corner_zener-int",
-                             "trace_zener-int"]
+                             "corner_zener-int", *traced]
     assert all([p.suffix for p in paths] == [".png", ".svg"] for paths in written.values())
     with pytest.raises(InputError, match="'formats'.*'xyz'"):
         write_figures(single, tmp_path, formats=("png", "xyz"))
@@ -647,8 +669,9 @@ def test_a_forked_figure_process_that_dies_holding_the_lock_does_not_block_the_p
 def test_only_the_leading_structures_get_corner_and_trace_figures(comparison, tmp_path):
     written = write_figures(comparison, tmp_path / "one", structure_figures=1)
     best = comparison.ranking[0]
+    traced = [f"trace_{best}"] if comparison[best].posterior.sampler != "importance" else []
     assert [n for n in written if n.startswith(("corner_", "trace_"))] == [
-        f"corner_{best}", f"trace_{best}"]
+        f"corner_{best}", *traced]
     assert all(p.suffix == ".png" for paths in written.values() for p in paths)  # the default
     every = write_figures(comparison, tmp_path / "all", structure_figures=None)
     assert {n for n in every if n.startswith("corner_")} == {

@@ -244,21 +244,25 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     if isinstance(out, dict):
         return None, None, out
     rounds = [_assessed(out)]
-    if not _certifies(rounds[0], evidence=True):
-        # Not certified, or certified with weights too heavy-tailed for ln Z (0.5 ≤ k̂ < 0.7,
-        # typical of a structure that misfits): a round adapted to the weighted draws.
-        adapted = _adapted(out, n_proposals, rng)
-        if adapted is not None:
-            rounds.append(_assessed(adapted))
+    if not (_certifies(rounds[0]) and _undetermined(lik, tr, rounds[0])):
+        # (An order the first round's certified weights leave undetermined sends the posterior
+        # to the tempered ladder whatever later rounds give, which only lighten the tails of
+        # weights that already certify it: they are not run.)
+        if not _certifies(rounds[0], evidence=True):
+            # Not certified, or certified with weights too heavy-tailed for ln Z (0.5 ≤ k̂ <
+            # 0.7, typical of a structure that misfits): a round adapted to the weighted draws.
+            adapted = _adapted(out, n_proposals, rng)
+            if adapted is not None:
+                rounds.append(_assessed(adapted))
+        certified = [r for r in rounds if _certifies(r)]
+        if certified and not any(_certifies(r, evidence=True) for r in certified):
+            # The posterior is certified, its ln Z not: a round whose proposal is a normal
+            # mixture fitted to the certified draws usually has lighter tails; where its k̂ is
+            # below 0.5 it gives ln Z, which would otherwise take a tempered ladder.
+            fitted = _fitted(min(certified, key=lambda r: r[2]), n_proposals, rng)
+            if fitted is not None:
+                rounds.append(_assessed(fitted))
     certified = [r for r in rounds if _certifies(r)]
-    if certified and not any(_certifies(r, evidence=True) for r in certified):
-        # The posterior is certified, its ln Z not: a round whose proposal is a normal
-        # mixture fitted to the certified draws usually has lighter tails; where its k̂ is
-        # below 0.5 it gives ln Z, which would otherwise take a tempered ladder.
-        fitted = _fitted(min(certified, key=lambda r: r[2]), n_proposals, rng)
-        if fitted is not None:
-            rounds.append(_assessed(fitted))
-            certified = [r for r in rounds if _certifies(r)]
     # The certified round with the lightest tail (the smallest k̂) gives the posterior and,
     # where k̂ < 0.5, ln Z; with none certified, the last round says why.
     best = min(certified, key=lambda r: r[2]) if certified else rounds[-1]
@@ -376,6 +380,13 @@ def _orders_determined(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray, info: 
                       f"{100 * share:.0f} % of its prior range), so the proposal at the "
                       "optima may miss configurations the data allow")
     return False
+
+
+def _undetermined(lik: Likelihood, tr, assessed) -> bool:
+    """Whether an order is undetermined (:func:`_orders_determined`) under the weights of an
+    assessed round."""
+    (x, _, finite, _, _), _, _, w, _ = assessed
+    return _widest(lik, tr, x[finite], w)[1] > UNDETERMINED
 
 
 def _widest(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray) -> tuple[str, float]:

@@ -393,6 +393,10 @@ def _diagnostics_section(comparison) -> str:
             if len(rounds) > 1:
                 how += (f"; {len(rounds)} rounds of importance sampling (k̂ "
                         + " → ".join(_num(k, ".2f") for k in rounds) + ")")
+            if info.get("ladder_outside") is not None:
+                how += (f"; the tempered ladder run for ln Z put "
+                        f"{_num(100 * info['ladder_outside'], '.1f')} % of its particles outside "
+                        "the range of the draws")
         else:
             how = (f"{post.n_walkers} walkers × {post.n_steps} steps, τ max "
                    f"{_num(tau, '.0f')}, acceptance {_num(post.acceptance, '.2f')}")

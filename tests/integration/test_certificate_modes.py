@@ -22,6 +22,7 @@ import pytest
 
 import bayesfo as bf
 from bayesfo.inference import Likelihood
+from bayesfo.inference import certified as certified_module
 from bayesfo.inference import importance as importance_module
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
@@ -67,10 +68,24 @@ def test_weights_alone_certify_a_posterior_that_misses_a_configuration(invisible
     data, reference = invisible
     monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)  # the first part alone
     monkeypatch.setattr(importance_module, "PROBE_MISSED", np.inf)
+    monkeypatch.setattr(certified_module, "LADDER_MISSED", np.inf)
     r = _compare(data, 24)
     assert r.posterior.sampler == "importance" and r.posterior.converged
     assert r.criteria.importance["k_hat"] < importance_module.K_HAT_MAX
     assert _outside(r.posterior, reference) > 0.2
+
+
+def test_the_ladder_run_for_ln_z_alone_finds_what_the_proposal_misses(invisible, monkeypatch):
+    """Without the rule on orders and the ridge probe, the weights' k̂ (0.5 or more) leaves ln Z
+    to the tempered ladder, whose particles lie outside the importance draws: they give the
+    posterior, which covers the reference."""
+    data, reference = invisible
+    monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)
+    monkeypatch.setattr(importance_module, "PROBE_MISSED", np.inf)
+    r = _compare(data, 24)
+    assert r.posterior.sampler == "ladder" and r.posterior.converged
+    assert any("outside the range of the importance draws" in n for n in r.criteria.warnings)
+    assert _outside(r.posterior, reference) < 0.05
 
 
 def test_the_ridge_probe_alone_finds_what_the_proposal_misses(invisible, monkeypatch):
@@ -80,6 +95,7 @@ def test_the_ridge_probe_alone_finds_what_the_proposal_misses(invisible, monkeyp
     reference."""
     data, reference = invisible
     monkeypatch.setattr(importance_module, "UNDETERMINED", 1.0)
+    monkeypatch.setattr(certified_module, "LADDER_MISSED", np.inf)
     r = _compare(data, 24)
     assert r.posterior.converged
     if r.posterior.sampler == "importance":

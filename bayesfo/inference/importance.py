@@ -227,7 +227,8 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
         the weights were computed but do not certify,
         ``proposal_draws``: up to :data:`GUIDE_DRAWS` draws of the proposal in the sampling
         coordinates, a guide for the tempered ladder). A first round that does not certify
-        ln Z (k̂ ≥ 0.5 or too few effective draws) is followed by the adapted round, and where
+        ln Z (k̂ ≥ 0.5 or too few effective draws) is followed by the adapted round (unless it
+        certifies the posterior with an order undetermined: the ladder takes over), and where
         no round certifies ln Z but one certifies the posterior, by a round fitted to its draws
         (:func:`_fitted`); the certified round with the smallest k̂ gives the posterior, and ln Z
         where its k̂ < 0.5 (see :data:`K_HAT_EVIDENCE`; else the evidence is None). The

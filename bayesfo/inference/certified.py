@@ -205,9 +205,9 @@ def _ladder_first(lik, seed: int, guide=None):
 
 #: Share of the particles of the tempered ladder run for ln Z beside an importance posterior
 #: (its weights too heavy-tailed for ln Z) that may lie outside the range of the importance
-#: draws on some parameter before the ladder's particles replace them. Draws from one posterior
-#: leave well under 1 % outside each other's range; importance posteriors that missed a
-#: configuration of the springpots left 13-45 % (BENCHMARKS.md, "Fifteenth session").
+#: draws on some parameter before the ladder's particles replace them. Ladders beside
+#: importance draws of the same posterior left about 1 % outside; importance posteriors that
+#: missed a configuration of the springpots left 13-45 % (BENCHMARKS.md, "Fifteenth session").
 LADDER_MISSED = 0.03
 
 

@@ -205,10 +205,19 @@ def _ladder_first(lik, seed: int, guide=None):
 
 #: Share of the particles of the tempered ladder run for ln Z beside an importance posterior
 #: (its weights too heavy-tailed for ln Z) that may lie outside the range of the importance
-#: draws on some parameter before the ladder's particles replace them. Ladders beside
+#: draws on some parameter, beyond the share expected of draws from the same posterior
+#: (:func:`_expected_outside`), before the ladder's particles replace them. Ladders beside
 #: importance draws of the same posterior left about 1 % outside; importance posteriors that
 #: missed a configuration of the springpots left 13-45 % (BENCHMARKS.md, "Fifteenth session").
 LADDER_MISSED = 0.03
+
+
+def _expected_outside(n_params: int, ess: float) -> float:
+    """The share of draws from a posterior expected outside the range of ``ess`` independent
+    draws from it on some of ``n_params`` parameters: at most 2/(ess + 1) per parameter (the
+    chance that a new draw is the smallest or the largest), summed; about 1 % for four
+    parameters and 1 000 draws, several % for the dozens of a master curve."""
+    return min(1.0, 2.0 * n_params / (max(ess, 1.0) + 1.0))
 
 
 def _outside(draws: np.ndarray, others: np.ndarray) -> float:
@@ -220,15 +229,16 @@ def _outside(draws: np.ndarray, others: np.ndarray) -> float:
 def _checked_by_ladder(lik, post, runs, seed, info: dict):
     """The last part of the importance route's certificate, where its weights gave the posterior
     but not ln Z and a tempered ladder (started from the prior) ran for it: where the ladder's
-    particles lie outside the range of the importance draws in more than
-    :data:`LADDER_MISSED` of cases, the draws missed part of the posterior (a configuration no
-    probe from the optima reaches), and the ladder's particles are the posterior if its runs
-    agree. Records ``ladder_outside`` in ``info``; returns (posterior, note or None)."""
+    particles lie outside the range of the importance draws in :data:`LADDER_MISSED` more of
+    cases than draws of one posterior would (:func:`_expected_outside`), the draws missed part
+    of the posterior (a configuration no probe from the optima reaches), and the ladder's
+    particles are the posterior if its runs agree. Records ``ladder_outside`` in ``info``;
+    returns (posterior, note or None)."""
     name = lik.structure.name
     ladder = posterior_from_particles(lik, runs, seed=seed)
     outside = _outside(post.samples_scaled, ladder.samples_scaled)
     info["ladder_outside"] = outside
-    if outside <= LADDER_MISSED:
+    if outside <= LADDER_MISSED + _expected_outside(lik.ndim, post.ess_min):
         return post, None
     share = f"{100 * outside:.0f} % of the particles of the tempered-ladder runs that gave ln Z"
     if not ladder.converged:

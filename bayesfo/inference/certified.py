@@ -15,8 +15,9 @@ The routes, in order, with ``sampler="auto"``:
    proposal does not reach (the ridge probe); ln Z from the same weights where k̂ < 0.5
    (where it is 0.5 or more, from a later round, adapted to the weighted draws or a normal
    mixture fitted to them, if its k̂ is below 0.5, else from a tempered ladder, whose
-   particles replace the importance draws where more than :data:`LADDER_MISSED` of them lie
-   outside the draws' range and its runs agree: the draws missed part of the posterior);
+   particles replace the importance draws where :data:`LADDER_MISSED` more of them lie outside
+   the draws' range than draws of one posterior would and its runs agree: the draws missed
+   part of the posterior);
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
    tempered ladder guided by the proposal's draws: their final particles are the posterior
    when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence;

@@ -29,7 +29,7 @@ import numpy as np
 
 import bayesfo as bf
 from bayesfo.data import FrequencyResponse
-from bayesfo.inference import Likelihood
+from bayesfo.inference import Likelihood, certified
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
 from bayesfo.inference.transform import _Transform
@@ -69,8 +69,7 @@ def one(card: str, seed: int) -> dict:
     _, runs = ladder_runs(lik, seed=10_000 + seed, n_particles=3000, guide=None)
     ref = posterior_from_particles(lik, runs, seed=seed)
     k = lik.structure.n_params
-    got, want = r.posterior.samples[:, :k], ref.samples[:, :k]
-    outside = float(np.mean(np.any((want < got.min(0)) | (want > got.max(0)), axis=1)))
+    outside = certified._outside(r.posterior.samples[:, :k], ref.samples[:, :k])
     widest = (r.criteria.importance or {}).get("widest") or {}
     return {"card": card, "seed": seed, "route": r.posterior.sampler,
             "certified": bool(r.posterior.converged), "outside": outside,

@@ -29,7 +29,7 @@ import numpy as np
 
 import bayesfo as bf
 from bayesfo.identify.optimize import fit_structure
-from bayesfo.inference import Likelihood, starting_points
+from bayesfo.inference import Likelihood, certified, starting_points
 from bayesfo.inference import importance as importance_module
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
@@ -39,8 +39,7 @@ SWEEP = Path(__file__).parents[1] / "examples" / "data" / "adhesive_468mp"
 
 def _outside(reported, reference) -> float:
     """Share of the reference's draws outside the range of the reported ones on some parameter."""
-    got, want = reported.samples_scaled, reference.samples_scaled
-    return float(np.mean(np.any((want < got.min(0)) | (want > got.max(0)), axis=1)))
+    return certified._outside(reported.samples_scaled, reference.samples_scaled)
 
 
 def main() -> None:

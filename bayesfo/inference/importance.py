@@ -245,10 +245,12 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     if isinstance(out, dict):
         return None, None, out
     rounds = [_assessed(out)]
-    if not (_certifies(rounds[0]) and _undetermined(lik, tr, rounds[0])):
-        # (An order the first round's certified weights leave undetermined sends the posterior
-        # to the tempered ladder whatever later rounds give, which only lighten the tails of
-        # weights that already certify it: they are not run.)
+    # An order the first round's certified weights leave undetermined sends the posterior to
+    # the tempered ladder whatever later rounds give, which only lighten the tails of weights
+    # that already certify it: they are not run.
+    (x1, _, finite1, _, _), _, _, w1, _ = rounds[0]
+    undetermined = _certifies(rounds[0]) and not _orders_determined(lik, tr, x1[finite1], w1, {})
+    if not undetermined:
         if not _certifies(rounds[0], evidence=True):
             # Not certified, or certified with weights too heavy-tailed for ln Z (0.5 ≤ k̂ <
             # 0.7, typical of a structure that misfits): a round adapted to the weighted draws.
@@ -381,13 +383,6 @@ def _orders_determined(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray, info: 
                       f"{100 * share:.0f} % of its prior range), so the proposal at the "
                       "optima may miss configurations the data allow")
     return False
-
-
-def _undetermined(lik: Likelihood, tr, assessed) -> bool:
-    """Whether an order is undetermined (:func:`_orders_determined`) under the weights of an
-    assessed round."""
-    (x, _, finite, _, _), _, _, w, _ = assessed
-    return _widest(lik, tr, x[finite], w)[1] > UNDETERMINED
 
 
 def _widest(lik: Likelihood, tr, x: np.ndarray, w: np.ndarray) -> tuple[str, float]:

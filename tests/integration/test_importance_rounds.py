@@ -28,7 +28,7 @@ from scipy.stats import norm
 
 import bayesfo as bf
 from bayesfo.identify.optimize import fit_structure
-from bayesfo.inference import Likelihood, starting_points
+from bayesfo.inference import Likelihood, certified, starting_points
 from bayesfo.inference import importance as importance_module
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
@@ -203,8 +203,7 @@ def voigt_150():
 
 
 def _outside(post, ref) -> float:
-    got, want = post.samples_scaled, ref.samples_scaled
-    return float(np.mean(np.any((want < got.min(0)) | (want > got.max(0)), axis=1)))
+    return certified._outside(post.samples_scaled, ref.samples_scaled)
 
 
 def test_without_the_probe_the_weights_certify_a_posterior_that_misses_the_ridge(voigt_150,

@@ -15,10 +15,23 @@ inherit what the optima miss), the truth's rank under it printed beside the rout
 coverage of both over the same data sets: where the two agree, the route computes the
 posterior the model defines, and a coverage off nominal is the model's (or chance), not the
 route's. ``--first`` skips the first data sets (their draws are made all the same, so the data
-sets are those of a full run), to split a long run over processes.
+sets are those of a full run), to split a long run over processes; ``--noise-level`` keeps only
+the data sets of one noise level.
+
+With ``--tails``, the truth's rank is also computed by importance sampling from a
+heavy-tailed proposal fitted to the route's draws: a normal mixture (k ≤ 4 by BIC) whose
+components become Student-t distributions of 3 degrees of freedom at twice their scale,
+2 million draws. Its Pareto k̂ says whether the proposal's tails cover the posterior's (below
+0.7 the estimates converge); there, a rank that agrees with the route's says that the route's
+draws represent the posterior out to its tails (a mode the route misses altogether is
+``--reference``'s to find). The same draws weigh two posteriors: the tool's (σ as the data give
+it) and the generative model's, whose σ is the noise level times |G(θ)| of each θ. The data
+sets give σ = level · |G(θ_true)|, which depends on the truth: only under the second are the
+truth's ranks uniform by construction (the first treats σ as known numbers), so the two
+coverages tell the setup's effect from the tool's.
 
 Usage: python benchmarks/bench_calibration_routes.py [--card fractional_zener_sl] [--n 300]
-[--seed 14] [--first 0] [--reference] [--json out.json]
+[--seed 14] [--first 0] [--noise-level 0.01] [--reference] [--tails] [--json out.json]
 """
 
 from __future__ import annotations
@@ -47,13 +60,78 @@ def _coverage(ranks: np.ndarray, level: float) -> np.ndarray:
     return np.mean((ranks > 0.5 - half) & (ranks < 0.5 + half), axis=0)
 
 
+TAIL_DRAWS = 2_000_000
+TAIL_DF = 3.0
+TAIL_SCALE = 2.0
+
+
+def _tails(lik, post, theta, level, seed) -> dict:
+    """The truth's rank under importance sampling from a heavy-tailed mixture fitted to the
+    route's draws (see the module's docstring), under the tool's posterior and the generative
+    model's; the Pareto k̂ and ESS of the tool's weights."""
+    from scipy.special import gammaln, logsumexp
+
+    from bayesfo.inference._arviz import psis
+    from bayesfo.inference._mixture import _GaussianMixture
+    from bayesfo.inference.transform import _log_prob_fn, _Transform
+
+    rng = np.random.default_rng(seed)
+    tr = _Transform(lik)
+    log_prob = _log_prob_fn(lik, tr)
+    u = tr.to_u(lik.to_scaled(post.samples))
+    mix = _GaussianMixture.fit(u, rng)
+    d = u.shape[1]
+    chols = [TAIL_SCALE * c for c in mix.chols]
+    which = rng.choice(len(chols), size=TAIL_DRAWS, p=mix.weights)
+    z = rng.standard_normal((TAIL_DRAWS, d)) / np.sqrt(
+        rng.chisquare(TAIL_DF, size=TAIL_DRAWS) / TAIL_DF)[:, None]
+    x = np.empty((TAIL_DRAWS, d))
+    for i, c in enumerate(chols):
+        rows = which == i
+        x[rows] = mix.means[i] + z[rows] @ c.T
+    const = gammaln((TAIL_DF + d) / 2) - gammaln(TAIL_DF / 2) - 0.5 * d * np.log(TAIL_DF * np.pi)
+    log_q = []
+    for i, c in enumerate(chols):
+        y = np.linalg.solve(c, (x - mix.means[i]).T).T
+        log_q.append(np.log(mix.weights[i]) + const - np.sum(np.log(np.diag(c)))
+                     - 0.5 * (TAIL_DF + d) * np.log1p(np.sum(y * y, axis=1) / TAIL_DF))
+    log_q = logsumexp(np.array(log_q), axis=0)
+    tool = np.full(TAIL_DRAWS, -np.inf)
+    generative = np.full(TAIL_DRAWS, -np.inf)
+    physical = np.full(x.shape, np.nan)
+    for i in range(0, TAIL_DRAWS, 200_000):
+        block = slice(i, i + 200_000)
+        lp = log_prob(x[block])
+        tool[block] = lp
+        ok = np.flatnonzero(np.isfinite(lp))
+        if not ok.size:
+            continue
+        th = tr.to_theta(x[block][ok])
+        model = lik.model(th)
+        var = (level * np.abs(model)) ** 2
+        own = np.sum(-np.log(np.pi * var) - np.abs(lik.g_scaled - model) ** 2 / var, axis=1)
+        generative[i + ok] = lp[ok] - lik(th) + own
+        physical[i + ok] = lik.to_physical(th)
+    kept = np.isfinite(tool)
+    out = {}
+    for name, lp in (("tails", tool), ("generative", generative)):
+        smoothed, k_hat = psis(lp[kept] - log_q[kept])
+        w = np.exp(smoothed - logsumexp(smoothed))
+        out[name] = [float(np.sum(w[physical[kept, j] < theta[j]])) for j in range(theta.size)]
+        if name == "tails":
+            out["k_hat"], out["ess"] = float(k_hat), float(1.0 / np.sum(w**2))
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--card", default="fractional_zener_sl")
     ap.add_argument("--n", type=int, default=300)
     ap.add_argument("--seed", type=int, default=14)
     ap.add_argument("--first", type=int, default=0)
+    ap.add_argument("--noise-level", type=float, default=None)
     ap.add_argument("--reference", action="store_true")
+    ap.add_argument("--tails", action="store_true")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)
@@ -72,7 +150,7 @@ def main() -> None:
         sd = level * np.abs(g)
         noisy = g + sd / np.sqrt(2) * (rng.normal(size=w.size) + 1j * rng.normal(size=w.size))
         data = FrequencyResponse(w, noisy, sd, kind="compliance")
-        if k < args.first:
+        if k < args.first or args.noise_level not in (None, float(level)):
             continue
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -87,6 +165,11 @@ def main() -> None:
                 row["reference_ranks"] = np.mean(ref.samples[:, :theta.size] < theta,
                                                  axis=0).tolist()
                 row["reference_certified"] = bool(ref.converged)
+            if args.tails:
+                lik = Likelihood(s, data, priors=priors, scaling=calibration.SCALING)
+                t = _tails(lik, post, theta, float(level), seed=k)
+                row["tails_ranks"], row["generative_ranks"] = t["tails"], t["generative"]
+                row["tails_k_hat"], row["tails_ess"] = t["k_hat"], t["ess"]
         rows.append(row)
     names = list(s.param_names)
     print(f"{args.card}: data sets {args.first}-{args.n - 1} (seed {args.seed}), "
@@ -96,7 +179,8 @@ def main() -> None:
     groups.update({f"noise {100 * level:.0f} %": [r for r in rows if r["noise"] == level]
                    for level in sorted({r["noise"] for r in rows})})
     groups["all"] = rows
-    keys = ["ranks"] + (["reference_ranks"] if args.reference else [])
+    keys = (["ranks"] + (["reference_ranks"] if args.reference else [])
+            + (["tails_ranks", "generative_ranks"] if args.tails else []))
     for group, members in groups.items():
         for key in keys:
             ranks = np.array([r[key] for r in members])
@@ -104,15 +188,22 @@ def main() -> None:
             extreme = np.mean((ranks < 0.02) | (ranks > 0.98), axis=0)
             cells = ", ".join(f"{n} {a:.2f}/{b:.2f} (extreme {e:.3f})"
                               for n, a, b, e in zip(names, c50, c90, extreme, strict=True))
-            by = "route" if key == "ranks" else "reference"
+            by = {"ranks": "route", "reference_ranks": "reference",
+                  "tails_ranks": "heavy-tailed importance",
+                  "generative_ranks": "generative model"}[key]
             print(f"  {group} ({len(members)}), {by}: 50 %/90 % coverage: {cells}")
-    if args.reference:
-        diff = np.abs(np.array([r["ranks"] for r in rows])
-                      - np.array([r["reference_ranks"] for r in rows]))
-        print("  |rank by the route - rank by the reference|: mean "
+    for key in keys[1:]:
+        diff = np.abs(np.array([r["ranks"] for r in rows]) - np.array([r[key] for r in rows]))
+        print(f"  |rank by the route - rank by {key.split('_')[0]}|: mean "
               + ", ".join(f"{n} {d:.3f}" for n, d in zip(names, diff.mean(0), strict=True))
               + "; largest " + ", ".join(f"{n} {d:.3f}" for n, d in zip(names, diff.max(0),
                                                                          strict=True)))
+    if args.tails:
+        k_hat = np.array([r["tails_k_hat"] for r in rows])
+        ess = np.array([r["tails_ess"] for r in rows])
+        print(f"  heavy-tailed importance: k̂ median {np.median(k_hat):.2f}, largest "
+              f"{k_hat.max():.2f} ({np.sum(k_hat >= 0.7)} of {k_hat.size} at 0.7 or more); "
+              f"ESS median {np.median(ess):.0f}, smallest {ess.min():.0f}")
     ranks = np.array([r["ranks"] for r in rows])
     for j, n in enumerate(names):
         print(f"  ranks of {n}: {np.histogram(ranks[:, j], bins=10, range=(0, 1))[0].tolist()}")

@@ -87,19 +87,23 @@ def _tails(lik, post, theta, level, seed) -> dict:
     u = tr.to_u(lik.to_scaled(post.samples))
     mix = _GaussianMixture.fit(u, rng)
     d = u.shape[1]
-    chols = [TAIL_SCALE * c for c in mix.chols]
-    which = rng.choice(len(chols), size=TAIL_DRAWS, p=mix.weights)
+    if mix is None:  # no mixture fitted: one component at the draws' mean and covariance
+        means, chols, weights = [u.mean(0)], [np.linalg.cholesky(np.cov(u.T))], np.ones(1)
+    else:
+        means, chols, weights = list(mix.means), list(mix.chols), np.asarray(mix.weights)
+    chols = [TAIL_SCALE * c for c in chols]
+    which = rng.choice(len(chols), size=TAIL_DRAWS, p=weights)
     z = rng.standard_normal((TAIL_DRAWS, d)) / np.sqrt(
         rng.chisquare(TAIL_DF, size=TAIL_DRAWS) / TAIL_DF)[:, None]
     x = np.empty((TAIL_DRAWS, d))
     for i, c in enumerate(chols):
         rows = which == i
-        x[rows] = mix.means[i] + z[rows] @ c.T
+        x[rows] = means[i] + z[rows] @ c.T
     const = gammaln((TAIL_DF + d) / 2) - gammaln(TAIL_DF / 2) - 0.5 * d * np.log(TAIL_DF * np.pi)
     log_q = []
     for i, c in enumerate(chols):
-        y = np.linalg.solve(c, (x - mix.means[i]).T).T
-        log_q.append(np.log(mix.weights[i]) + const - np.sum(np.log(np.diag(c)))
+        y = np.linalg.solve(c, (x - means[i]).T).T
+        log_q.append(np.log(weights[i]) + const - np.sum(np.log(np.diag(c)))
                      - 0.5 * (TAIL_DF + d) * np.log1p(np.sum(y * y, axis=1) / TAIL_DF))
     log_q = logsumexp(np.array(log_q), axis=0)
     tool = np.full(TAIL_DRAWS, -np.inf)
@@ -165,6 +169,8 @@ def main() -> None:
     ap.add_argument("--conditional", action="store_true")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
+    if args.conditional and (args.reference or args.tails):
+        ap.error("--conditional does not run the route: it goes without --reference and --tails")
     rng = np.random.default_rng(args.seed)
     s = get_structure(args.card)
     table = calibration.PRIORS_RIDGED.get(args.card, calibration.PRIORS)

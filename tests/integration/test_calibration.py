@@ -117,6 +117,19 @@ def test_calibration_full(name):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("name", ["voigt", "zener"])
+def test_calibration_of_thesis_structures_by_the_default_route(name):
+    # The data sets of test_calibration_full (seed 12), the posterior as compare computes it
+    # (importance sampling where certified, else the tempered ladder): 200 data sets, nominal
+    # rate within ±5 %.
+    cov = coverage(name, 200, seed=12, route="default")
+    print(name, cov)
+    assert cov["uncertified"] == 0, cov
+    assert abs(cov[0.5] - 0.5) <= 0.05, cov
+    assert abs(cov[0.9] - 0.9) <= 0.05, cov
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["maxwell", "max-n2m1"])
 def test_calibration_of_ridged_structures_by_the_default_route(name):
     # The Maxwell (either springpot may vanish: two arms) and a second-order max member, by the

@@ -195,10 +195,13 @@ def _pairs(lik, theta) -> list[float]:
         ga, gb = (np.linspace(box_lo[i], box_hi[i], 300) for i in (0, 1))
         coarse = np.column_stack([np.repeat(ga, gb.size), np.tile(gb, ga.size)])
         values = lp2(coarse)
+        def neg(x, lp2=lp2):
+            value = lp2(x[None, :])[0]
+            return -value if np.isfinite(value) else 1e300
+
         best = None
         for x0 in (ut[[a, b]], coarse[int(np.argmax(values))]):
-            res = minimize(lambda x: -lp2(x[None, :])[0] if np.isfinite(lp2(x[None, :])[0])
-                           else 1e300, x0, method="Nelder-Mead",
+            res = minimize(neg, x0, method="Nelder-Mead",
                            options={"xatol": 1e-10, "fatol": 1e-10, "maxfev": 3000})
             if best is None or res.fun < best.fun:
                 best = res

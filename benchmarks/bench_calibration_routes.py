@@ -24,8 +24,8 @@ the data sets of one noise level.
 With ``--tails``, the truth's rank is also computed by importance sampling from a
 heavy-tailed proposal fitted to the route's draws: a normal mixture (k ≤ 4 by BIC) whose
 components become Student-t distributions (the importance route's, 5 degrees of freedom) at
-twice their scale, 2 million draws. Its Pareto k̂ says whether the proposal's tails cover the posterior's (below
-0.7 the estimates converge); there, a rank that agrees with the route's says that the route's
+twice their scale, 2 million draws. Its Pareto k̂ says whether the proposal's tails cover the
+posterior's (below 0.7 the estimates converge); there, a rank that agrees with the route's says that the route's
 draws represent the posterior out to its tails (a mode the route misses altogether is
 ``--reference``'s to find). The same draws weigh two posteriors: the tool's (σ as the data give
 it) and the generative model's, whose σ is the noise level times |G(θ)| of each θ. The data
@@ -140,16 +140,21 @@ def _tails(lik, post, theta, level, seed) -> dict:
 CONDITIONAL_POINTS = 200_001
 
 
+def _exact_setup(lik, theta):
+    """What the sampler-free checks share: the sampling coordinates, the log posterior density
+    in them, and the truth there."""
+    from bayesfo.inference.transform import _log_prob_fn, _Transform
+
+    tr = _Transform(lik)
+    return tr, _log_prob_fn(lik, tr), tr.to_u(lik.to_scaled(theta[None, :]))[0]
+
+
 def _conditional(lik, theta) -> list[float]:
     """The truth's rank under each parameter's posterior given the others at their true values
     (quadrature over the parameter's prior range in the sampling coordinates)."""
     from scipy.special import logsumexp
 
-    from bayesfo.inference.transform import _log_prob_fn, _Transform
-
-    tr = _Transform(lik)
-    log_prob = _log_prob_fn(lik, tr)
-    ut = tr.to_u(lik.to_scaled(theta[None, :]))[0]
+    tr, log_prob, ut = _exact_setup(lik, theta)
     out = []
     for j in range(ut.size):
         grid = np.linspace(tr.lo_u[j], tr.hi_u[j], CONDITIONAL_POINTS)
@@ -175,11 +180,7 @@ def _pairs(lik, theta) -> list[float]:
     from scipy.optimize import minimize
     from scipy.special import logsumexp
 
-    from bayesfo.inference.transform import _log_prob_fn, _Transform
-
-    tr = _Transform(lik)
-    log_prob = _log_prob_fn(lik, tr)
-    ut = tr.to_u(lik.to_scaled(theta[None, :]))[0]
+    tr, log_prob, ut = _exact_setup(lik, theta)
     out = []
     for a, b in itertools.combinations(range(ut.size), 2):
         box_lo = np.array([tr.lo_u[a], tr.lo_u[b]])

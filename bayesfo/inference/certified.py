@@ -20,7 +20,8 @@ The routes, in order, with ``sampler="auto"``:
    part of the posterior);
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
    tempered ladder guided by the proposal's draws: their final particles are the posterior
-   when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence;
+   when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do
+   not, two more runs, and the four where the new pair agrees and all four agree;
 3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its
    draws where the walkers converged, else by a tempered ladder guided by them, whose
    particles replace the walkers' draws when its runs agree. A posterior that no route
@@ -128,7 +129,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
     sampler_options = dict(sampler_options or {})
     modes = np.atleast_2d(np.asarray(modes, dtype=float))
     name = lik.structure.name
-    post = ev = tried = info = None
+    post = ev = tried = info = more = None
     # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
     if sampler == "auto" and evidence != "bridge" and modes.size:
         try:
@@ -136,7 +137,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
             post, ev, info = None, None, {}
         if post is None and evidence == "auto" and not sampler_options:
-            post, ev, tried = _ladder_first(lik, seed, info.get("proposal_draws"))
+            post, ev, tried, more = _ladder_first(lik, seed, info.get("proposal_draws"))
     notes = []
     # The warnings of emcee's draws are held until it is known whether they are the posterior
     # reported: a ladder that certifies it instead replaces them.
@@ -149,6 +150,8 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         if post.sampler == "ladder" and info and (info.get("undetermined") or info.get("ridge")):
             notes.append(f"{name}: {info['reason']}; the tempered ladder, started from the "
                          "prior, gave the posterior")
+        if more and post.sampler == "ladder":
+            notes.append(more)
         if post.sampler == "emcee" and tried:
             notes.append(f"{name}: the tempered-ladder runs tried first did not certify the "
                          f"posterior ({tried}); emcee ran instead")
@@ -187,21 +190,47 @@ def _ladder_first(lik, seed: int, guide=None):
     tempered ladder's two independent runs: their final particles are the posterior when the
     runs agree (R-hat < 1.01, ESS ≥ 400; see
     :func:`~bayesfo.inference.results.posterior_from_particles`), and their ln Z the evidence.
-    Returns (posterior, evidence, None), or (None, None, reason) when the runs disagree or the
-    ladder fails: emcee then runs, and a ladder guided by its walkers.
+
+    Where the two do not agree, two more runs are made: the four are the posterior when the two
+    new runs agree with each other and all four agree, by the same tests (a second, independent
+    pair that passes on its own, and the first pair's particles consistent with it). The R-hat
+    of two runs whose particles share ancestors scatters enough on a broad posterior that two
+    runs of the same posterior can fail the test by chance, and emcee, the next route, costs
+    many times as much on the posteriors that reach it (undetermined orders; BENCHMARKS.md,
+    "Eighteenth session").
+
+    Returns (posterior, evidence, None, note), or (None, None, reason, None) when the runs
+    disagree or the ladder fails: emcee then runs, and a ladder guided by its walkers. ``note``
+    says so where the posterior took four runs.
 
     ``guide``: the importance proposal's draws (sampling coordinates), which cover every optimum
     found; the ladder's independence moves propose from them too, so that a narrow mode with
     little prior mass that the optimiser found is not lost (see
     :func:`~bayesfo.inference.smc.ladder_run`)."""
+    def why(post):
+        return "; ".join(m.split(": ", 1)[-1] for m in post.messages)
+
     try:
         ev, runs = ladder_runs(lik, seed=seed, guide=guide)
         post = posterior_from_particles(lik, runs, seed=seed)
+        if post.converged:
+            return post, ev, None, None
+        first = post
+        ev, runs = ladder_runs(lik, seed=seed, guide=guide, earlier=runs)
+        second = posterior_from_particles(lik, runs[len(runs) // 2:], seed=seed,
+                                          predictive=False)
+        post = posterior_from_particles(lik, runs, seed=seed)
     except (InputError, np.linalg.LinAlgError, FloatingPointError) as exc:  # to emcee
-        return None, None, str(exc)
+        return None, None, str(exc), None
+    if not second.converged:
+        return None, None, f"{why(first)}; two more runs: {why(second)}", None
     if not post.converged:
-        return None, None, "; ".join(m.split(": ", 1)[-1] for m in post.messages)
-    return post, ev, None
+        return None, None, f"{why(first)}; all four runs: {why(post)}", None
+    note = (f"{lik.structure.name}: the first two tempered-ladder runs did not certify the "
+            f"posterior ({why(first)}); two more runs agree with each other (R-hat "
+            f"{second.rhat_max:.3f}) and with them (R-hat {post.rhat_max:.3f} over the four, "
+            f"ESS {post.ess_min:.0f}), and the four give the posterior")
+    return post, ev, None, note
 
 
 #: Share of the particles of the tempered ladder run for ln Z beside an importance posterior

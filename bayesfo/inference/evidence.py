@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.special import logsumexp
@@ -229,7 +229,8 @@ def ladder_evidence(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000,
 
 
 def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_runs: int = 2,
-                guide: PosteriorResult | np.ndarray | None = None, **ladder_kwargs) -> tuple:
+                guide: PosteriorResult | np.ndarray | None = None, earlier=(),
+                **ladder_kwargs) -> tuple:
     """:func:`ladder_evidence` and the runs it came from (their final particles are
     independent sets of posterior draws: see
     :func:`~bayesfo.inference.posterior.posterior_from_particles`).
@@ -246,19 +247,36 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
     (BENCHMARKS.md, "Measurements behind design choices"; see
     :class:`~bayesfo.inference.smc._Guide` for the cause and the fix).
 
+    ``earlier``: the runs of an earlier call with the same ``lik``, ``seed``, ``guide`` and
+    ``n_particles``, to which this call adds ``n_runs`` more: they continue the earlier runs'
+    sequence of generators (children of the same seed), are guided by the same shares of the
+    guide, and the evidence returned (with the list of runs) is that of all of them, the
+    earlier ones first.
+
     Returns
     -------
     (Evidence, list of LadderRun)
     """
     t0 = time.perf_counter()
-    if n_runs < 2:
-        raise ValueError("n_runs must be at least 2 (their spread is part of the error)")
-    children = np.random.SeedSequence(seed).spawn(n_runs)
-    values, errors, calls, reached, runs = [], [], 0, [], []
+    earlier = list(earlier)
+    if n_runs < 1 or n_runs + len(earlier) < 2:
+        raise ValueError("n_runs must be at least 2, or 1 with earlier runs (their spread is "
+                         "part of the error)")
+    if any(r.bridge is None for r in earlier):
+        raise ValueError("earlier runs must come from ladder_runs (their ln Z by bridge "
+                         "sampling is part of the evidence)")
+    first = len(earlier)
+    children = np.random.SeedSequence(seed).spawn(first + n_runs)[first:]
+    values = [r.bridge[0] for r in earlier]
+    errors = [r.bridge[1] for r in earlier]
+    calls, runs = sum(r.n_likelihood for r in earlier), list(earlier)
+    reached = [float(np.max(r.log_likelihood)) for r in earlier]
     # ln P(S) once for all runs, from as many prior draws as the runs' separate estimates had:
-    # its error is common to the runs, so it enters the error whole, not averaged down.
-    log_s, log_s_err = log_support_fraction(lik, np.random.default_rng([seed, n_runs]),
-                                            n=20_000 * n_runs)
+    # its error is common to the runs, so it enters the error whole, not averaged down (the
+    # same estimate as the earlier call's, where runs are added).
+    shared = first or n_runs
+    log_s, log_s_err = log_support_fraction(lik, np.random.default_rng([seed, shared]),
+                                            n=20_000 * shared)
     if guide is None or isinstance(guide, np.ndarray):
         guide_u = guide
     else:
@@ -268,15 +286,15 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
     # that ladder_run would give with its generator.
     together = ladder_runs_together(lik, [np.random.default_rng(c) for c in children],
                                     guides=shares, n_particles=n_particles, **ladder_kwargs)
-    for i, run in enumerate(together):
+    for i, run in enumerate(together, start=first):
         ev = _bridge(lik, run.particles[None], seed=seed + i, support=(log_s, 0.0))
         values.append(ev.log_z)
         errors.append(ev.log_z_err)
         calls += run.n_likelihood + ev.n_likelihood
         reached.append(float(np.max(run.log_likelihood)))
-        runs.append(run)
+        runs.append(replace(run, bridge=(ev.log_z, ev.log_z_err)))
     values, errors = np.array(values), np.array(errors)
-    err = math.sqrt((np.mean(errors**2) + np.var(values, ddof=1)) / n_runs + log_s_err**2)
+    err = math.sqrt((np.mean(errors**2) + np.var(values, ddof=1)) / values.size + log_s_err**2)
     return Evidence(
         log_z=float(values.mean()),
         log_z_err=err,

@@ -73,6 +73,10 @@ class LadderRun:
     log_likelihood: np.ndarray
     acceptance: np.ndarray
     n_likelihood: int
+    #: ln Z and its error by bridge sampling from the final particles, where
+    #: :func:`~bayesfo.inference.evidence.ladder_runs` computed them (the run's share of the
+    #: evidence; runs of a later call that adds runs are combined with them).
+    bridge: tuple[float, float] | None = None
 
 
 class _Target:

@@ -170,3 +170,39 @@ def test_a_ladder_that_fails_first_hands_over_to_emcee_and_says_why(monkeypatch)
     assert r.posterior.sampler == "emcee" and r.posterior.converged
     assert ("zener: the tempered-ladder runs tried first did not certify the posterior (Matrix "
             "is not positive definite); emcee ran instead") in r.criteria.warnings
+
+
+def test_a_ladder_pair_that_disagrees_is_joined_by_a_second_pair(monkeypatch):
+    # The first pair of ladder runs made to fail its test (as two runs of a broad posterior
+    # can by chance): two more runs are made, and the four give the posterior where the new
+    # pair agrees on its own and all four agree; the user is told.
+    import dataclasses
+
+    import bayesfo.inference.certified as route
+
+    monkeypatch.setattr(route, "importance_posterior",
+                        lambda *a, **k: (None, None, {"reason": "forced"}))
+    real = route.posterior_from_particles
+    seen = []
+
+    def first_pair_fails(lik, runs, **kwargs):
+        post = real(lik, runs, **kwargs)
+        seen.append(len(runs))
+        if len(seen) == 1:
+            return dataclasses.replace(post, converged=False, messages=(
+                "zener: the tempered-ladder runs disagree (R-hat 1.012 is not below 1.01)",))
+        return post
+
+    monkeypatch.setattr(route, "posterior_from_particles", first_pair_fails)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PredictiveWarning)
+        r = bf.compare(bf.read(DATA), "zener", seed=1, workers=1, progress=False,
+                       noise="constant")["zener"]
+    assert seen[:3] == [2, 2, 4]
+    assert r.posterior.sampler == "ladder" and r.posterior.converged
+    assert r.posterior.n_walkers == 4 and r.posterior.samples.shape[0] == 4000
+    assert r.criteria.evidence.method == "ladder"
+    note = [w for w in r.criteria.warnings if "two more runs agree" in w]
+    assert len(note) == 1 and note[0].startswith(
+        "zener: the first two tempered-ladder runs did not certify the posterior (the "
+        "tempered-ladder runs disagree (R-hat 1.012 is not below 1.01)); two more runs agree")

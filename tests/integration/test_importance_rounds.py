@@ -208,15 +208,19 @@ def _outside(post, ref) -> float:
 
 def test_without_the_probe_the_weights_certify_a_posterior_that_misses_the_ridge(voigt_150,
                                                                                 monkeypatch):
-    """Measured: 7-8 % of the reference's draws lie beyond the reported draws' range, and ln Z
-    is low by about 0.06 nats."""
+    """Measured: 4.5-8 % of the reference's draws lie beyond the reported draws' range (the
+    share depends on the optimiser's and the draws' path, which the CPU's rounding changes),
+    and ln Z is low by about 0.06 nats. A miss by the tool's own rule for a ladder beside
+    importance draws: more than :data:`~bayesfo.inference.certified.LADDER_MISSED` above the
+    share that draws of one posterior leave outside each other's range."""
     lik, modes, _, ref = voigt_150
     monkeypatch.setattr(importance_module, "PROBE_MISSED", math.inf)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         post, _, info = importance_module.importance_posterior(lik, modes, seed=0)
     assert post is not None and info["k_hat"] < importance_module.K_HAT_MAX
-    assert _outside(post, ref) > 0.05
+    null = certified._expected_outside(lik.ndim, post.ess_min)
+    assert _outside(post, ref) > certified.LADDER_MISSED + null
 
 
 def test_the_probe_widens_the_proposal_along_the_ridge(voigt_150):

@@ -86,8 +86,11 @@ def test_maximum_likelihood_minimises_pyrheo_cost_on_the_adhesive():
     lsq = optimize.least_squares(lambda t: _relative_parts(lik, t), start, method="lm",
                                  xtol=1e-15, ftol=1e-15, gtol=1e-15)
     sigma = 0.03
+    # fatol well above the rounding of −ln L ≈ 346 (one unit in the last place is 5.7e-14):
+    # asked for 1e-14, the simplex shrinks to single ulps in θ and stops only where its values
+    # happen to round alike, which depends on the CPU.
     ml = optimize.minimize(lambda t: -lik(np.r_[t, sigma][None])[0], start, method="Nelder-Mead",
-                           options={"xatol": 1e-12, "fatol": 1e-14, "maxfev": 20_000})
+                           options={"xatol": 1e-12, "fatol": 1e-10, "maxfev": 20_000})
     assert lsq.success and ml.success
     assert not np.allclose(start, lsq.x, rtol=1e-3)  # the weighting differs from the fit's
     np.testing.assert_allclose(ml.x, lsq.x, rtol=1e-6)

@@ -4,6 +4,8 @@ runs in the slow suite)."""
 
 from __future__ import annotations
 
+import json
+import math
 import re
 import subprocess
 import sys
@@ -83,8 +85,15 @@ def _demo_rows(text: str) -> dict:
 @pytest.mark.filterwarnings("always::bayesfo.errors.PredictiveWarning")
 def test_the_readme_demo_table_is_what_the_demo_prints(run_cli, tmp_path):
     """The README shows the output of `make demo`: the same structures in the same order, with
-    the same ln Z (within three times its error), orders (within 0.005), certificates and fit
-    checks. Regenerate the README block from a run when this fails."""
+    the same ln Z (within three times its error), orders, certificates and fit checks.
+    Regenerate the README block from a run when this fails.
+
+    An order's mean is compared within 0.005 or three standard errors of the difference of two
+    certified posteriors' means, whichever is larger: each has an ESS of at least 400 (the
+    certificate's floor), so the difference has a standard error of at most sd·√(2/400). A
+    sharp order (sd 0.001) is held to 0.005; an undetermined one (the Maxwell's α, sd about
+    0.15, whose posterior two machines reach by different floating-point paths) to about 0.03.
+    """
     makefile = (ROOT / "Makefile").read_text()
     data = re.search(r"^DEMO_DATA \?= (\S+)", makefile, flags=re.M)[1]
     structures = re.search(r"^DEMO_STRUCTURES \?= (\S+)", makefile, flags=re.M)[1]
@@ -94,6 +103,15 @@ def test_the_readme_demo_table_is_what_the_demo_prints(run_cli, tmp_path):
     shown = _demo_rows(re.search(r"```\n( # structure.*?)```", README, flags=re.S)[1])
     ran = _demo_rows(out)
     assert list(shown) == list(ran) and len(ran) == len(structures.split(","))
+    summary = json.loads((tmp_path / "demo" / "summary.json").read_text())
+    # The sd of each order shown, by symbol; an order derived from others (the Maxwell's
+    # δ = β − α) at most the sum of theirs.
+    names = {"q": "q", "α": "alpha", "β": "beta", "γ": "gamma"}
+    order_sd = {}
+    for r in summary["structures"]:
+        sds = {n: p["sd"] for n, p in r["parameters"].items() if n in names.values()}
+        order_sd[r["name"]] = {symbol: sds.get(names.get(symbol), sum(sds.values()))
+                               for symbol in ran.get(r["name"], {}).get("orders", {})}
     for name, row in ran.items():
         want = shown[name]
         assert (want["rank"], want["k"], want["ok"], want["fits"]) == \
@@ -101,7 +119,8 @@ def test_the_readme_demo_table_is_what_the_demo_prints(run_cli, tmp_path):
         assert abs(want["log_z"] - row["log_z"]) <= 3 * max(want["err"], row["err"]) + 0.02, name
         assert want["orders"].keys() == row["orders"].keys(), name
         for symbol, mean in row["orders"].items():
-            assert abs(want["orders"][symbol] - mean) <= 0.005, (name, symbol)
+            tolerance = max(0.005, 3 * order_sd[name][symbol] * math.sqrt(2 / 400))
+            assert abs(want["orders"][symbol] - mean) <= tolerance, (name, symbol, tolerance)
     # The baseline lines and the held warning are shown as printed.
     for line in out.splitlines():
         if " vs " in line and "ln Z difference" in line:

@@ -44,9 +44,17 @@ coarse grid over the whole prior box). ``--routes-from JSON`` (the ``--json`` of
 route on the same data sets) splits these checks by the route each data set took: a subset that
 the data choose is calibrated too when the posteriors are exact.
 
+With ``--density``, beside the route's ranks: the truth's rank in posterior density (the share
+of the route's draws whose log posterior density in the sampling coordinates exceeds the
+truth's; uniform where the posterior is right, whatever the shape of a ridge), and where a
+Nelder-Mead ascent of the log posterior from the truth ends: its squared Mahalanobis distance
+(under the draws' covariance) to the nearest draw and its height against the highest draw. An
+ascent that ends far from every draw, not far below the top, has found a configuration the
+route's draws do not visit (``--reference`` then says how much mass it holds).
+
 Usage: python benchmarks/bench_calibration_routes.py [--card fractional_zener_sl] [--n 300]
-[--seed 14] [--first 0] [--noise-level 0.01] [--reference] [--tails] [--conditional | --pairs]
-[--routes-from earlier.json] [--json out.json]
+[--seed 14] [--first 0] [--noise-level 0.01] [--reference] [--tails] [--density]
+[--conditional | --pairs] [--routes-from earlier.json] [--json out.json]
 """
 
 from __future__ import annotations
@@ -166,6 +174,33 @@ def _conditional(lik, theta) -> list[float]:
     return out
 
 
+#: An ascent from the truth that ends farther than this (squared Mahalanobis distance under the
+#: draws' covariance) from every draw is listed.
+DENSITY_FAR = 25.0
+
+
+def _density(lik, post, theta) -> dict:
+    """The truth's rank in posterior density among the route's draws, and where an ascent of
+    the log posterior from the truth ends relative to the draws (see ``--density``)."""
+    from scipy.optimize import minimize
+
+    tr, log_prob, ut = _exact_setup(lik, theta)
+    u = tr.to_u(post.samples_scaled)
+    lp = log_prob(u)
+    at_truth = float(log_prob(ut[None, :])[0])
+
+    def neg(x):
+        v = log_prob(x[None, :])[0]
+        return -v if np.isfinite(v) else 1e300
+
+    end = minimize(neg, ut, method="Nelder-Mead",
+                   options={"maxiter": 4000, "xatol": 1e-6, "fatol": 1e-8})
+    inv = np.linalg.inv(np.cov(u.T))
+    d2 = np.einsum("ij,jk,ik->i", u - end.x, inv, u - end.x)
+    return {"density_rank": float(np.mean(lp > at_truth)),
+            "ascent_d2": float(d2.min()), "ascent_below_top": float(lp.max() + end.fun)}
+
+
 PAIR_POINTS = 400
 PAIR_DROP = 30.0
 
@@ -246,15 +281,16 @@ def main() -> None:
     ap.add_argument("--noise-level", type=float, default=None)
     ap.add_argument("--reference", action="store_true")
     ap.add_argument("--tails", action="store_true")
+    ap.add_argument("--density", action="store_true")
     ap.add_argument("--conditional", action="store_true")
     ap.add_argument("--pairs", action="store_true")
     ap.add_argument("--routes-from", default=None)
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
     exact = args.conditional or args.pairs
-    if exact and (args.reference or args.tails):
-        ap.error("--conditional and --pairs do not run the route: they go without --reference "
-                 "and --tails")
+    if exact and (args.reference or args.tails or args.density):
+        ap.error("--conditional and --pairs do not run the route: they go without --reference, "
+                 "--tails and --density")
     if args.conditional and args.pairs:
         ap.error("--conditional and --pairs are separate runs: choose one")
     if args.routes_from and not exact:
@@ -298,6 +334,9 @@ def main() -> None:
                 row["reference_ranks"] = np.mean(ref.samples[:, :theta.size] < theta,
                                                  axis=0).tolist()
                 row["reference_certified"] = bool(ref.converged)
+            if args.density:
+                lik = Likelihood(s, data, priors=priors, scaling=calibration.SCALING)
+                row.update(_density(lik, post, theta))
             if args.tails:
                 lik = Likelihood(s, data, priors=priors, scaling=calibration.SCALING)
                 t = _tails(lik, post, theta, float(level), seed=k)
@@ -336,6 +375,16 @@ def main() -> None:
               + ", ".join(f"{n} {d:.3f}" for n, d in zip(names, diff.mean(0), strict=True))
               + "; largest " + ", ".join(f"{n} {d:.3f}" for n, d in zip(names, diff.max(0),
                                                                          strict=True)))
+    if args.density:
+        for group, members in groups.items():
+            ranks = np.array([r["density_rank"] for r in members])
+            print(f"  {group} ({len(members)}), rank in posterior density at most 0.5 / 0.9: "
+                  f"{np.mean(ranks <= 0.5):.3f} / {np.mean(ranks <= 0.9):.3f}")
+        far = [r for r in rows if r["ascent_d2"] > DENSITY_FAR]
+        print("  ascents from the truth that end far from every draw (set, route, squared "
+              "distance, nats below the highest draw): "
+              + ("; ".join(f"{r['set']} {r['route']} {r['ascent_d2']:.0f} "
+                           f"{r['ascent_below_top']:.2f}" for r in far) or "none"))
     if args.tails:
         k_hat = np.array([r["tails_k_hat"] for r in rows])
         ess = np.array([r["tails_ess"] for r in rows])

@@ -148,6 +148,16 @@ def _tails(lik, post, theta, level, seed) -> dict:
 CONDITIONAL_POINTS = 200_001
 
 
+def _negative(log_density):
+    """−log density of one point, for a minimiser (a large finite number outside the support)."""
+
+    def neg(x):
+        value = log_density(x[None, :])[0]
+        return -value if np.isfinite(value) else 1e300
+
+    return neg
+
+
 def _exact_setup(lik, theta):
     """What the sampler-free checks share: the sampling coordinates, the log posterior density
     in them, and the truth there."""
@@ -189,11 +199,7 @@ def _density(lik, post, theta) -> dict:
     lp = log_prob(u)
     at_truth = float(log_prob(ut[None, :])[0])
 
-    def neg(x):
-        v = log_prob(x[None, :])[0]
-        return -v if np.isfinite(v) else 1e300
-
-    end = minimize(neg, ut, method="Nelder-Mead",
+    end = minimize(_negative(log_prob), ut, method="Nelder-Mead",
                    options={"maxiter": 4000, "xatol": 1e-6, "fatol": 1e-8})
     inv = np.linalg.inv(np.cov(u.T))
     d2 = np.einsum("ij,jk,ik->i", u - end.x, inv, u - end.x)
@@ -231,10 +237,7 @@ def _pairs(lik, theta) -> list[float]:
         ga, gb = (np.linspace(box_lo[i], box_hi[i], 300) for i in (0, 1))
         coarse = np.column_stack([np.repeat(ga, gb.size), np.tile(gb, ga.size)])
         values = lp2(coarse)
-        def neg(x, lp2=lp2):
-            value = lp2(x[None, :])[0]
-            return -value if np.isfinite(value) else 1e300
-
+        neg = _negative(lp2)
         best = None
         for x0 in (ut[[a, b]], coarse[int(np.argmax(values))]):
             res = minimize(neg, x0, method="Nelder-Mead",

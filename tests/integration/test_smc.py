@@ -3,6 +3,7 @@ evidence and mode weights are known."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -166,8 +167,7 @@ def test_runs_added_to_earlier_ones_continue_their_sequence():
     assert abs(more.log_z - exact) < max(4 * more.log_z_err, 0.02)
     assert more.n_likelihood > first.n_likelihood
     with pytest.raises(ValueError, match="earlier runs"):
-        ladder_runs(lik, seed=3, earlier=[r.__class__(**{**r.__dict__, "bridge": None})
-                                          for r in two])
+        ladder_runs(lik, seed=3, earlier=[dataclasses.replace(r, bridge=None) for r in two])
 
 
 def test_a_broad_guide_still_gives_the_narrow_modes_their_share():

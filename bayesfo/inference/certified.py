@@ -42,11 +42,13 @@ import numpy as np
 
 from ..errors import CertifiedWarning, ConvergenceWarning, EvidenceWarning, InputError
 from ..options import EVIDENCE_ROUTES, SAMPLERS
+from ._configurations import configurations, vanished
 from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
 from .importance import importance_posterior
 from .likelihood import Likelihood
 from .posterior import sample_posterior
 from .results import PosteriorResult, posterior_from_particles
+from .transform import _Transform
 
 #: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by
 #: the optimiser and the sampler has missed part of the posterior (1 000 particles of a
@@ -129,7 +131,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
     sampler_options = dict(sampler_options or {})
     modes = np.atleast_2d(np.asarray(modes, dtype=float))
     name = lik.structure.name
-    post = ev = tried = info = more = None
+    post = ev = tried = info = more = slabs = None
     # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
     if sampler == "auto" and evidence != "bridge" and modes.size:
         try:
@@ -137,7 +139,9 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
             post, ev, info = None, None, {}
         if post is None and evidence == "auto" and not sampler_options:
-            post, ev, tried, more = _ladder_first(lik, seed, info.get("proposal_draws"))
+            guide = info.get("proposal_draws")
+            slabs = configurations(lik, modes, guide)
+            post, ev, tried, more = _ladder_first(lik, seed, guide, slabs)
     notes = []
     # The warnings of emcee's draws are held until it is known whether they are the posterior
     # reported: a ladder that certifies it instead replaces them.
@@ -157,8 +161,18 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
                          f"posterior ({tried}); emcee ran instead")
         best = max(post.max_log_likelihood, fit_log_likelihood)
         of_draws = len(held)
-        found = _evidence(lik, post, seed, evidence, best_log_likelihood=best, importance=ev)
+        if slabs is None and (evidence == "ladder" or (evidence == "auto" and ev is None and (
+                not post.converged or post.sampler == "importance"))):
+            # A ladder runs for ln Z: it proposes in the configurations too.
+            slabs = configurations(lik, modes, _Transform(lik).to_u(post.samples_scaled))
+        found = _evidence(lik, post, seed, evidence, best_log_likelihood=best, importance=ev,
+                          slabs=slabs or ())
         runs = found.pop("ladder_runs")
+        if slabs and (post.sampler == "ladder" or runs is not None):
+            names = vanished(lik, slabs)
+            notes.append(f"{name}: where {' or '.join(names)} vanish"
+                         f"{'es' if len(names) == 1 else ''}, the posterior holds a region that "
+                         "no optimum seeds; the tempered ladder proposes there as well")
         replaced = False
         if runs is not None and not post.converged:
             post, note, replaced = _certified_by_ladder(lik, post, runs, seed, remedy)
@@ -185,7 +199,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         best_log_likelihood=max(best, post.max_log_likelihood))
 
 
-def _ladder_first(lik, seed: int, guide=None):
+def _ladder_first(lik, seed: int, guide=None, slabs=()):
     """Where importance sampling does not certify the posterior (ridges, several regions), the
     tempered ladder's two independent runs: their final particles are the posterior when the
     runs agree (R-hat < 1.01, ESS ≥ 400; see
@@ -206,17 +220,18 @@ def _ladder_first(lik, seed: int, guide=None):
     ``guide``: the importance proposal's draws (sampling coordinates), which cover every optimum
     found; the ladder's independence moves propose from them too, so that a narrow mode with
     little prior mass that the optimiser found is not lost (see
-    :func:`~bayesfo.inference.smc.ladder_run`)."""
+    :func:`~bayesfo.inference.smc.ladder_run`); ``slabs``: the configurations where an element
+    vanishes (:mod:`~bayesfo.inference._configurations`), where the ladder proposes too."""
     def why(post):
         return "; ".join(m.split(": ", 1)[-1] for m in post.messages)
 
     try:
-        ev, runs = ladder_runs(lik, seed=seed, guide=guide)
+        ev, runs = ladder_runs(lik, seed=seed, guide=guide, slabs=slabs)
         post = posterior_from_particles(lik, runs, seed=seed)
         if post.converged:
             return post, ev, None, None
         first = post
-        ev, runs = ladder_runs(lik, seed=seed, guide=guide, earlier=runs)
+        ev, runs = ladder_runs(lik, seed=seed, guide=guide, earlier=runs, slabs=slabs)
         second = posterior_from_particles(lik, runs[len(runs) // 2:], seed=seed,
                                           predictive=False)
         post = posterior_from_particles(lik, runs, seed=seed)
@@ -303,8 +318,9 @@ def _certified_by_ladder(lik, post, runs, seed, remedy: str):
 
 
 def _evidence(lik, post: PosteriorResult, seed: int, route: str = "auto", *,
-              best_log_likelihood: float | None = None, importance=None) -> dict:
-    """ln Z of ``post`` by ``route``: ``{"evidence", "ladder_runs", "warnings"}``."""
+              best_log_likelihood: float | None = None, importance=None, slabs=()) -> dict:
+    """ln Z of ``post`` by ``route``: ``{"evidence", "ladder_runs", "warnings"}``; a ladder
+    proposes in the configurations ``slabs`` too."""
     out = {"evidence": None, "warnings": [], "ladder_runs": None}
     # Bridge sampling from the emcee draws needs draws that represent the posterior; where the
     # walkers did not converge (ridges, several modes), a tempered ladder reaches the posterior
@@ -318,7 +334,8 @@ def _evidence(lik, post: PosteriorResult, seed: int, route: str = "auto", *,
             out["evidence"] = importance  # the certified weights that gave the posterior
         elif ladder:
             try:
-                out["evidence"], out["ladder_runs"] = ladder_runs(lik, seed=seed, guide=post)
+                out["evidence"], out["ladder_runs"] = ladder_runs(lik, seed=seed, guide=post,
+                                                                  slabs=slabs)
             except InputError as exc:
                 if route == "ladder":
                     raise

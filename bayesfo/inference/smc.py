@@ -61,6 +61,10 @@ MIN_DISTINCT_PER_DIM = 10
 #: set enough distinct points in a narrow mode where the guide has few.
 GUIDE_EXTRA = 4000
 
+#: The share of an independence step's proposal given to the slabs of the configurations where
+#: an element vanishes (:mod:`~bayesfo.inference._configurations`), where there are any.
+SLAB_SHARE = 0.2
+
 
 @dataclass(frozen=True)
 class LadderRun:
@@ -196,7 +200,8 @@ def _next_beta(beta: float, log_lik: np.ndarray, ess_fraction: float) -> float:
 def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 1000,
                ess_fraction: float = 0.8, accepted_moves: float = 5.0, max_moves: int = 100,
                jump_fraction: float = 0.1, max_rungs: int = 2000, guide=None,
-               guided_moves: int = 2, own_moves: int = 3, final_moves: int = 30) -> LadderRun:
+               guided_moves: int = 2, own_moves: int = 3, final_moves: int = 30,
+               slabs=()) -> LadderRun:
     """One sequential Monte Carlo run from the prior to the posterior of ``lik``.
 
     At each rung the particles take Metropolis steps until each has made ``accepted_moves``
@@ -219,12 +224,19 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
     steps connect only through a narrow neck. These moves, with ``ess_fraction=0.8``, let the
     two runs of :func:`ladder_runs` agree on a posterior of two arms that meet in such a neck
     (BENCHMARKS.md, "Measurements behind design choices").
+
+    ``slabs`` (:class:`~bayesfo.inference._configurations._Slab`: configurations where an
+    element vanishes, which no optimum seeds) join the proposal of every independence step with
+    :data:`SLAB_SHARE` of its weight, at every rung: a region that the particles leave at one
+    rung is otherwise never regained, and both runs can agree on a posterior without it
+    (see :mod:`~bayesfo.inference._configurations`). The steps stay exact: the slabs' densities
+    are part of the proposal's.
     """
     return ladder_runs_together(lik, [rng], n_particles=n_particles, ess_fraction=ess_fraction,
                                 accepted_moves=accepted_moves, max_moves=max_moves,
                                 jump_fraction=jump_fraction, max_rungs=max_rungs,
                                 guides=[guide], guided_moves=guided_moves, own_moves=own_moves,
-                                final_moves=final_moves)[0]
+                                final_moves=final_moves, slabs=slabs)[0]
 
 
 def ladder_runs_together(lik: Likelihood, rngs, *, guides=None, **kwargs) -> list[LadderRun]:
@@ -286,7 +298,8 @@ def _ladder_steps(lik: Likelihood, target: _Target, rng: np.random.Generator, *,
                   n_particles: int = 1000, ess_fraction: float = 0.8,
                   accepted_moves: float = 5.0, max_moves: int = 100,
                   jump_fraction: float = 0.1, max_rungs: int = 2000, guide=None,
-                  guided_moves: int = 2, own_moves: int = 3, final_moves: int = 30):
+                  guided_moves: int = 2, own_moves: int = 3, final_moves: int = 30,
+                  slabs=()):
     """The body of :func:`ladder_run`, as a generator of evaluation requests (:func:`_drive`)
     that returns the run."""
     calls = 0
@@ -332,10 +345,11 @@ def _ladder_steps(lik: Likelihood, target: _Target, rng: np.random.Generator, *,
         beta = new_beta
         betas.append(beta)
         if guide_at is None:
-            yield from count(_guided_moves(None, u, log_prior, log_lik, beta, rng, own_moves))
+            yield from count(_guided_moves(None, u, log_prior, log_lik, beta, rng, own_moves,
+                                           slabs))
         else:
             yield from count(_guided_moves(guide_at.mixture(beta, rng), u, log_prior, log_lik,
-                                           beta, rng, guided_moves))
+                                           beta, rng, guided_moves, slabs))
         snapshot = u.copy()
         accepted = np.zeros(n)
         steps = 0
@@ -373,7 +387,7 @@ def _ladder_steps(lik: Likelihood, target: _Target, rng: np.random.Generator, *,
     # mixture at β = 1 takes part: a narrow mode that holds few particles gets no component of
     # the particles' own mixture.
     yield from count(_guided_moves(None if guide_at is None else guide_at.mixture(1.0, rng), u,
-                                   log_prior, log_lik, 1.0, rng, final_moves))
+                                   log_prior, log_lik, 1.0, rng, final_moves, slabs))
     return LadderRun(log_z=log_z, betas=np.array(betas), particles=u, log_likelihood=log_lik,
                      acceptance=np.array(acceptance), n_likelihood=calls)
 
@@ -422,10 +436,11 @@ class _Guide:
 
 
 def _guided_moves(guide_mix: _GaussianMixture | None, u, log_prior, log_lik, beta: float,
-                  rng: np.random.Generator, steps: int):
+                  rng: np.random.Generator, steps: int, slabs=()):
     """Independence Metropolis–Hastings steps (in place) targeting prior · L^β, proposing from
     ½ (mixture fitted to the particles) + ½ (``guide_mix``), or from the particles' mixture
-    alone without a guide."""
+    alone without a guide; ``slabs`` (configurations where an element vanishes) take
+    :data:`SLAB_SHARE` of the proposal's weight, in equal parts, from the others."""
     if steps <= 0:
         return
     n, d = u.shape
@@ -433,19 +448,33 @@ def _guided_moves(guide_mix: _GaussianMixture | None, u, log_prior, log_lik, bet
     own = _GaussianMixture.fit(unique, rng) if len(unique) >= 10 * d else None
     if own is None:
         return
+    parts = [own] if guide_mix is None else [own, guide_mix]
+    weights = [1.0 / len(parts)] * len(parts)
+    if slabs:
+        weights = [w * (1.0 - SLAB_SHARE) for w in weights] + [SLAB_SHARE / len(slabs)] * len(slabs)
+        parts += list(slabs)
+    log_weights = np.log(weights)
 
     def log_q(x):
-        if guide_mix is None:
+        if len(parts) == 1:
             return own.log_pdf(x)
-        return np.logaddexp(own.log_pdf(x), guide_mix.log_pdf(x)) - math.log(2.0)
+        return logsumexp([lw + p.log_pdf(x) for lw, p in zip(log_weights, parts, strict=True)],
+                         axis=0)
 
     log_q_u = log_q(u)  # kept up to date as moves are accepted, not evaluated again
     for _ in range(steps):
-        if guide_mix is None:
+        if len(parts) == 1:
             prop = own.sample(n, rng)
-        else:
+        elif not slabs:
             from_guide = rng.random(n) < 0.5
             prop = np.where(from_guide[:, None], guide_mix.sample(n, rng), own.sample(n, rng))
+        else:
+            which = rng.choice(len(parts), size=n, p=weights)
+            prop = np.empty_like(u)
+            for i, part in enumerate(parts):
+                rows = np.flatnonzero(which == i)
+                if rows.size:
+                    prop[rows] = part.sample(rows.size, rng)
         log_q_prop = log_q(prop)
         ok = yield from _accept(prop, u, log_prior, log_lik, beta, np.log(rng.random(n)),
                                 log_q_prop, log_q_u)

@@ -1,0 +1,215 @@
+"""Configurations of a posterior that no optimum seeds: an element that vanishes.
+
+Where the data leave an element invisible, its coefficient is free from where it stops mattering
+down to its prior bound: the posterior holds a region (a *plateau* along that coefficient, in
+the sampling coordinates where the prior is flat) in which the other parameters take the values
+that describe the data without the element, often far from the optimum's (a Zener whose spring
+vanishes makes do with a springpot of small order and a large viscosity). The optimiser ends at
+one configuration; the importance proposal and the guide of the tempered ladder are built
+there; and a ladder's particles that lose the plateau at one rung never regain it, since its
+differential-evolution moves cannot jump between regions and its independence moves propose
+from mixtures fitted to where the particles already are. Two runs that agree can then both
+miss a tenth of the posterior (BENCHMARKS.md, "Nineteenth session").
+
+:func:`vanishing_slabs` looks for each such configuration from each optimum: the coefficient
+held near its lower prior bound, the others maximised (a profile point, as the ridge probe's),
+kept where the log posterior there is within :data:`DEPTH` nats of the highest optimum and the
+guide's draws do not already reach the plateau. Each becomes a :class:`_Slab`, a proposal
+component with an exact density: uniform along the coefficient from its bound to where the
+plateau ends, normal in the other coordinates (the cross-section's Laplace covariance, widened).
+The ladder proposes from the slabs at every rung (:func:`~bayesfo.inference.smc.ladder_run`),
+so that particles move between the plateau and the rest as each tempered posterior requires.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ._ridge import _profile_point
+
+#: Where a coefficient is held to find the configuration in which its element vanishes: this
+#: share of its prior range (in the sampling coordinates) above its lower bound.
+VANISH = 0.02
+#: Configurations whose profile point lies more than this many nats below the highest optimum
+#: are left out (their mass is negligible unless the plateau is very long: e^-10 of the peak's
+#: height over a plateau a hundred times the peak's width is 0.5 % of the posterior).
+DEPTH = 10.0
+#: The plateau ends where the log posterior along the coefficient (the others held at the
+#: configuration) falls this many nats below the configuration's value.
+PLATEAU_DROP = 3.0
+#: A configuration whose plateau already holds this share of the guide's draws is covered.
+COVERED = 0.05
+#: Scale of a slab's normal part relative to the cross-section's Laplace covariance (the
+#: importance proposal's).
+SLAB_SCALE = 1.5
+#: Points of the grid along the coefficient on which the plateau's end is found.
+PLATEAU_GRID = 101
+#: Profile points from the plateau's end to the optimum: the way between the two regions,
+#: where the other parameters move from the configuration's values to the optimum's.
+CHAIN_POINTS = 8
+
+
+@dataclass(frozen=True)
+class _Slab:
+    """A proposal component for the configuration where coordinate ``index`` has vanished:
+    uniform on [``lo``, ``hi``] along it, normal with mean ``mean`` (that coordinate's entry
+    unused) and Cholesky factor ``chol`` in the others."""
+
+    index: int
+    lo: float
+    hi: float
+    mean: np.ndarray
+    chol: np.ndarray
+    #: The log posterior at the configuration (the profile point).
+    height: float
+
+    @property
+    def _rest(self) -> np.ndarray:
+        return np.delete(np.arange(self.mean.size), self.index)
+
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        rest = self._rest
+        x = np.empty((n, self.mean.size))
+        x[:, self.index] = rng.uniform(self.lo, self.hi, size=n)
+        x[:, rest] = self.mean[rest] + rng.standard_normal((n, rest.size)) @ self.chol.T
+        return x
+
+    @cached_property
+    def _whitening(self) -> tuple[np.ndarray, float]:
+        inverse = np.linalg.inv(self.chol)
+        const = (-float(np.sum(np.log(np.diag(self.chol))))
+                 - 0.5 * (self.mean.size - 1) * math.log(2 * math.pi)
+                 - math.log(self.hi - self.lo))
+        return inverse, const
+
+    def log_pdf(self, x: np.ndarray) -> np.ndarray:
+        rest = self._rest
+        inverse, const = self._whitening
+        z = (x[:, rest] - self.mean[rest]) @ inverse.T
+        column = x[:, self.index]
+        inside = (column >= self.lo) & (column <= self.hi)
+        return np.where(inside, const - 0.5 * np.einsum("ij,ij->i", z, z), -np.inf)
+
+
+def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None) -> list[_Slab]:
+    """The configurations where one coefficient's element vanishes, as :class:`_Slab`\\ s (see
+    the module's docstring); ``modes_u``: the optima in the sampling coordinates (rows, with the
+    noise parameter where ``lik`` has one); ``guide_u``: draws that already cover the posterior
+    as far as they reach (a configuration whose plateau holds :data:`COVERED` of them gives no
+    slab). Deterministic: no random step."""
+    from .transform import _log_prob_fn, _Transform
+
+    tr = _Transform(lik)
+    log_prob = _log_prob_fn(lik, tr)
+    modes_u = np.atleast_2d(np.asarray(modes_u, dtype=float))
+    heights = log_prob(modes_u)
+    keep = np.isfinite(heights)
+    if not np.any(keep):
+        return []
+    modes_u, heights = modes_u[keep], heights[keep]
+    top = float(np.max(heights))
+    lo, hi = tr.lo_u, tr.hi_u
+    slabs: list[_Slab] = []
+    for j, p in enumerate(lik.structure.parameters):
+        if p.role == "exponent" or not tr.log[j] or not np.isfinite(hi[j] - lo[j]):
+            continue
+        value = lo[j] + VANISH * (hi[j] - lo[j])
+        for mode in modes_u:
+            if mode[j] <= value:
+                continue  # the optimum is this configuration: the proposal is built there
+            u, height, cross = _profile_point(log_prob, mode[None, :], j, value, lo, hi)
+            if cross is None or not height >= top - DEPTH:
+                continue
+            grid = np.linspace(lo[j], hi[j], PLATEAU_GRID)
+            along = np.repeat(u[None, :], grid.size, axis=0)
+            along[:, j] = grid
+            fallen = np.flatnonzero(~(log_prob(along) >= height - PLATEAU_DROP) & (grid > value))
+            end = float(grid[fallen[0]]) if fallen.size else float(hi[j])
+            if guide_u is not None and len(guide_u) and np.mean(guide_u[:, j] <= end) >= COVERED:
+                continue
+            if any(isinstance(s, _Slab) and s.index == j and abs(s.hi - end) < 1e-9
+                   and np.allclose(s.mean, u) for s in slabs):
+                continue
+            eig, vec = cross
+            cov = SLAB_SCALE**2 * (vec / eig[None, :]) @ vec.T
+            try:
+                chol = np.linalg.cholesky(cov)
+            except np.linalg.LinAlgError:
+                continue
+            slabs.append(_Slab(index=j, lo=float(lo[j]), hi=end, mean=u, chol=chol,
+                               height=float(height)))
+            way = _way(log_prob, u, mode, j, end, lo, hi, top)
+            if way is not None:
+                slabs.append(way)
+    return slabs
+
+
+def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, hi,
+         top: float):
+    """Normal components on the way from a plateau's end (``end`` along coordinate ``j``) to
+    the optimum ``mode``: :data:`CHAIN_POINTS` profile points at equal steps of the coordinate,
+    each started from the one before, with the cross-section's Laplace covariance (widened by
+    :data:`SLAB_SCALE`) and the step along the crest; weighted by their Laplace masses. A
+    :class:`~bayesfo.inference._mixture._GaussianMixture`, or None where no point is within
+    :data:`DEPTH` of ``top`` or the way is empty."""
+    from ._mixture import _GaussianMixture
+
+    if not mode[j] > end:
+        return None
+    d = start.size
+    rest = np.delete(np.arange(d), j)
+    values = np.linspace(end, mode[j], CHAIN_POINTS + 2)[1:-1]
+    step = float(values[1] - values[0]) if values.size > 1 else float(mode[j] - end)
+    means, chols, log_masses = [], [], []
+    here, before = start, start
+    for value in values:
+        guess = here + (here - before) * (value - here[j]) / (here[j] - before[j]) \
+            if here[j] != before[j] else here
+        point, height, cross = _profile_point(log_prob, np.array([guess, here, mode]), j, value,
+                                              lo, hi)
+        before, here = here, point
+        if cross is None or not height >= top - DEPTH:
+            continue
+        eig, vec = cross
+        cov = np.zeros((d, d))
+        cov[np.ix_(rest, rest)] = SLAB_SCALE**2 * (vec / eig[None, :]) @ vec.T
+        tangent = (here - before) / (here[j] - before[j])
+        cov += step**2 * np.outer(tangent, tangent)
+        try:
+            chols.append(np.linalg.cholesky(cov))
+        except np.linalg.LinAlgError:
+            continue
+        means.append(point)
+        log_masses.append(height + float(np.sum(np.log(np.diag(chols[-1])))))
+    if not means:
+        return None
+    weights = np.exp(np.array(log_masses) - max(log_masses))
+    return _GaussianMixture(weights / weights.sum(), np.array(means), np.array(chols))
+
+
+def configurations(lik, modes_scaled, guide_u=None) -> list:
+    """:func:`vanishing_slabs` from the optima as ``certified_posterior`` receives them
+    (scaled coordinates without the noise parameter, whose estimate at each optimum is added
+    where ``lik`` has one); [] where the search fails numerically."""
+    from .transform import _Transform
+
+    modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
+    if modes.size == 0:
+        return []
+    if lik.noise_param:
+        modes = np.column_stack([modes, lik.noise_estimate(modes)])
+    try:
+        with np.errstate(all="ignore"):
+            return vanishing_slabs(lik, _Transform(lik).to_u(modes), guide_u)
+    except (np.linalg.LinAlgError, FloatingPointError, ValueError):
+        return []
+
+
+def vanished(lik, slabs) -> list[str]:
+    """The names of the coefficients whose vanishing the slabs describe, each once."""
+    names = lik.param_names
+    return list(dict.fromkeys(names[s.index] for s in slabs if isinstance(s, _Slab)))

@@ -42,7 +42,7 @@ import numpy as np
 
 from ..errors import CertifiedWarning, ConvergenceWarning, EvidenceWarning, InputError
 from ..options import EVIDENCE_ROUTES, SAMPLERS
-from ._configurations import configurations, vanished
+from ._configurations import configurations, missed_share, vanished
 from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
 from .importance import importance_posterior
 from .likelihood import Likelihood
@@ -138,9 +138,12 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
             post, ev, info = importance_posterior(lik, modes, seed=seed)
         except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
             post, ev, info = None, None, {}
+        if post is not None and ev is not None:
+            post, ev, slabs = _configurations_checked(lik, modes, post, ev, info, seed)
         if post is None and evidence == "auto" and not sampler_options:
             guide = info.get("proposal_draws")
-            slabs = configurations(lik, modes, guide)
+            if slabs is None:
+                slabs = configurations(lik, modes, guide)
             post, ev, tried, more = _ladder_first(lik, seed, guide, slabs)
     notes = []
     # The warnings of emcee's draws are held until it is known whether they are the posterior
@@ -151,7 +154,8 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
             x0 = modes if starts is None or not np.size(starts) else np.vstack([modes, starts])
             post = sample_posterior(lik, x0, seed=seed, progress=False,
                                     **{"give_up": True, **sampler_options})
-        if post.sampler == "ladder" and info and (info.get("undetermined") or info.get("ridge")):
+        if post.sampler == "ladder" and info and (info.get("undetermined") or info.get("ridge")
+                                                  or info.get("vanishing")):
             notes.append(f"{name}: {info['reason']}; the tempered ladder, started from the "
                          "prior, gave the posterior")
         if more and post.sampler == "ladder":
@@ -197,6 +201,38 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         evidence_agree=checked.get("evidence_agree"), notes=tuple(notes),
         importance=info if post.sampler == "importance" else None,
         best_log_likelihood=max(best, post.max_log_likelihood))
+
+
+#: The share of the posterior that configurations where an element vanishes may hold beyond
+#: the importance draws' reach (:func:`~._configurations.missed_share`) for the weights to
+#: certify it: the ridge probe's threshold, for the same reason.
+CONFIGURATIONS_MISSED = 0.03
+
+
+def _configurations_checked(lik, modes, post, ev, info: dict, seed: int):
+    """The fourth part of the importance route's certificate, where its weights gave the
+    posterior and ln Z (no ladder runs to check them): the configurations where an element
+    vanishes (:mod:`~._configurations`), which no optimum seeds, and the posterior mass they
+    hold beyond the draws' range. Records ``configurations`` in ``info`` (the coefficients
+    whose vanishing was found, the share missed); where it exceeds :data:`CONFIGURATIONS_MISSED`
+    the importance posterior is not certified (``vanishing`` and ``reason`` in ``info``, its
+    draws the ladder's guide). Returns (posterior or None, evidence or None, slabs)."""
+    draws_u = _Transform(lik).to_u(post.samples_scaled)
+    slabs = configurations(lik, modes, draws_u)
+    names = vanished(lik, slabs)
+    missed = 0.0
+    if slabs:
+        with np.errstate(all="ignore"):
+            missed = missed_share(lik, slabs, draws_u, ev.log_z + ev.log_support, seed)
+    info["configurations"] = {"vanishing": names, "missed": missed}
+    if not missed > CONFIGURATIONS_MISSED:
+        return post, ev, slabs
+    info["vanishing"] = names
+    info["reason"] = (f"where {' or '.join(names)} vanish{'es' if len(names) == 1 else ''}, the "
+                      f"posterior holds about {100 * missed:.0f} % of its mass beyond the "
+                      "importance draws' reach")
+    info["proposal_draws"] = draws_u
+    return None, None, slabs
 
 
 def _ladder_first(lik, seed: int, guide=None, slabs=()):

@@ -389,6 +389,13 @@ def _diagnostics_section(comparison) -> str:
                     how += (f" (after widening it along a ridge in {_e(probe['ridge'])}, where "
                             f"the first proposal missed an estimated "
                             f"{_num(100 * probe.get('covered', 0.0), '.0f')} %)")
+            found = info.get("configurations")
+            if found is not None:
+                vanishing = found.get("vanishing") or []
+                how += ("; configurations where an element vanishes: "
+                        + (f"{_e(', '.join(vanishing))}, "
+                           f"{_num(100 * found.get('missed', 0.0), '.1f')} % of the posterior "
+                           "beyond the draws' reach" if vanishing else "none"))
             rounds = info.get("k_hat_rounds") or []
             if len(rounds) > 1:
                 how += (f"; {len(rounds)} rounds of importance sampling (k̂ "

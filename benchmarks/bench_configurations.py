@@ -11,7 +11,8 @@ springpot of small order and a large viscosity) beside the optimum's. Printed:
   from 1 000 000 draws of a proposal that covers both regions: a normal mixture fitted to the
   route's draws at twice their scale, and the slabs and ways of
   :func:`bayesfo.inference._configurations.configurations` (exact densities), with the Pareto k̂
-  of the weights (below 0.7: the estimate converges) and their ESS;
+  of the weights (below 0.7: the estimate converges) and their ESS, and ln Z' (the log
+  evidence on the support, the prior normalised on its box);
 - for seeds 44-47 of ``certified_posterior`` with the configurations searched (the default) and
   without (``--without`` adds that run): the route, its seconds, the share below 0.0646 and the
   bins, and ln Z.
@@ -68,7 +69,9 @@ def _exact(lik, draws_u, slabs, n=1_000_000, seed=5):
     smoothed, k_hat = psis(lp[ok] - log_q[ok])
     w = np.exp(smoothed - logsumexp(smoothed))
     u0 = x[ok, 0]
-    return float(w[u0 < math.log(setup.LOWEST)].sum()), _bins(u0, w), float(k_hat), float(1 / np.sum(w**2))
+    log_z = float(logsumexp(lp[ok] - log_q[ok]) - math.log(n))
+    return (float(w[u0 < math.log(setup.LOWEST)].sum()), _bins(u0, w), float(k_hat),
+            float(1 / np.sum(w**2)), log_z)
 
 
 def main() -> None:
@@ -103,9 +106,9 @@ def main() -> None:
         finally:
             certified.configurations = saved
     slabs = configurations(lik, modes, route_draws[:0])
-    share, bins, k_hat, ess = _exact(lik, route_draws, slabs)
+    share, bins, k_hat, ess, log_z = _exact(lik, route_draws, slabs)
     print(f"exact (importance sampling, 1 000 000 draws, k̂ {k_hat:.2f}, ESS {ess:.0f}): share "
-          f"below {setup.LOWEST}: {share:.3f}, bins {bins}")
+          f"below {setup.LOWEST}: {share:.3f}, bins {bins}; ln Z' (on the support) {log_z:.3f}")
     print(f"bins of ln G_e: {', '.join(f'[{a:.2f}, {b:.2f})' for a, b in zip(EDGES[:-1], EDGES[1:]))}")
 
 

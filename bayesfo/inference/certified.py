@@ -17,9 +17,14 @@ The routes, in order, with ``sampler="auto"``:
    mixture fitted to them, if its k̂ is below 0.5, else from a tempered ladder, whose
    particles replace the importance draws where :data:`LADDER_MISSED` more of them lie outside
    the draws' range than draws of one posterior would and its runs agree: the draws missed
-   part of the posterior);
+   part of the posterior); where the weights give ln Z and no ladder runs, the configurations
+   where an element vanishes (:mod:`~bayesfo.inference._configurations`: a coefficient at its
+   lower prior bound, the others maximised), which no optimum seeds, are searched, and the
+   posterior mass they hold beyond the draws' range must be at most
+   :data:`CONFIGURATIONS_MISSED`;
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
-   tempered ladder guided by the proposal's draws: their final particles are the posterior
+   tempered ladder guided by the proposal's draws (and proposing in the configurations where
+   an element vanishes, as every ladder of this module does where there are any): their final particles are the posterior
    when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do
    not, two more runs, and the four where the new pair agrees and all four agree;
 3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its

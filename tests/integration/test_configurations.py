@@ -7,6 +7,8 @@ of its mass, beside the optimum's. The share below G_e = :data:`LOWEST` (scaled)
 importance sampling from a million draws of a proposal that covers both regions (Pareto k̂
 0.39-0.47; ``benchmarks/bench_configurations.py``). Before the search for such configurations,
 the default route's tempered ladders put none of their particles there, and both runs agreed.
+The log evidence on the support, ln Z' (prior normalised on its box), is -6.09 by the same
+computation.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import math
 import warnings
 
 import numpy as np
+import pytest
 
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference import Likelihood, certified_posterior, starting_points
@@ -22,8 +25,9 @@ from bayesfo.structures import get_structure
 
 #: The lowest G_e (scaled) of the route's draws before the configurations were searched.
 LOWEST = 0.0646
-#: The posterior's share below it, by the independent computation above.
+#: The posterior's share below it, and ln Z', by the independent computation above.
 EXACT_SHARE = 0.095
+EXACT_LOG_Z_SUPPORT = -6.09
 
 
 def set_44():
@@ -50,11 +54,16 @@ def set_44():
     return lik, modes, starts
 
 
-def test_a_vanishing_spring_gets_its_share_of_the_posterior():
+@pytest.fixture(scope="module")
+def route():
     lik, modes, starts = set_44()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        found = certified_posterior(lik, modes, starts=starts, seed=44)
+        return lik, modes, certified_posterior(lik, modes, starts=starts, seed=44)
+
+
+def test_a_vanishing_spring_gets_its_share_of_the_posterior(route):
+    lik, _, found = route
     post = found.posterior
     assert post.converged and post.sampler == "ladder"
     assert any("G_e" in note and "vanish" in note for note in found.notes)
@@ -63,3 +72,23 @@ def test_a_vanishing_spring_gets_its_share_of_the_posterior():
     # scatter (0.079-0.106 per run over four seeds): ±0.035 is about 3.5 standard errors of a run.
     assert abs(share - EXACT_SHARE) < 0.035, share
     assert math.isfinite(found.evidence.log_z)
+
+
+def test_the_mass_beyond_draws_that_miss_the_configuration_is_estimated(route):
+    """The importance route's check (:func:`~bayesfo.inference._configurations.missed_share`)
+    on draws that miss the region (the route's draws above :data:`LOWEST`): the mass beyond
+    their range is the region's share, 0.095, which the estimate approaches from below (it
+    counts the slabs' draws alone; 0.079-0.095 over five seeds). Draws that hold the region
+    leave little beyond their range."""
+    from bayesfo.inference._configurations import configurations, missed_share
+    from bayesfo.inference.transform import _Transform
+
+    lik, modes, found = route
+    u = _Transform(lik).to_u(found.posterior.samples_scaled)
+    main = u[u[:, 0] > math.log(LOWEST)]
+    slabs = configurations(lik, modes, main)
+    assert slabs
+    share = missed_share(lik, slabs, main, EXACT_LOG_Z_SUPPORT, seed=0)
+    assert 0.06 < share < 0.12, share
+    # The whole posterior's draws: the slabs' mass beyond their range is small.
+    assert missed_share(lik, slabs, u, EXACT_LOG_Z_SUPPORT, seed=0) < 0.02

@@ -29,7 +29,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ._ridge import _profile_point
+from ._ridge import PROBE_MAX_DIM, _profile_point
 
 #: Where a coefficient is held to find the configuration in which its element vanishes: this
 #: share of its prior range (in the sampling coordinates) above its lower bound.
@@ -48,6 +48,16 @@ COVERED = 0.05
 SLAB_SCALE = 1.5
 #: Points of the grid along the coefficient on which the plateau's end is found.
 PLATEAU_GRID = 101
+#: The configurations are searched from this many of the highest optima (a bound on the cost:
+#: each start is a profile optimisation per coefficient, and the optimiser's optima of one
+#: posterior often lie along one ridge).
+MODES = 3
+#: A configuration whose profile point ends between :data:`DEPTH` and this many nats below the
+#: highest optimum is searched again by Nelder-Mead (:func:`_retried`); one further below is
+#: taken as an element that cannot vanish.
+RETRY = 1000.0
+#: Function evaluations of that search, per coordinate.
+RETRY_EVALUATIONS = 300
 #: Profile points from the plateau's end to the optimum: the way between the two regions,
 #: where the other parameters move from the configuration's values to the optimum's.
 CHAIN_POINTS = 8
@@ -112,40 +122,105 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
         return []
     modes_u, heights = modes_u[keep], heights[keep]
     top = float(np.max(heights))
+    modes_u = modes_u[np.argsort(-heights, kind="stable")[:MODES]]
     lo, hi = tr.lo_u, tr.hi_u
     slabs: list[_Slab] = []
     for j, p in enumerate(lik.structure.parameters):
         if p.role == "exponent" or not tr.log[j] or not np.isfinite(hi[j] - lo[j]):
             continue
         value = lo[j] + VANISH * (hi[j] - lo[j])
+        best = None
         for mode in modes_u:
             if mode[j] <= value:
                 continue  # the optimum is this configuration: the proposal is built there
             u, height, cross = _profile_point(log_prob, mode[None, :], j, value, lo, hi)
-            if cross is None or not height >= top - DEPTH:
+            if best is None or height > best[1]:
+                best = (u, height, cross, mode)
+        if best is None:
+            continue
+        u, height, cross, mode = best
+        if top - RETRY >= height or height >= top - DEPTH:
+            pass  # far below (the element cannot vanish), or found
+        else:
+            # Where two springpots exchange roles (one vanishes, the other takes over with
+            # nearly the same order), the profile's Newton and L-BFGS-B steps stall in a narrow
+            # curved valley far below its floor: Nelder-Mead from where they ended.
+            u, height, cross = _retried(log_prob, u, j, value, lo, hi)
+        if not height >= top - DEPTH:
+            continue
+        if cross is None:
+            cross = _cross_section(log_prob, u, j, lo, hi)
+            if cross is None:
                 continue
-            grid = np.linspace(lo[j], hi[j], PLATEAU_GRID)
-            along = np.repeat(u[None, :], grid.size, axis=0)
-            along[:, j] = grid
-            fallen = np.flatnonzero(~(log_prob(along) >= height - PLATEAU_DROP) & (grid > value))
-            end = float(grid[fallen[0]]) if fallen.size else float(hi[j])
-            if guide_u is not None and len(guide_u) and np.mean(guide_u[:, j] <= end) >= COVERED:
-                continue
-            if any(isinstance(s, _Slab) and s.index == j and abs(s.hi - end) < 1e-9
-                   and np.allclose(s.mean, u) for s in slabs):
-                continue
-            eig, vec = cross
-            cov = SLAB_SCALE**2 * (vec / eig[None, :]) @ vec.T
-            try:
-                chol = np.linalg.cholesky(cov)
-            except np.linalg.LinAlgError:
-                continue
-            slabs.append(_Slab(index=j, lo=float(lo[j]), hi=end, mean=u, chol=chol,
-                               height=float(height)))
-            way = _way(log_prob, u, mode, j, end, lo, hi, top)
-            if way is not None:
-                slabs.append(way)
+        grid = np.linspace(lo[j], hi[j], PLATEAU_GRID)
+        along = np.repeat(u[None, :], grid.size, axis=0)
+        along[:, j] = grid
+        fallen = np.flatnonzero(~(log_prob(along) >= height - PLATEAU_DROP) & (grid > value))
+        end = float(grid[fallen[0]]) if fallen.size else float(hi[j])
+        if guide_u is not None and len(guide_u) and np.mean(guide_u[:, j] <= end) >= COVERED:
+            continue
+        eig, vec = cross
+        cov = SLAB_SCALE**2 * (vec / eig[None, :]) @ vec.T
+        try:
+            chol = np.linalg.cholesky(cov)
+        except np.linalg.LinAlgError:
+            continue
+        slabs.append(_Slab(index=j, lo=float(lo[j]), hi=end, mean=u, chol=chol,
+                           height=float(height)))
+        way = _way(log_prob, u, mode, j, end, lo, hi, top)
+        if way is not None:
+            slabs.append(way)
     return slabs
+
+
+def _cross_section(log_prob, u: np.ndarray, j: int, lo, hi):
+    """The precision of the cross-section at ``u`` (coordinate ``j`` held) as eigenvalues and
+    eigenvectors, where :func:`~._ridge._profile_point` found it not peaked: directions without
+    curvature (the order of the element that vanished, which the data no longer see) get a
+    variance that spreads over the prior box, as in the importance route's Laplace
+    approximations. None where the difference stencil leaves the support."""
+    from ._peaks import _hessian
+
+    rest = np.delete(np.arange(u.size), j)
+    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u))[rest]
+    h = 1e-4 * span
+    point = np.clip(u[rest], lo[rest] + 3 * h, hi[rest] - 3 * h)
+
+    def g(r):
+        x = np.repeat(u[None, :], len(r), axis=0)
+        x[:, rest] = r
+        return log_prob(x)
+
+    out = _hessian(g, point, h)
+    if out is None:
+        return None
+    eig, vec = np.linalg.eigh(-out[2])
+    if not np.all(np.isfinite(eig)):
+        return None
+    floor = 1.0 / (np.max(span) / 4.0) ** 2
+    return np.where(eig > floor, eig, floor), vec
+
+
+def _retried(log_prob, u: np.ndarray, j: int, value: float, lo, hi):
+    """The profile point at ``value`` of coordinate ``j`` again: Nelder-Mead over the other
+    coordinates from ``u`` (the box's outside is the worst value), then the profile's Newton
+    steps from its end for the cross-section's curvature. Returns (point, value, cross)."""
+    from scipy.optimize import minimize
+
+    rest = np.delete(np.arange(u.size), j)
+
+    def negative(r):
+        x = u.copy()
+        x[rest] = r
+        v = float(log_prob(x[None, :])[0])
+        return -v if np.isfinite(v) else 1e300
+
+    found = minimize(negative, u[rest], method="Nelder-Mead",
+                     options={"maxfev": RETRY_EVALUATIONS * rest.size, "xatol": 1e-9,
+                              "fatol": 1e-9, "adaptive": True})
+    start = u.copy()
+    start[rest] = found.x
+    return _profile_point(log_prob, start[None, :], j, value, lo, hi)
 
 
 def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, hi,
@@ -172,8 +247,12 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
         point, height, cross = _profile_point(log_prob, np.array([guess, here, mode]), j, value,
                                               lo, hi)
         before, here = here, point
-        if cross is None or not height >= top - DEPTH:
+        if not height >= top - DEPTH:
             continue
+        if cross is None:
+            cross = _cross_section(log_prob, point, j, lo, hi)
+            if cross is None:
+                continue
         eig, vec = cross
         cov = np.zeros((d, d))
         cov[np.ix_(rest, rest)] = SLAB_SCALE**2 * (vec / eig[None, :]) @ vec.T
@@ -194,11 +273,13 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
 def configurations(lik, modes_scaled, guide_u=None) -> list:
     """:func:`vanishing_slabs` from the optima as ``certified_posterior`` receives them
     (scaled coordinates without the noise parameter, whose estimate at each optimum is added
-    where ``lik`` has one); [] where the search fails numerically."""
+    where ``lik`` has one); [] where the search fails numerically, and for posteriors of more
+    than :data:`~._ridge.PROBE_MAX_DIM` parameters (each profile point maximises over all the
+    others, as the ridge probe's: the joint master-curve posteriors are not searched)."""
     from .transform import _Transform
 
     modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
-    if modes.size == 0:
+    if modes.size == 0 or lik.ndim > PROBE_MAX_DIM:
         return []
     if lik.noise_param:
         modes = np.column_stack([modes, lik.noise_estimate(modes)])

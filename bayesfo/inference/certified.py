@@ -48,6 +48,7 @@ import numpy as np
 from ..errors import CertifiedWarning, ConvergenceWarning, EvidenceWarning, InputError
 from ..options import EVIDENCE_ROUTES, SAMPLERS
 from ._configurations import configurations, missed_share, vanished
+from ._ridge import PROBE_MAX_DIM
 from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
 from .importance import importance_posterior
 from .likelihood import Likelihood
@@ -230,6 +231,8 @@ def _configurations_checked(lik, modes, post, ev, info: dict, seed: int):
         with np.errstate(all="ignore"):
             missed = missed_share(lik, slabs, draws_u, ev.log_z + ev.log_support, seed)
     info["configurations"] = {"vanishing": names, "missed": missed}
+    if lik.ndim > PROBE_MAX_DIM:
+        info["configurations"]["skipped"] = f"{lik.ndim} parameters, more than {PROBE_MAX_DIM}"
     if not missed > CONFIGURATIONS_MISSED:
         return post, ev, slabs
     info["vanishing"] = names

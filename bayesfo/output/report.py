@@ -390,7 +390,10 @@ def _diagnostics_section(comparison) -> str:
                             f"the first proposal missed an estimated "
                             f"{_num(100 * probe.get('covered', 0.0), '.0f')} %)")
             found = info.get("configurations")
-            if found is not None:
+            if found is not None and found.get("skipped"):
+                how += (f"; configurations where an element vanishes not searched "
+                        f"({_e(found['skipped'])})")
+            elif found is not None:
                 vanishing = found.get("vanishing") or []
                 how += ("; configurations where an element vanishes: "
                         + (f"{_e(', '.join(vanishing))}, "

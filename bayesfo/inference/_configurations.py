@@ -4,21 +4,28 @@ Where the data leave an element invisible, its coefficient is free from where it
 down to its prior bound: the posterior holds a region (a *plateau* along that coefficient, in
 the sampling coordinates where the prior is flat) in which the other parameters take the values
 that describe the data without the element, often far from the optimum's (a Zener whose spring
-vanishes makes do with a springpot of small order and a large viscosity). The optimiser ends at
-one configuration; the importance proposal and the guide of the tempered ladder are built
-there; and a ladder's particles that lose the plateau at one rung never regain it, since its
-differential-evolution moves cannot jump between regions and its independence moves propose
-from mixtures fitted to where the particles already are. Two runs that agree can then both
-miss a tenth of the posterior (BENCHMARKS.md, "Nineteenth session").
+vanishes makes do with a springpot of small order and a large viscosity; two springpots of
+nearly equal order, one vanishing while the other takes over). The optimiser ends at one
+configuration; the importance proposal and the guide of the tempered ladder are built there;
+and a ladder whose particles leave the plateau at one rung does not regain it: the
+differential-evolution moves cannot reach a region that no particle occupies, and the
+independence moves propose from mixtures fitted to where the particles already are. Two runs
+that agree can then both miss a tenth of the posterior (BENCHMARKS.md, "Nineteenth session").
 
-:func:`vanishing_slabs` looks for each such configuration from each optimum: the coefficient
-held near its lower prior bound, the others maximised (a profile point, as the ridge probe's),
-kept where the log posterior there is within :data:`DEPTH` nats of the highest optimum and the
-guide's draws do not already reach the plateau. Each becomes a :class:`_Slab`, a proposal
-component with an exact density: uniform along the coefficient from its bound to where the
-plateau ends, normal in the other coordinates (the cross-section's Laplace covariance, widened).
-The ladder proposes from the slabs at every rung (:func:`~bayesfo.inference.smc.ladder_run`),
-so that particles move between the plateau and the rest as each tempered posterior requires.
+:func:`vanishing_slabs` looks for each such configuration from the highest optima: the
+coefficient held near its lower prior bound, the others maximised (a profile point, as the
+ridge probe's), kept where the log posterior there is within :data:`DEPTH` nats of the highest
+optimum and the guide's draws do not already reach the plateau. Each becomes a :class:`_Slab`,
+a proposal component with an exact density: uniform along the coefficient from its bound to
+where the plateau ends, normal in the other coordinates (the cross-section's Laplace covariance,
+widened), and a *way*, normal components at profile points from the plateau's end back to the
+optimum, where the other parameters change from one configuration's values to the other's. The
+ladder proposes from them at every rung (:func:`~bayesfo.inference.smc.ladder_run`), so that
+particles move between the plateau and the rest as each tempered posterior requires; the
+importance route's certificate estimates the mass they hold beyond its draws
+(:func:`missed_share`). Only configurations that this search finds are covered: posteriors of
+more than :data:`~._ridge.PROBE_MAX_DIM` parameters are not searched, and a configuration whose
+profile point the optimisers do not reach is not found.
 """
 
 from __future__ import annotations
@@ -48,9 +55,9 @@ COVERED = 0.05
 SLAB_SCALE = 1.5
 #: Points of the grid along the coefficient on which the plateau's end is found.
 PLATEAU_GRID = 101
-#: The configurations are searched from this many of the highest optima (a bound on the cost:
-#: each start is a profile optimisation per coefficient, and the optimiser's optima of one
-#: posterior often lie along one ridge).
+#: The configurations are searched from this many of the highest optima: a bound on the cost
+#: (each start is a profile optimisation per coefficient; the optimiser can return many optima
+#: along one ridge, eight on a fractional_kelvin_voigt data set of the certificate study).
 MODES = 3
 #: A configuration whose profile point ends between :data:`DEPTH` and this many nats below the
 #: highest optimum is searched again by Nelder-Mead (:func:`_retried`); one further below is
@@ -143,15 +150,16 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
             pass  # far below (the element cannot vanish), or found
         else:
             # Where two springpots exchange roles (one vanishes, the other takes over with
-            # nearly the same order), the profile's Newton and L-BFGS-B steps stall in a narrow
-            # curved valley far below its floor: Nelder-Mead from where they ended.
+            # nearly the same order), the profile's Newton and L-BFGS-B steps can stall in a
+            # narrow curved valley, far below the valley's highest point: Nelder-Mead from where
+            # they ended (BENCHMARKS.md, "Nineteenth session": 112 nats below, then found).
             u, height, cross = _retried(log_prob, u, j, value, lo, hi)
         if not height >= top - DEPTH:
             continue
+        cross = _floored(cross, lo, hi) if cross is not None else \
+            _cross_section(log_prob, u, j, lo, hi)
         if cross is None:
-            cross = _cross_section(log_prob, u, j, lo, hi)
-            if cross is None:
-                continue
+            continue
         grid = np.linspace(lo[j], hi[j], PLATEAU_GRID)
         along = np.repeat(u[None, :], grid.size, axis=0)
         along[:, j] = grid
@@ -197,8 +205,20 @@ def _cross_section(log_prob, u: np.ndarray, j: int, lo, hi):
     eig, vec = np.linalg.eigh(-out[2])
     if not np.all(np.isfinite(eig)):
         return None
-    floor = 1.0 / (np.max(span) / 4.0) ** 2
-    return np.where(eig > floor, eig, floor), vec
+    return _floored((eig, vec), lo, hi)
+
+
+def _floored(cross, lo, hi):
+    """A cross-section's precision ``(eigenvalues, eigenvectors)`` with each eigenvalue at
+    least that of a variance spreading over the prior box (a quarter of its widest finite
+    range, as the importance route's Laplace approximations): a direction of little curvature
+    does not send the normal part's draws far outside the box."""
+    eig, vec = cross
+    span = hi - lo
+    span = span[np.isfinite(span)]
+    widest = float(np.max(span)) if span.size else 1.0
+    floor = 1.0 / (widest / 4.0) ** 2
+    return np.maximum(eig, floor), vec
 
 
 def _retried(log_prob, u: np.ndarray, j: int, value: float, lo, hi):
@@ -249,10 +269,10 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
         before, here = here, point
         if not height >= top - DEPTH:
             continue
+        cross = _floored(cross, lo, hi) if cross is not None else \
+            _cross_section(log_prob, point, j, lo, hi)
         if cross is None:
-            cross = _cross_section(log_prob, point, j, lo, hi)
-            if cross is None:
-                continue
+            continue
         eig, vec = cross
         cov = np.zeros((d, d))
         cov[np.ix_(rest, rest)] = SLAB_SCALE**2 * (vec / eig[None, :]) @ vec.T
@@ -267,7 +287,9 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
     if not means:
         return None
     weights = np.exp(np.array(log_masses) - max(log_masses))
-    return _GaussianMixture(weights / weights.sum(), np.array(means), np.array(chols))
+    kept = weights > 0  # a component whose mass underflows has no log weight
+    return _GaussianMixture(weights[kept] / weights[kept].sum(), np.array(means)[kept],
+                            np.array(chols)[kept])
 
 
 def configurations(lik, modes_scaled, guide_u=None) -> list:

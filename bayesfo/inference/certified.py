@@ -17,15 +17,15 @@ The routes, in order, with ``sampler="auto"``:
    mixture fitted to them, if its k̂ is below 0.5, else from a tempered ladder, whose
    particles replace the importance draws where :data:`LADDER_MISSED` more of them lie outside
    the draws' range than draws of one posterior would and its runs agree: the draws missed
-   part of the posterior); where the weights give ln Z and no ladder runs, the configurations
-   where an element vanishes (:mod:`~bayesfo.inference._configurations`: a coefficient at its
+   part of the posterior); where the weights give ln Z (and ``evidence="auto"``, without
+   sampler settings), the configurations where an element vanishes (:mod:`~bayesfo.inference._configurations`: a coefficient at its
    lower prior bound, the others maximised), which no optimum seeds, are searched, and the
    posterior mass they hold beyond the draws' range must be at most
    :data:`CONFIGURATIONS_MISSED`;
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
    tempered ladder guided by the proposal's draws (and proposing in the configurations where
-   an element vanishes, as every ladder of this module does where there are any): their final particles are the posterior
-   when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do
+   an element vanishes that the search found, as every ladder of this module does): their
+   final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do
    not, two more runs, and the four where the new pair agrees and all four agree;
 3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its
    draws where the walkers converged, else by a tempered ladder guided by them, whose
@@ -144,7 +144,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
             post, ev, info = importance_posterior(lik, modes, seed=seed)
         except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
             post, ev, info = None, None, {}
-        if post is not None and ev is not None:
+        if post is not None and ev is not None and evidence == "auto" and not sampler_options:
             post, ev, slabs = _configurations_checked(lik, modes, post, ev, info, seed)
         if post is None and evidence == "auto" and not sampler_options:
             guide = info.get("proposal_draws")
@@ -178,11 +178,11 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         found = _evidence(lik, post, seed, evidence, best_log_likelihood=best, importance=ev,
                           slabs=slabs or ())
         runs = found.pop("ladder_runs")
-        if slabs and (post.sampler == "ladder" or runs is not None):
-            names = vanished(lik, slabs)
-            notes.append(f"{name}: where {' or '.join(names)} vanish"
-                         f"{'es' if len(names) == 1 else ''}, the posterior holds a region that "
-                         "no optimum seeds; the tempered ladder proposes there as well")
+        if slabs and (post.sampler == "ladder" or runs is not None) \
+                and not (info or {}).get("vanishing"):
+            notes.append(f"{name}: where {' or '.join(vanished(lik, slabs))} vanishes, the "
+                         "posterior holds a region that no optimum seeds; the tempered ladder "
+                         "proposes there as well")
         replaced = False
         if runs is not None and not post.converged:
             post, note, replaced = _certified_by_ladder(lik, post, runs, seed, remedy)
@@ -236,7 +236,7 @@ def _configurations_checked(lik, modes, post, ev, info: dict, seed: int):
     if not missed > CONFIGURATIONS_MISSED:
         return post, ev, slabs
     info["vanishing"] = names
-    info["reason"] = (f"where {' or '.join(names)} vanish{'es' if len(names) == 1 else ''}, the "
+    info["reason"] = (f"where {' or '.join(names)} vanishes, the "
                       f"posterior holds about {100 * missed:.0f} % of its mass beyond the "
                       "importance draws' reach")
     info["proposal_draws"] = draws_u

@@ -247,8 +247,8 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
     (BENCHMARKS.md, "Measurements behind design choices"; see
     :class:`~bayesfo.inference.smc._Guide` for the cause and the fix).
 
-    ``earlier``: the runs of an earlier call with the same ``lik``, ``seed``, ``guide`` and
-    ``n_particles``, to which this call adds ``n_runs`` more: they continue the earlier runs'
+    ``earlier``: the runs of an earlier call with the same ``lik``, ``seed``, ``guide``,
+    ``n_particles`` and other settings (``slabs`` among them), to which this call adds ``n_runs`` more: they continue the earlier runs'
     sequence of generators (children of the same seed), are guided by the same shares of the
     guide, and the evidence returned (with the list of runs) is that of all of them, the
     earlier ones first.

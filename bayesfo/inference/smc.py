@@ -225,12 +225,14 @@ def ladder_run(lik: Likelihood, rng: np.random.Generator, *, n_particles: int = 
     two runs of :func:`ladder_runs` agree on a posterior of two arms that meet in such a neck
     (BENCHMARKS.md, "Measurements behind design choices").
 
-    ``slabs`` (:class:`~bayesfo.inference._configurations._Slab`: configurations where an
-    element vanishes, which no optimum seeds) join the proposal of every independence step with
-    :data:`SLAB_SHARE` of its weight, at every rung: a region that the particles leave at one
-    rung is otherwise never regained, and both runs can agree on a posterior without it
-    (see :mod:`~bayesfo.inference._configurations`). The steps stay exact: the slabs' densities
-    are part of the proposal's.
+    ``slabs`` (the slabs and ways of :func:`~bayesfo.inference._configurations.configurations`:
+    regions where an element vanishes, which no optimum seeds) join the proposal of every
+    independence step with :data:`SLAB_SHARE` of its weight, at every rung: the differential-
+    evolution moves cannot reach a region that no particle occupies, and the particles' own
+    mixture has no component there, so a region lost at one rung is otherwise not regained,
+    and both runs can agree on a posterior without it (see
+    :mod:`~bayesfo.inference._configurations`). The steps stay exact: the slabs' densities are
+    part of the proposal's.
     """
     return ladder_runs_together(lik, [rng], n_particles=n_particles, ess_fraction=ess_fraction,
                                 accepted_moves=accepted_moves, max_moves=max_moves,
@@ -458,6 +460,8 @@ def _guided_moves(guide_mix: _GaussianMixture | None, u, log_prior, log_lik, bet
     def log_q(x):
         if len(parts) == 1:
             return own.log_pdf(x)
+        if not slabs:  # the two halves, as before there were slabs (the same numbers)
+            return np.logaddexp(own.log_pdf(x), guide_mix.log_pdf(x)) - math.log(2.0)
         return logsumexp([lw + p.log_pdf(x) for lw, p in zip(log_weights, parts, strict=True)],
                          axis=0)
 

@@ -3,12 +3,13 @@ sampled with its share (:mod:`bayesfo.inference._configurations`).
 
 The data set: number 44 of the fractional_zener_sl calibration with seed 16 (truth G_e 8.8e-4,
 α 0.012, 5 % noise), whose posterior holds a region where the spring G_e vanishes, about a tenth
-of its mass, beside the optimum's. The share below G_e = :data:`LOWEST` (scaled) is 0.094-0.098
-by importance sampling from a million draws of proposals that cover both regions (three
-proposals, Pareto k̂ 0.34-0.47; ``benchmarks/bench_configurations.py``). Before the search for such configurations,
-the default route's tempered ladders put none of their particles there, and both runs agreed.
-The log evidence on the support, ln Z' (prior normalised on its box), is -6.08 to -6.12 by the
-same computations.
+of its mass, beside the optimum's. The share below G_e = :data:`LOWEST` (scaled) is 0.092-0.098
+by importance sampling from a million draws of proposals that cover both regions (four
+proposals, Pareto k̂ 0.27-0.47; ``benchmarks/bench_configurations.py``). Before the search for
+such configurations, the default route put 0.000-0.025 of its draws there (seeds 44-47), its
+pairs of ladder runs agreeing, or emcee running (BENCHMARKS.md, "Nineteenth session"). The log
+evidence on the support, ln Z' (prior normalised on its box), is -6.06 to -6.12 by the same
+computations.
 """
 
 from __future__ import annotations
@@ -68,8 +69,8 @@ def test_a_vanishing_spring_gets_its_share_of_the_posterior(route):
     assert post.converged and post.sampler == "ladder"
     assert any("G_e" in note and "vanish" in note for note in found.notes)
     share = float(np.mean(post.samples_scaled[:, 0] < LOWEST))
-    # 2 000 particles of two runs: a binomial standard error of 0.0066, and the runs' own
-    # scatter (0.079-0.106 per run over four seeds): ±0.035 is about 3.5 standard errors of a run.
+    # 2 000 particles of two runs: a binomial standard error of 0.0066; the route gave
+    # 0.091-0.102 over four seeds (BENCHMARKS.md): ±0.035 leaves room for the runs' own scatter.
     assert abs(share - EXACT_SHARE) < 0.035, share
     assert math.isfinite(found.evidence.log_z)
 
@@ -77,9 +78,9 @@ def test_a_vanishing_spring_gets_its_share_of_the_posterior(route):
 def test_the_mass_beyond_draws_that_miss_the_configuration_is_estimated(route):
     """The importance route's check (:func:`~bayesfo.inference._configurations.missed_share`)
     on draws that miss the region (the route's draws above :data:`LOWEST`): the mass beyond
-    their range is the region's share, 0.095, which the estimate approaches from below (it
-    counts the slabs' draws alone; 0.079-0.095 over five seeds). Draws that hold the region
-    leave little beyond their range."""
+    their range is the region's share, 0.092-0.098, which the estimate approaches from below
+    (it counts the slabs' draws alone; 0.079-0.095 over five seeds, BENCHMARKS.md). Draws that
+    hold the region leave little beyond their range."""
     from bayesfo.inference._configurations import configurations, missed_share
     from bayesfo.inference.transform import _Transform
 

@@ -154,10 +154,7 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
             # narrow curved valley, far below the valley's highest point: Nelder-Mead from where
             # they ended (BENCHMARKS.md, "Nineteenth session": 112 nats below, then found).
             u, height, cross = _retried(log_prob, u, j, value, lo, hi)
-        if not height >= top - DEPTH:
-            continue
-        cross = _floored(cross, lo, hi) if cross is not None else \
-            _cross_section(log_prob, u, j, lo, hi)
+        cross = _kept(log_prob, u, height, cross, j, lo, hi, top)
         if cross is None:
             continue
         grid = np.linspace(lo[j], hi[j], PLATEAU_GRID)
@@ -179,6 +176,15 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
         if way is not None:
             slabs.append(way)
     return slabs
+
+
+def _kept(log_prob, u: np.ndarray, height: float, cross, j: int, lo, hi, top: float):
+    """The floored precision of the cross-section at a profile point (its own where it was
+    peaked, else :func:`_cross_section`'s), or None where the point lies more than
+    :data:`DEPTH` below ``top`` or has no cross-section."""
+    if not height >= top - DEPTH:
+        return None
+    return _floored(cross, lo, hi) if cross is not None else _cross_section(log_prob, u, j, lo, hi)
 
 
 def _cross_section(log_prob, u: np.ndarray, j: int, lo, hi):
@@ -267,10 +273,7 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
         point, height, cross = _profile_point(log_prob, np.array([guess, here, mode]), j, value,
                                               lo, hi)
         before, here = here, point
-        if not height >= top - DEPTH:
-            continue
-        cross = _floored(cross, lo, hi) if cross is not None else \
-            _cross_section(log_prob, point, j, lo, hi)
+        cross = _kept(log_prob, point, height, cross, j, lo, hi, top)
         if cross is None:
             continue
         eig, vec = cross

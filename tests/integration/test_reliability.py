@@ -428,6 +428,12 @@ def _cpu_seconds(proc) -> float:
 
 
 def _cli(*args, cwd):
+    # A test suite started in the background of a shell without job control (`cmd &` in a
+    # script) has SIGINT ignored, which the command would inherit (an ignored signal stays
+    # ignored across exec): the suite's own handler is put back, so that the command starts as
+    # under a terminal, and the signal tests test the command, not how the suite was started.
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     env = dict(os.environ, MPLBACKEND="Agg")
     return subprocess.Popen([sys.executable, "-m", "bayesfo.cli", *map(str, args)], cwd=cwd,
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

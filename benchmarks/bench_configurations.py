@@ -135,7 +135,8 @@ def main() -> None:
     share, bins, k_hat, ess, log_z = _exact(lik, route_draws, slabs)
     print(f"exact (importance sampling, 1 000 000 draws, k̂ {k_hat:.2f}, ESS {ess:.0f}): share "
           f"below {setup.LOWEST}: {share:.3f}, bins {bins}; ln Z' (on the support) {log_z:.3f}")
-    print(f"bins of ln G_e: {', '.join(f'[{a:.2f}, {b:.2f})' for a, b in zip(EDGES[:-1], EDGES[1:]))}")
+    bins = ", ".join(f"[{a:.2f}, {b:.2f})" for a, b in zip(EDGES[:-1], EDGES[1:]))
+    print(f"bins of ln G_e: {bins}")
 
 
 if __name__ == "__main__":

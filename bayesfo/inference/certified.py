@@ -18,15 +18,16 @@ The routes, in order, with ``sampler="auto"``:
    particles replace the importance draws where :data:`LADDER_MISSED` more of them lie outside
    the draws' range than draws of one posterior would and its runs agree: the draws missed
    part of the posterior); where the weights give ln Z (and ``evidence="auto"``, without
-   sampler settings), the configurations where an element vanishes (:mod:`~bayesfo.inference._configurations`: a coefficient at its
-   lower prior bound, the others maximised), which no optimum seeds, are searched, and the
-   posterior mass they hold beyond the draws' range must be at most
-   :data:`CONFIGURATIONS_MISSED`;
+   sampler settings), the configurations where an element vanishes
+   (:mod:`~bayesfo.inference._configurations`: a coefficient at its lower prior bound, the
+   others maximised), which no optimum seeds, are searched, and the posterior mass they hold
+   beyond the draws' range must be at most :data:`CONFIGURATIONS_MISSED`;
 2. where the weights do not certify it (ridges, several regions), two independent runs of the
    tempered ladder guided by the proposal's draws (and proposing in the configurations where
    an element vanishes that the search found, as every ladder of this module does): their
-   final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do
-   not, two more runs, and the four where the new pair agrees and all four agree;
+   final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400), and their
+   ln Z the evidence; where they do not, two more runs, and the four where the new pair agrees
+   and all four agree;
 3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its
    draws where the walkers converged, else by a tempered ladder guided by them, whose
    particles replace the walkers' draws when its runs agree. A posterior that no route

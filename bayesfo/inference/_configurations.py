@@ -81,8 +81,6 @@ class _Slab:
     hi: float
     mean: np.ndarray
     chol: np.ndarray
-    #: The log posterior at the configuration (the profile point).
-    height: float
 
     @property
     def _rest(self) -> np.ndarray:
@@ -170,8 +168,7 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
             chol = np.linalg.cholesky(cov)
         except np.linalg.LinAlgError:
             continue
-        slabs.append(_Slab(index=j, lo=float(lo[j]), hi=end, mean=u, chol=chol,
-                           height=float(height)))
+        slabs.append(_Slab(index=j, lo=float(lo[j]), hi=end, mean=u, chol=chol))
         way = _way(log_prob, u, mode, j, end, lo, hi, top)
         if way is not None:
             slabs.append(way)

@@ -451,11 +451,11 @@ def _guided_moves(guide_mix: _GaussianMixture | None, u, log_prior, log_lik, bet
     if own is None:
         return
     parts = [own] if guide_mix is None else [own, guide_mix]
-    weights = [1.0 / len(parts)] * len(parts)
     if slabs:
-        weights = [w * (1.0 - SLAB_SHARE) for w in weights] + [SLAB_SHARE / len(slabs)] * len(slabs)
+        weights = ([(1.0 - SLAB_SHARE) / len(parts)] * len(parts)
+                   + [SLAB_SHARE / len(slabs)] * len(slabs))
         parts += list(slabs)
-    log_weights = np.log(weights)
+        log_weights = np.log(weights)
 
     def log_q(x):
         if len(parts) == 1:

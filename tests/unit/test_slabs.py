@@ -15,8 +15,7 @@ def _slab():
     rng = np.random.default_rng(0)
     a = rng.normal(size=(3, 3))
     chol = np.linalg.cholesky(a @ a.T + 0.5 * np.eye(3))
-    return _Slab(index=1, lo=-9.0, hi=-5.5, mean=np.array([0.3, 99.0, -1.0, 2.0]), chol=chol,
-                 height=0.0)
+    return _Slab(index=1, lo=-9.0, hi=-5.5, mean=np.array([0.3, 99.0, -1.0, 2.0]), chol=chol)
 
 
 def test_slab_density_is_uniform_times_normal():

@@ -54,7 +54,7 @@ from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
 from .importance import importance_posterior
 from .likelihood import Likelihood
 from .posterior import sample_posterior
-from .results import PosteriorResult, posterior_from_particles
+from .results import PosteriorResult, ladder_agreement, posterior_from_particles
 from .transform import _Transform
 
 #: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by
@@ -272,20 +272,19 @@ def _ladder_first(lik, seed: int, guide=None, slabs=()):
 
     try:
         ev, runs = ladder_runs(lik, seed=seed, guide=guide, slabs=slabs)
-        post = posterior_from_particles(lik, runs, seed=seed)
-        if post.converged:
-            return post, ev, None, None
-        first = post
+        first = ladder_agreement(lik, runs, seed=seed)
+        if first.converged:
+            return posterior_from_particles(lik, runs, seed=seed, agreement=first), ev, None, None
         ev, runs = ladder_runs(lik, seed=seed, guide=guide, earlier=runs, slabs=slabs)
-        second = posterior_from_particles(lik, runs[len(runs) // 2:], seed=seed,
-                                          predictive=False)
-        post = posterior_from_particles(lik, runs, seed=seed)
+        second = ladder_agreement(lik, runs[len(runs) // 2:], seed=seed)
+        four = ladder_agreement(lik, runs, seed=seed)
+        if not second.converged:
+            return None, None, f"{why(first)}; two more runs: {why(second)}", None
+        if not four.converged:
+            return None, None, f"{why(first)}; all four runs: {why(four)}", None
+        post = posterior_from_particles(lik, runs, seed=seed, agreement=four)
     except (InputError, np.linalg.LinAlgError, FloatingPointError) as exc:  # to emcee
         return None, None, str(exc), None
-    if not second.converged:
-        return None, None, f"{why(first)}; two more runs: {why(second)}", None
-    if not post.converged:
-        return None, None, f"{why(first)}; all four runs: {why(post)}", None
     note = (f"{lik.structure.name}: the first two tempered-ladder runs did not certify the "
             f"posterior ({why(first)}); two more runs agree with each other (R-hat "
             f"{second.rhat_max:.3f}) and with them (R-hat {post.rhat_max:.3f} over the four, "
@@ -325,11 +324,14 @@ def _checked_by_ladder(lik, post, runs, seed, info: dict):
     particles are the posterior if its runs agree. Records ``ladder_outside`` in ``info``;
     returns (posterior, note or None)."""
     name = lik.structure.name
-    ladder = posterior_from_particles(lik, runs, seed=seed)
-    outside = _outside(post.samples_scaled, ladder.samples_scaled)
+    agreement = ladder_agreement(lik, runs, seed=seed)
+    particles = _Transform(lik).to_theta(
+        agreement.chain_u.reshape(-1, agreement.chain_u.shape[-1]))
+    outside = _outside(post.samples_scaled, particles)
     info["ladder_outside"] = outside
     if outside <= LADDER_MISSED + _expected_outside(lik.ndim, post.ess_min):
         return post, None
+    ladder = posterior_from_particles(lik, runs, seed=seed, agreement=agreement)
     share = f"{100 * outside:.0f} % of the particles of the tempered-ladder runs that gave ln Z"
     if not ladder.converged:
         note = (f"{name}: {share} lie outside the range of the importance draws, but the runs "

@@ -140,8 +140,55 @@ class PosteriorResult:
         }
 
 
+@dataclass(frozen=True)
+class Agreement:
+    """Whether independent tempered-ladder runs agree (:func:`ladder_agreement`): the runs'
+    particles as chains (sampling coordinates, each run in random order) and the diagnostics
+    of the certificate, without the posterior's summaries and DataTree."""
+
+    chain_u: np.ndarray
+    rhat_max: float
+    ess_bulk_min: float
+    ess_tail_min: float
+    messages: tuple[str, ...]
+
+    @property
+    def converged(self) -> bool:
+        return not self.messages
+
+    @property
+    def ess_min(self) -> float:
+        return min(self.ess_bulk_min, self.ess_tail_min)
+
+
+def ladder_agreement(lik: Likelihood, runs, *, seed: int = 0) -> Agreement:
+    """The certificate of :func:`posterior_from_particles` alone (the same numbers from the same
+    ``seed``): where the runs only decide what runs next, the posterior need not be built."""
+    rng = np.random.default_rng(seed)
+    tr = _Transform(lik)
+    chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
+    n_runs, n_kept, _ = chain_u.shape
+    if n_runs < 2:
+        raise ValueError("at least two runs are needed to certify the posterior")
+    chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
+    chains = tr.to_theta(chain_u)
+    r_hat = rhat_max(chains)
+    distinct = float(len(np.unique(chain_u.reshape(-1, chain_u.shape[2]), axis=0)))
+    ess_bulk = min(distinct, ess_min(chains, "bulk"))
+    ess_tail = min(distinct, ess_min(chains, "tail"))
+    messages = []
+    if not r_hat < RHAT_MAX:
+        messages.append(f"{lik.structure.name}: the tempered-ladder runs disagree (R-hat "
+                        f"{r_hat:.3f} is not below {RHAT_MAX})")
+    if not min(ess_bulk, ess_tail) >= ESS_MIN:
+        messages.append(f"{lik.structure.name}: the tempered-ladder particles give an effective "
+                        f"sample size of {min(ess_bulk, ess_tail):.0f}, below {ESS_MIN}")
+    return Agreement(chain_u, r_hat, ess_bulk, ess_tail, tuple(messages))
+
+
 def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
-                             predictive: bool = True) -> PosteriorResult:
+                             predictive: bool = True,
+                             agreement: Agreement | None = None) -> PosteriorResult:
     """The posterior as the final particles of independent tempered-ladder runs.
 
     Each run (a :class:`~bayesfo.inference.smc.LadderRun`, or its particles in the sampling
@@ -164,6 +211,8 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
         Seed of the shuffle and of the posterior predictive draws.
     predictive : bool
         Store the posterior predictive and the model response in the DataTree.
+    agreement : Agreement, optional
+        :func:`ladder_agreement` of the same runs and seed, where it was already computed.
 
     Returns
     -------
@@ -171,31 +220,16 @@ def posterior_from_particles(lik: Likelihood, runs, *, seed: int = 0,
         With ``sampler="ladder"``; ``n_walkers`` is the number of runs, ``n_steps`` 0 and
         ``tau`` NaN (no chain); ``converged`` when R-hat < 1.01 and the ESS ≥ 400.
     """
-    rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
-    chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
-    n_runs, n_kept, _ = chain_u.shape
-    if n_runs < 2:
-        raise ValueError("at least two runs are needed to certify the posterior")
-    chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
-    chains = tr.to_theta(chain_u)
-    r_hat = rhat_max(chains)
-    distinct = float(len(np.unique(chain_u.reshape(-1, chain_u.shape[2]), axis=0)))
-    ess_bulk = min(distinct, ess_min(chains, "bulk"))
-    ess_tail = min(distinct, ess_min(chains, "tail"))
-    messages = []
-    if not r_hat < RHAT_MAX:
-        messages.append(f"{lik.structure.name}: the tempered-ladder runs disagree (R-hat "
-                        f"{r_hat:.3f} is not below {RHAT_MAX})")
-    if not min(ess_bulk, ess_tail) >= ESS_MIN:
-        messages.append(f"{lik.structure.name}: the tempered-ladder particles give an effective "
-                        f"sample size of {min(ess_bulk, ess_tail):.0f}, below {ESS_MIN}")
+    if agreement is None:
+        agreement = ladder_agreement(lik, runs, seed=seed)
+    a = agreement
     acceptance = [float(np.mean(r.acceptance[-1:])) for r in runs if hasattr(r, "acceptance")]
-    post = result_from_draws(lik, chain_u, sampler="ladder", rhat=r_hat, ess_bulk=ess_bulk,
-                             ess_tail=ess_tail, messages=tuple(messages),
-                             converged=not messages, seed=seed, predictive=predictive,
+    post = result_from_draws(lik, a.chain_u, sampler="ladder", rhat=a.rhat_max,
+                             ess_bulk=a.ess_bulk_min, ess_tail=a.ess_tail_min,
+                             messages=a.messages, converged=a.converged, seed=seed,
+                             predictive=predictive,
                              acceptance=float(np.mean(acceptance)) if acceptance else np.nan)
-    post.idata.posterior.attrs.update(sampler="tempered ladder", runs=n_runs)
+    post.idata.posterior.attrs.update(sampler="tempered ladder", runs=len(a.chain_u))
     return post
 
 

@@ -212,8 +212,8 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
         (:func:`draw_forked`; only where :func:`can_fork`, else here alone), 1 here alone. The
         files are the same.
     meanwhile : callable, optional
-        Called once in this process before it draws (with two processes: while the forked one
-        already draws), e.g. to write other files.
+        Called once in this process before it draws (with two processes or a pool: while the
+        forked process or the workers already draw), e.g. to write other files.
     structure_figures : int or None
         How many structures (the best by the ranking) get corner (and trace) figures.
 
@@ -241,9 +241,9 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
     if pool is None and processes == 2 and can_fork():
         return draw_forked(comparison, out_dir, formats, seed=seed, meanwhile=meanwhile,
                            structure_figures=structure_figures)
-    if meanwhile is not None:
-        meanwhile()
     if pool is None:
+        if meanwhile is not None:
+            meanwhile()
         written: dict[str, list[Path]] = {}
         for name, make in figure_jobs(comparison, seed=seed,
                                       structure_figures=structure_figures):
@@ -257,17 +257,33 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
     tasks = [("structure", r, styles[r.name].color)
              for r in _detailed(comparison, structure_figures)]
     tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
+    from concurrent.futures import wait
     from concurrent.futures.process import BrokenProcessPool
 
+    futures, pending = [], meanwhile
     try:
         futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed)
                    for t in reversed(tasks)]
+        if pending is not None:
+            # While the workers draw (this process would otherwise wait for them).
+            pending, run = None, pending
+            try:
+                run()
+            except Exception:
+                # The workers' figures go into ``out_dir``, which the caller removes on an
+                # error: those being drawn end first, the others are not started.
+                for f in futures:
+                    f.cancel()
+                wait(futures)
+                raise
         drawn = {}
         for f in futures:
             drawn.update(f.result())
     except BrokenProcessPool:
         # A worker died (killed, out of memory): the figures are drawn here (a figure's file is
         # written through a rename, so one the worker left half-done is replaced whole).
+        if pending is not None:
+            pending()
         drawn = {}
         for name, make in figure_jobs(comparison, seed=seed,
                                       structure_figures=structure_figures):

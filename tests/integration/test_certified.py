@@ -182,18 +182,18 @@ def test_a_ladder_pair_that_disagrees_is_joined_by_a_second_pair(monkeypatch):
 
     monkeypatch.setattr(route, "importance_posterior",
                         lambda *a, **k: (None, None, {"reason": "forced"}))
-    real = route.posterior_from_particles
+    real = route.ladder_agreement
     seen = []
 
     def first_pair_fails(lik, runs, **kwargs):
-        post = real(lik, runs, **kwargs)
+        agreement = real(lik, runs, **kwargs)
         seen.append(len(runs))
         if len(seen) == 1:
-            return dataclasses.replace(post, converged=False, messages=(
+            return dataclasses.replace(agreement, messages=(
                 "zener: the tempered-ladder runs disagree (R-hat 1.012 is not below 1.01)",))
-        return post
+        return agreement
 
-    monkeypatch.setattr(route, "posterior_from_particles", first_pair_fails)
+    monkeypatch.setattr(route, "ladder_agreement", first_pair_fails)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PredictiveWarning)
         r = bf.compare(bf.read(DATA), "zener", seed=1, workers=1, progress=False,

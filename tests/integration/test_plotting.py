@@ -521,12 +521,28 @@ def test_write_figures_in_worker_processes_gives_the_same_files(comparison, tmp_
     from bayesfo.parallel import process_pool
 
     serial = write_figures(comparison, tmp_path / "serial", formats=("png",))
+    steps = []
+
+    def fails():
+        raise OSError(28, "No space left on device")
+
     with process_pool(2) as pool:
-        pooled = write_figures(comparison, tmp_path / "pooled", formats=("png",), pool=pool)
+        pooled = write_figures(comparison, tmp_path / "pooled", formats=("png",), pool=pool,
+                               meanwhile=lambda: steps.append("meanwhile"))
+        # Where the work done meanwhile fails, its error is raised once the workers have
+        # ended the figures they were drawing: nothing is written into the directory after.
+        with pytest.raises(OSError, match="No space left"):
+            write_figures(comparison, tmp_path / "failed", formats=("png",), pool=pool,
+                          meanwhile=fails)
+        left = sorted(p.name for p in (tmp_path / "failed").rglob("*"))
+        assert not [n for n in left if n.startswith(".")], left  # no save half-done
+        assert all(f.endswith(".png") for f in left)
+    assert steps == ["meanwhile"]
     assert list(pooled) == list(serial)
     for name, paths in serial.items():
         # Agg renders the same pixels in any process: the figures are the same figures.
         assert pooled[name][0].read_bytes() == paths[0].read_bytes(), name
+    assert left == sorted(p.name for p in (tmp_path / "failed").rglob("*"))
 
 
 def _mark_child(monkeypatch, marker, fail: bool = False):

@@ -203,8 +203,9 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
         Seed of the posterior draws behind the response figures.
     pool : concurrent.futures.Executor, optional
         Worker processes that draw the figures side by side (e.g.
-        :func:`bayesfo.parallel.process_pool`): the combined figures in two tasks, the figures
-        of each structure in one. The files are the same as drawn here. A
+        :func:`bayesfo.parallel.process_pool`): each combined figure in a task of its own,
+        the figures of each structure in one, the costliest first. The files are the same as
+        drawn here. A
         :class:`~bayesfo.parallel.LazyPool` that has not started its processes is not started
         for the figures: they are drawn here.
     processes : int
@@ -253,17 +254,19 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
                                              structure_figures=structure_figures)]
     combined = list(_combined_makers(comparison, seed))
     styles = comparison_styles(comparison)
-    # Per-structure tasks carry one result only; the combined figures need all of them.
-    tasks = [("structure", r, styles[r.name].color)
-             for r in _detailed(comparison, structure_figures)]
-    tasks += [("combined", comparison, combined[0::2]), ("combined", comparison, combined[1::2])]
+    # One task per figure, the costliest first (:func:`_draw_order`), so that the workers end
+    # close together. Per-structure tasks carry one result only; the combined figures need all
+    # of them (a comparison pickles in a small part of a figure's drawing time).
+    by_name = {f"corner_{_file_stem(r.name)}": ("structure", r, styles[r.name].color)
+               for r in _detailed(comparison, structure_figures)}
+    by_name.update({name: ("combined", comparison, [name]) for name in combined})
+    tasks = [by_name[name] for name in _draw_order(comparison, list(by_name))]
     from concurrent.futures import wait
     from concurrent.futures.process import BrokenProcessPool
 
     futures, pending = [], meanwhile
     try:
-        futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed)
-                   for t in reversed(tasks)]
+        futures = [pool.submit(_draw_in_worker, t, out_dir, formats, seed) for t in tasks]
         if pending is not None:
             # While the workers draw (this process would otherwise wait for them).
             pending, run = None, pending

@@ -53,23 +53,26 @@ def power_sum(omega, coef, exponent) -> np.ndarray:
     """
     omega = np.asarray(omega, dtype=float)
     coef, exponent = np.broadcast_arrays(np.asarray(coef, float), np.asarray(exponent, float))
-    log_w = np.log(omega)
-    # Real exponential for the modulus and a per-term phase factor: cheaper than a complex
-    # exponential over (..., n_terms, n_freq).
-    modulus = np.exp(exponent[..., None] * log_w)
-    phase = coef * np.exp(1j * HALF_PI * exponent)
-    # Σ_t phase_t · modulus_t with real arithmetic: Re = 0 + Σ Re(phase_t) modulus_t and likewise
-    # Im, summed over t in order from zero, as the einsum of the complex phases with the real
-    # moduli sums its products (the same values and signs of zeros for finite terms; an einsum
-    # casts the moduli to a complex temporary of shape (..., n_terms, n_freq) and is slower:
-    # BENCHMARKS.md, "Measurements behind design choices").
-    re, im = phase.real, phase.imag
-    out = np.zeros(np.broadcast_shapes(phase.shape[:-1] + (1,),
-                                       modulus.shape[:-2] + modulus.shape[-1:]), dtype=complex)
+    log_w = np.log(omega).reshape(-1)
+    # Σ_t c_t e^{j e_t π/2} ω^{e_t} with real arithmetic, term by term from zero: a real
+    # exponential for the modulus and a per-term phase factor (cheaper than a complex
+    # exponential over (..., n_terms, n_freq), and than an einsum, which casts the moduli to a
+    # complex temporary: BENCHMARKS.md, "Measurements behind design choices").
+    out = np.zeros(coef.shape[:-1] + log_w.shape, dtype=complex)
     out_re, out_im = out.real, out.imag
     for t in range(coef.shape[-1]):
-        out_re += re[..., t:t + 1] * modulus[..., t, :]
-        out_im += im[..., t:t + 1] * modulus[..., t, :]
+        e, c = exponent[..., t:t + 1], coef[..., t:t + 1]
+        if not e.any():
+            # (jω)^0 = 1 (a spring, the constant of a side): the term adds c to the real part
+            # and c·0 to the imaginary part, the values of the products below (NaN for an
+            # infinite c), without their exponentials.
+            out_re += c
+            out_im += c * 0.0 + 0.0
+            continue
+        phase = c * np.exp(1j * HALF_PI * e)
+        modulus = np.exp(e * log_w)
+        out_re += phase.real * modulus
+        out_im += phase.imag * modulus
     return out
 
 

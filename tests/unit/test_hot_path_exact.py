@@ -129,6 +129,26 @@ def test_power_sum_is_the_einsum_of_the_former_code(terms):
     _identical(response.power_sum(omega, coef[0], expo[0]), _power_sum_ref(omega, coef[0], expo[0]))
     c3, e3 = coef.reshape(30, 100, terms), expo.reshape(30, 100, terms)
     _identical(response.power_sum(omega, c3, e3), _power_sum_ref(omega, c3, e3))
+    if terms:
+        # A constant term (exponent 0 in every set: a spring, the 1 of a side), first, last or
+        # with the sign of zero flipped, is added without its exponentials: the same values.
+        for t, zero in ((0, 0.0), (terms - 1, -0.0), (terms // 2, 0.0)):
+            e0 = expo.copy()
+            e0[:, t] = zero
+            _identical(response.power_sum(omega, coef, e0), _power_sum_ref(omega, coef, e0))
+        with np.errstate(invalid="ignore", over="ignore"):
+            inf = coef.copy()
+            inf[100:110, 0] = np.inf
+            inf[110:120, 0] = -np.inf
+            inf[120:130, 0] = np.nan
+            e0 = expo.copy()
+            e0[:, 0] = 0.0
+            got, ref = response.power_sum(omega, inf, e0), _power_sum_ref(omega, inf, e0)
+            # Not finite where a coefficient is not (the former code's NaN real part is ±inf
+            # here, as in the real-arithmetic sum before constants were singled out).
+            np.testing.assert_array_equal(np.isfinite(got), np.isfinite(ref))
+            assert not np.isfinite(got[100:130]).any()
+            _identical(got[130:], ref[130:])
 
 
 @pytest.mark.parametrize("degree", [0, 1, 2, 3, 4])

@@ -48,6 +48,13 @@ def draw_truth(lik: Likelihood, rng) -> np.ndarray:
             return lik.to_physical(theta)[0]
 
 
+def within(cov: dict, bound: float) -> bool:
+    """Both coverages (50 % and 90 %) within ``bound`` of their nominal rates, the bound
+    included: a coverage of 85 hits in 100 is 0.05 from 0.9, though 0.85 − 0.9 rounds to
+    −0.0500000000000000044 in floating point."""
+    return all(abs(cov[level] - level) <= bound + 1e-12 for level in (0.5, 0.9))
+
+
 def default_route(s, data, priors, seed: int):
     """The posterior as ``compare`` computes it by default
     (:func:`bayesfo.inference.certified_posterior`: importance sampling from the optima where its
@@ -112,8 +119,7 @@ def test_calibration_quick(name):
 def test_calibration_full(name):
     # 200 data sets: nominal rate within ±5 % (binomial sd about 0.02-0.035 for 200 sets).
     cov = coverage(name, 200, seed=12)
-    assert abs(cov[0.5] - 0.5) <= 0.05, cov
-    assert abs(cov[0.9] - 0.9) <= 0.05, cov
+    assert within(cov, 0.05), cov
 
 
 @pytest.mark.slow
@@ -125,8 +131,7 @@ def test_calibration_of_thesis_structures_by_the_default_route(name):
     cov = coverage(name, 200, seed=12, route="default")
     print(name, cov)
     assert cov["uncertified"] == 0, cov
-    assert abs(cov[0.5] - 0.5) <= 0.05, cov
-    assert abs(cov[0.9] - 0.9) <= 0.05, cov
+    assert within(cov, 0.05), cov
 
 
 @pytest.mark.slow
@@ -136,8 +141,7 @@ def test_calibration_of_ridged_structures_by_the_default_route(name):
     # route compare takes (importance sampling where certified, else the tempered ladder, else
     # emcee): 200 data sets, nominal rate within ±5 % as for the Voigt and the Zener.
     cov = coverage(name, 200, seed=13, route="default")
-    assert abs(cov[0.5] - 0.5) <= 0.05, cov
-    assert abs(cov[0.9] - 0.9) <= 0.05, cov
+    assert within(cov, 0.05), cov
 
 
 #: The springpot cards: their own priors (log-uniform over eight decades, orders uniform on
@@ -154,8 +158,7 @@ def test_calibration_of_springpot_cards_by_the_default_route(name):
     # binomial sd of a coverage over 100 sets of 3-5 correlated parameters is about 0.02-0.04).
     cov = coverage(name, 100, seed=14, route="default")
     print(name, cov)
-    assert abs(cov[0.5] - 0.5) <= 0.05, cov
-    assert abs(cov[0.9] - 0.9) <= 0.05, cov
+    assert within(cov, 0.05), cov
 
 
 # ------------------------------------------------------------------ master-curve shift factors

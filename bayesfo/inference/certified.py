@@ -277,9 +277,9 @@ def _ladder_first(lik, seed: int, guide=None, slabs=()):
             return posterior_from_particles(lik, runs, seed=seed, agreement=first), ev, None, None
         ev, runs = ladder_runs(lik, seed=seed, guide=guide, earlier=runs, slabs=slabs)
         second = ladder_agreement(lik, runs[len(runs) // 2:], seed=seed)
-        four = ladder_agreement(lik, runs, seed=seed)
         if not second.converged:
             return None, None, f"{why(first)}; two more runs: {why(second)}", None
+        four = ladder_agreement(lik, runs, seed=seed)
         if not four.converged:
             return None, None, f"{why(first)}; all four runs: {why(four)}", None
         post = posterior_from_particles(lik, runs, seed=seed, agreement=four)

@@ -156,10 +156,6 @@ class Agreement:
     def converged(self) -> bool:
         return not self.messages
 
-    @property
-    def ess_min(self) -> float:
-        return min(self.ess_bulk_min, self.ess_tail_min)
-
 
 def ladder_agreement(lik: Likelihood, runs, *, seed: int = 0) -> Agreement:
     """The certificate of :func:`posterior_from_particles` alone (the same numbers from the same

@@ -11,8 +11,7 @@ def load_libraries(formats=()) -> None:
     during the imports ends the command after them, cleanly, instead of breaking one."""
     with held():
         import emcee  # noqa: F401
-        import h5netcdf  # noqa: F401
-        import h5py  # noqa: F401
+        import netCDF4  # noqa: F401
         import scipy.optimize  # noqa: F401
         import scipy.special  # noqa: F401
         import scipy.stats  # noqa: F401

@@ -177,7 +177,7 @@ def _read_netcdf(path: Path, name: str):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             idata = open_tree(path)
-    except Exception as exc:  # h5py, h5netcdf and xarray raise many kinds on a damaged file
+    except Exception as exc:  # netCDF4 and xarray raise many kinds on a damaged file
         raise InputError(f"'{path}': cannot be read as NetCDF ({type(exc).__name__}: "
                          f"{exc})") from None
     missing = [g for g in ("posterior", "log_likelihood", "observed_data")

@@ -18,6 +18,11 @@ from types import SimpleNamespace
 
 import numpy as np
 
+#: xarray's NetCDF engine: netCDF4 (the netCDF-C library), five to eight times faster than
+#: h5netcdf per posterior, written and read (its per-variable overhead; BENCHMARKS.md,
+#: "Twenty-first session"); the files are the same NetCDF-4/HDF5 either way.
+ENGINE = "netcdf4"
+
 #: The quantiles of the tail ESS (ArviZ's: the 5 % and 95 % quantiles).
 TAIL_PROB = (0.05, 0.95)
 
@@ -130,30 +135,27 @@ def open_tree(path: Path):
     closed."""
     import xarray as xr
 
-    with xr.open_datatree(path, engine="h5netcdf") as tree:
+    with xr.open_datatree(path, engine=ENGINE) as tree:
         return tree.load()
 
 
 def write_tree(tree, path) -> None:
     """Write a DataTree to NetCDF (HDF5, one group per ArviZ group).
 
-    The file is built in memory and then written with plain file writes: HDF5 writing to a
-    file system that fills up under it (another process took the space after the free-space
-    check of :func:`~bayesfo.inference.results.save_netcdf`) crashes the process
-    (segmentation fault) instead of raising, while a plain write raises ``OSError``
-    (``ENOSPC``) that the command reports.
+    The file is built in memory (netCDF-C's in-memory file) and then written with plain file
+    writes: HDF5 writing to a file system that fills up under it (another process took the
+    space after the free-space check of :func:`~bayesfo.inference.results.save_netcdf`)
+    crashes the process (segmentation fault) instead of raising, while a plain write raises
+    ``OSError`` (``ENOSPC``) that the command reports.
     """
-    import io
-
     import dask
 
-    buffer = io.BytesIO()
     # Inside a Dask worker xarray would take a distributed lock named after the target, which
-    # a buffer cannot name; the arrays are in memory, so the local scheduler's lock serves.
+    # an in-memory file has not; the arrays are in memory, so the local scheduler's lock serves.
     with dask.config.set(scheduler="synchronous"):
-        tree.to_netcdf(buffer, engine="h5netcdf")
+        data = tree.to_netcdf(engine=ENGINE)
     with open(path, "wb") as f:
-        f.write(buffer.getbuffer())
+        f.write(data)
 
 
 def preload() -> None:

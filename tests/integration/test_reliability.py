@@ -501,10 +501,10 @@ def test_a_signal_ends_the_automatic_schedule_leaving_the_earlier_output(
     proc = _cli("compare", ADHESIVE / "Tp020C.csv", "--structures", structures, "--out", out,
                 "--quiet", "--no-figures", cwd=tmp_path)
     if moment == "here":
-        # The command has imported its libraries (HDF5's is mapped among the last; signals are
-        # held back meanwhile) and computed since for half a second of its own CPU time (not
-        # wall-clock time: a busy machine changes nothing).
-        _wait_for(lambda: _has_loaded(proc, "h5py"))
+        # The command has imported its libraries (netCDF-C's is mapped among the last; signals
+        # are held back meanwhile) and computed since for half a second of its own CPU time
+        # (not wall-clock time: a busy machine changes nothing).
+        _wait_for(lambda: _has_loaded(proc, "libnetcdf"))
         loaded = _cpu_seconds(proc)
         _wait_for(lambda: _cpu_seconds(proc) > loaded + 0.5)
     else:

@@ -1,7 +1,8 @@
 """A NetCDF write that runs out of room mid-file raises OSError instead of crashing the process.
 
 HDF5 writing into a file system that fills up under it (another run took the space after the
-free-space check) died with a segmentation fault inside h5py. The file size limit of the
+free-space check) died with a segmentation fault inside h5py (the file is now built in memory,
+by netCDF-C, and written with plain writes). The file size limit of the
 process (RLIMIT_FSIZE, with SIGXFSZ ignored) makes the same failure happen at a chosen size
 on any POSIX machine: a write beyond it fails with EFBIG, as one on a full disk fails with
 ENOSPC.

@@ -43,3 +43,23 @@ def test_a_write_that_runs_out_of_room_raises_and_leaves_nothing(tmp_path):
     # Before: exit -11 (SIGSEGV) in h5py, a half-written temporary file left behind.
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip() == f"OSError {errno.EFBIG} []"
+
+
+def test_a_file_written_through_h5netcdf_reads_back_the_same(tmp_path):
+    # Earlier versions wrote the posteriors through h5netcdf; netCDF-C reads them now.
+    pytest.importorskip("h5netcdf")
+    import numpy as np
+
+    from bayesfo.inference._arviz import from_dict, open_tree
+
+    rng = np.random.default_rng(0)
+    tree = from_dict({"posterior": {"a": rng.normal(size=(4, 50)),
+                                    "G": rng.normal(size=(4, 50, 7))},
+                      "log_likelihood": {"G": rng.normal(size=(4, 50, 7))},
+                      "observed_data": {"omega": np.logspace(-1, 2, 7)}},
+                     dims={"G": ["omega"]})
+    tree.posterior.attrs["bayesfo_format"] = 3
+    tree.to_netcdf(tmp_path / "old.nc", engine="h5netcdf")
+    back = open_tree(tmp_path / "old.nc")
+    assert back.identical(tree)
+    assert back.posterior.attrs["bayesfo_format"] == 3

@@ -19,10 +19,15 @@ element vanishes, searched from the comparison's optima
 3 000 particles can lose such a region too (on one fractional_zener_sl data set it kept 0.042
 of the posterior where 0.095 lie; ``bench_configurations.py``), and the share it finds outside
 the reported draws is then too small. ``--without-configurations`` runs the route without the
-search for them (as before it existed; the reference keeps its slabs).
+search for them (as before it existed; the reference keeps its slabs). ``--without-orders-rule``
+runs the route without the second part of the importance certificate (an order left
+undetermined by the weights no longer sends the posterior to the tempered ladder): what the
+other parts (the ridge probe, the search for configurations, the ladder run for ln Z) catch
+on their own.
 
 Usage: python benchmarks/bench_certificate.py [--cards fractional_kelvin_voigt,...] [--n 40]
-       [--first-seed 0] [--reference-slabs] [--without-configurations] [--json out.json]
+       [--first-seed 0] [--reference-slabs] [--without-configurations]
+       [--without-orders-rule] [--json out.json]
 """
 
 from __future__ import annotations
@@ -37,7 +42,7 @@ import numpy as np
 
 import bayesfo as bf
 from bayesfo.data import FrequencyResponse
-from bayesfo.inference import Likelihood, certified, starting_points
+from bayesfo.inference import Likelihood, certified, importance, starting_points
 from bayesfo.inference._configurations import configurations
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
@@ -83,8 +88,12 @@ def one(card: str, seed: int, reference_slabs: bool = False) -> dict:
     ref = posterior_from_particles(lik, runs, seed=seed)
     k = lik.structure.n_params
     outside = certified._outside(r.posterior.samples[:, :k], ref.samples[:, :k])
-    widest = (r.criteria.importance or {}).get("widest") or {}
-    return {"card": card, "seed": seed, "route": r.posterior.sampler,
+    info = r.criteria.importance or {}
+    widest = info.get("widest") or {}
+    return {"k_hat": info.get("k_hat"), "evidence_method": r.criteria.evidence.method,
+            "configurations_missed": (info.get("configurations") or {}).get("missed"),
+            "ladder_outside": info.get("ladder_outside"),
+            "card": card, "seed": seed, "route": r.posterior.sampler,
             "certified": bool(r.posterior.converged), "outside": outside,
             "reference_certified": bool(ref.converged), "seconds": seconds,
             "widest": widest.get("share_of_prior"), "reference_slabs": len(slabs)}
@@ -98,11 +107,14 @@ def main() -> None:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--reference-slabs", action="store_true")
     ap.add_argument("--without-configurations", action="store_true")
+    ap.add_argument("--without-orders-rule", action="store_true")
     ap.add_argument("--json")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     if args.without_configurations:  # the route as before the configurations were searched
         certified.configurations = lambda *a, **k: []
+    if args.without_orders_rule:  # every order counts as determined
+        importance.UNDETERMINED = np.inf
     print(f"# {platform.node()} {platform.processor() or platform.machine()}, "
           f"bayesfo {bf.__version__}")
     rows = []
@@ -113,7 +125,12 @@ def main() -> None:
             print(f"{card:28s} {seed:4d} {row['route']:10s} certified={row['certified']!s:5s} "
                   f"outside {row['outside']:.3f}{'  MISS' if row['outside'] > MISS else ''}  "
                   f"{row['seconds']:.2f} s"
-                  + (f"  widest {row['widest']:.2f}" if row["widest"] is not None else "")
+                  + (f"  widest {row['widest']:.2f} k {row['k_hat']:.2f} "
+                     f"lnZ {row['evidence_method']}" if row["widest"] is not None else "")
+                  + (f" conf {row['configurations_missed']:.3f}"
+                     if row["configurations_missed"] is not None else "")
+                  + (f" ladder-out {row['ladder_outside']:.3f}"
+                     if row["ladder_outside"] is not None else "")
                   + (f"  reference slabs {row['reference_slabs']}" if args.reference_slabs
                      else ""),
                   flush=True)

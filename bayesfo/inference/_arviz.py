@@ -18,8 +18,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-#: xarray's NetCDF engine: netCDF4 (the netCDF-C library), five to eight times faster than
-#: h5netcdf per posterior, written and read (its per-variable overhead; BENCHMARKS.md,
+#: xarray's NetCDF engine: netCDF4 (the netCDF-C library), several times faster than
+#: h5netcdf per posterior, written and read (h5netcdf's cost is per variable; BENCHMARKS.md,
 #: "Twenty-first session"); the files are the same NetCDF-4/HDF5 either way.
 ENGINE = "netcdf4"
 

@@ -41,34 +41,16 @@ import test_calibration as calibration  # noqa: E402  (the calibration's isother
 
 import bayesfo as bf  # noqa: E402
 import bayesfo.inference as inference  # noqa: E402
-from bayesfo.data import FrequencyResponse  # noqa: E402
 from bayesfo.inference import certified  # noqa: E402
 from bayesfo.inference.evidence import ladder_runs  # noqa: E402
 from bayesfo.inference.results import posterior_from_particles  # noqa: E402
-from bayesfo.structures import get_structure  # noqa: E402
-from bayesfo.tts import wlf  # noqa: E402
 
 MISS = 0.05
 
 
 def data_sets(n: int, seed: int):
-    """The isotherms of ``mastercurve_shift_coverage(n, seed)``, in its order of draws."""
-    rng = np.random.default_rng(seed)
-    zener = get_structure("zener")
-    temps, w = calibration.MC_TEMPS, calibration.MC_W
-    for _ in range(n):
-        theta = np.array([10.0 ** rng.uniform(0, 2), 1.0, 10.0 ** rng.uniform(-2.5, -1),
-                          rng.uniform(0.3, 0.8)])
-        truth = (wlf(np.array(temps), 20.0, rng.uniform(6, 12), rng.uniform(60, 150))
-                 + rng.normal(0.0, 0.1, len(temps)))
-        truth -= truth[temps.index(20.0)]
-        rel = rng.choice([0.01, 0.03])
-        data = []
-        for t, a in zip(temps, truth, strict=True):
-            g = zener.response([theta], w * 10.0**a, "modulus")[0]
-            sd = rel * np.abs(g)
-            y = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
-            data.append((FrequencyResponse(w, y, kind="modulus", units="Pa"), t))
+    """The isotherms of ``mastercurve_shift_coverage(n, seed)`` and their noise levels."""
+    for data, _, rel in calibration.mastercurve_sets(n, seed):
         yield data, rel
 
 

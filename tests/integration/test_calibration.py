@@ -167,22 +167,13 @@ MC_TEMPS = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0]
 MC_W = np.logspace(-1, 2, 12)
 
 
-def mastercurve_shift_coverage(n_sets: int, seed: int) -> dict:
-    """Coverage of the central 50 % and 90 % intervals of the shifts log10 a_T of the joint
-    master-curve posterior (``bayesfo.mastercurve``, Zener master, free shifts, proportional
-    noise as fitted): over ``n_sets`` simulated sets of six isotherms, each from a random Zener
-    (q ~ U(0.3, 0.8), log10 a1 ~ U(0, 2), b0 = 1, b1 ~ 10^U(-2.5, -1)) shifted by a
-    random WLF law (C1 ~ U(6, 12), C2 ~ U(60, 150) °C at 20 °C) plus an independent N(0, 0.1)
-    departure per isotherm, with 1 % or 3 % complex proportional noise. The shifts' prior is
-    flat over ±15 decades around data that fix them to a few hundredths, so the intervals'
-    frequentist coverage at these truths is their nominal level if the posterior is right."""
-    import bayesfo as bf
+def mastercurve_sets(n_sets: int, seed: int):
+    """The simulated isotherms of :func:`mastercurve_shift_coverage`, one set at a time:
+    ``(isotherms as (FrequencyResponse, temperature) pairs, true log10 a_T, noise level)``."""
     from bayesfo.tts import wlf
 
     rng = np.random.default_rng(seed)
     zener = get_structure("zener")
-    hits = {0.5: [], 0.9: []}
-    routes, uncertified = {}, 0
     for _ in range(n_sets):
         # compliance (b0 + b1 s^q)/(1 + a1 s^q): b1/a1 < b0, a passive Zener, always here
         theta = np.array([10.0 ** rng.uniform(0, 2), 1.0, 10.0 ** rng.uniform(-2.5, -1),
@@ -197,6 +188,23 @@ def mastercurve_shift_coverage(n_sets: int, seed: int) -> dict:
             sd = rel * np.abs(g)
             y = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
             data.append((FrequencyResponse(MC_W, y, kind="modulus", units="Pa"), t))
+        yield data, truth, rel
+
+
+def mastercurve_shift_coverage(n_sets: int, seed: int) -> dict:
+    """Coverage of the central 50 % and 90 % intervals of the shifts log10 a_T of the joint
+    master-curve posterior (``bayesfo.mastercurve``, Zener master, free shifts, proportional
+    noise as fitted): over ``n_sets`` simulated sets of six isotherms, each from a random Zener
+    (q ~ U(0.3, 0.8), log10 a1 ~ U(0, 2), b0 = 1, b1 ~ 10^U(-2.5, -1)) shifted by a
+    random WLF law (C1 ~ U(6, 12), C2 ~ U(60, 150) °C at 20 °C) plus an independent N(0, 0.1)
+    departure per isotherm, with 1 % or 3 % complex proportional noise. The shifts' prior is
+    flat over ±15 decades around data that fix them to a few hundredths, so the intervals'
+    frequentist coverage at these truths is their nominal level if the posterior is right."""
+    import bayesfo as bf
+
+    hits = {0.5: [], 0.9: []}
+    routes, uncertified = {}, 0
+    for data, truth, _ in mastercurve_sets(n_sets, seed):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             mc = bf.mastercurve(data, "zener", reference_temperature=20.0, law="free", seed=0)

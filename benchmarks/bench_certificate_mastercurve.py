@@ -48,12 +48,6 @@ from bayesfo.inference.results import posterior_from_particles  # noqa: E402
 MISS = 0.05
 
 
-def data_sets(n: int, seed: int):
-    """The isotherms of ``mastercurve_shift_coverage(n, seed)`` and their noise levels."""
-    for data, _, rel in calibration.mastercurve_sets(n, seed):
-        yield data, rel
-
-
 def bundled():
     """The bundled sweep's isotherms, as the command reads them."""
     from bayesfo.cli.mastercurve import read_isotherm_files
@@ -104,8 +98,9 @@ def main() -> None:
     print(f"# {platform.node()} {platform.processor() or platform.machine()}, "
           f"bayesfo {bf.__version__}; seed {args.seed}")
     rows = []
-    sets = [(bundled(), None)] if args.bundled else data_sets(args.n, args.seed)
-    for k, (data, rel) in enumerate(sets):
+    sets = ([(bundled(), None, None)] if args.bundled
+            else calibration.mastercurve_sets(args.n, args.seed))
+    for k, (data, _, rel) in enumerate(sets):
         row = one(data, k)
         row["noise"] = None if rel is None else float(rel)
         rows.append(row)

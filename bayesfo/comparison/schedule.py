@@ -27,8 +27,11 @@ choices"). This process runs step (1) of every structure, here with the screen's
 estimates of every noise model to sample
 (:func:`~bayesfo.comparison.steps.fit_and_probe`); where their Pareto k̂ promises that importance
 sampling will certify the posterior, it runs (2) and (3) as well, and only the other
-structures' (2) and (3) go to the pool, whose processes start with the first of them. A wrong
-promise costs time, never a different number.
+structures' (2) and (3) go to the pool, whose processes start with the first of them. Once they
+have started (two or more), every step still to come goes to them as well, those queued here
+included: this process then only waits, so the comparison never runs more processes than CPUs
+while the workers are busy, nor leaves a CPU idle while this process works alone
+(BENCHMARKS.md, "Twenty-second session"). A wrong promise costs time, never a different number.
 
 Every step uses the comparison's seed wherever it runs, so the numbers do not depend on the pool
 or the worker count. A worker process that dies (killed, out of memory) breaks the pool: its
@@ -83,8 +86,9 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
     (:func:`~bayesfo.comparison.steps.fit_and_probe`) and then steps (2) and (3) of the
     structures whose screen promises a quick certified posterior; only the others' steps go to
     ``pool`` (a :class:`~bayesfo.parallel.LazyPool` then starts no process for a comparison
-    that has none). The step-(1) tasks of this process come before its others, so that the
-    long structures reach the pool early."""
+    that has none), and, once its processes have started (two or more), every step still to
+    come. The step-(1) tasks of this process come before its others, so that the long
+    structures reach the pool early."""
     n = len(structures)
     finished = queue.SimpleQueue()  # futures done, from the pool's threads to this one
     live = {}  # future -> (structure index, "first", a noise model, or "conclude")
@@ -101,8 +105,14 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
         # Step (1) first; otherwise first come, first run.
         heapq.heappush(local, (what != "first", next(order), i, what, args))
 
+    def pool_open():
+        # Once a long structure has started the workers (two or more), every step still to
+        # come goes to them too: this process would otherwise compute beside them, one process
+        # more than CPUs while they are busy and one CPU idle once they are not.
+        return here and not broken and pool.started and pool.workers > 1
+
     def submit(i, what, *args):
-        if not in_pool[i] or broken:
+        if broken or not (in_pool[i] or pool_open()):
             return run_here(i, what, args)
         try:
             future = pool.submit(_task, *args)
@@ -189,7 +199,10 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
             if local:
                 _, _, i, what, args = heapq.heappop(local)
                 if outcomes[i] is None:
-                    done(i, what, *_task(*args))
+                    if pool_open():  # queued here before the workers started
+                        submit(i, what, *args)
+                    else:
+                        done(i, what, *_task(*args))
             elif live:
                 collect(finished.get())
     except BaseException:

@@ -197,6 +197,63 @@ def test_structures_without_the_promise_go_to_the_pool(monkeypatch, noisy_sample
                                            ("sample_held", "maxwell-int", "proportional")]
 
 
+class _StartingRecorder(_LazyRecorder):
+    """A :class:`_LazyRecorder` of two workers that counts as started from its first task, as
+    a :class:`LazyPool` does."""
+
+    def __init__(self):
+        super().__init__()
+        self.workers = 2
+
+    @property
+    def started(self) -> bool:
+        return bool(self.steps)
+
+
+def test_once_the_workers_have_started_every_step_still_to_come_goes_to_them(monkeypatch,
+                                                                           noisy_sampler):
+    """The first structure (the larger) starts the workers; the other's fit, queued here
+    before they started, and every later step then run in the workers, with the numbers and
+    warnings of the serial path."""
+    probe = schedule.fit_and_probe
+
+    def pessimistic(s, data, options):
+        prepared, quick = probe(s, data, options)
+        return prepared, quick and s.name != "zener-int"
+
+    monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
+    serial, caught_serial = _compare(workers=1)
+    pool = _StartingRecorder()
+    auto, caught_auto = _compare(pool=pool)
+    assert _numbers(serial.results) == _numbers(auto.results)
+    assert caught_serial == caught_auto
+    assert sorted(pool.steps) == [("conclude", "maxwell-int", None),
+                                  ("conclude", "zener-int", None),
+                                  ("pessimistic", "maxwell-int", None),
+                                  ("sample_held", "maxwell-int", "constant"),
+                                  ("sample_held", "maxwell-int", "proportional"),
+                                  ("sample_held", "zener-int", "constant"),
+                                  ("sample_held", "zener-int", "proportional")]
+
+
+def test_with_one_worker_the_quick_steps_stay_here(monkeypatch, noisy_sampler):
+    """A pool of one worker (a machine with one CPU) takes only the long structure's steps:
+    handing it the others would only add the shipping."""
+    probe = schedule.fit_and_probe
+
+    def pessimistic(s, data, options):
+        prepared, quick = probe(s, data, options)
+        return prepared, quick and s.name != "zener-int"
+
+    monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
+    pool = _StartingRecorder()
+    pool.workers = 1
+    _compare(pool=pool)
+    assert sorted(pool.steps) == [("conclude", "zener-int", None),
+                                  ("sample_held", "zener-int", "constant"),
+                                  ("sample_held", "zener-int", "proportional")]
+
+
 def test_an_input_error_ends_that_structure_alone_on_the_automatic_schedule(failing_steps):
     auto, _ = _compare(BOTH + ",voigt-int", workers=0)
     assert auto["zener-int"].error == "no fit here"

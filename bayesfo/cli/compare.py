@@ -27,7 +27,8 @@ def add_parser(subparsers):
     p.add_argument("--workers", type=int, default=0, metavar="N",
                    help="processes running structures side by side and then drawing the figures "
                         "(default 0: automatic: quick posteriors in this process, the others in "
-                        "one process per CPU, started only when needed; without those, the "
+                        "one process per CPU, started only when needed, which then take the "
+                        "rest; without those, the "
                         "figures are drawn here and, when a CPU is idle, in a process forked "
                         "from this one); the numbers do not depend on it")
     p.add_argument("--no-figures", action="store_true",

@@ -67,7 +67,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         structure's optimisation and noise screen, and the posteriors that the screen's
         importance weights promise to certify quickly; the others (the tempered ladder, emcee)
         run in worker processes, one per CPU, started only when some structure needs them
-        (:func:`~bayesfo.parallel.lazy_process_pool`). The numbers do not depend on it: every
+        (:func:`~bayesfo.parallel.lazy_process_pool`), which then take every step still to
+        come. The numbers do not depend on it: every
         step runs with ``seed``.
     pool : concurrent.futures.Executor, optional
         Run the structures in this pool instead (from :func:`process_pool`; ``workers`` is then

@@ -70,7 +70,13 @@ DEFAULT_OPTIONS = {
     "walkers": None,         # emcee walkers (None: max(32, 4 x parameters))
     "models": (),            # extra structure cards (paths)
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
+    "figure_formats": ("png",),  # their file formats
+    "structure_figures": STRUCTURE_FIGURES,  # structures with corner (trace) figures; None: all
 }
+
+#: Options added after batch directories were first written: a data set's record leaves them
+#: out at these values, so that directories written before they existed stay complete.
+LATER_OPTIONS = {"figure_formats": ("png",), "structure_figures": STRUCTURE_FIGURES}
 
 EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
 SAMPLERS = ("auto", "emcee")
@@ -135,6 +141,17 @@ def check_options(options: dict, where: str) -> dict:
     if unused:
         raise InputError(f"{where}: prior '{unused[0]}' names a parameter no selected "
                          "structure has")
+    formats, detail = opts["figure_formats"], opts["structure_figures"]
+    if opts["figures"]:
+        from .plotting.output import check_formats
+
+        formats = check_formats(formats, f"{where}: figure_formats")
+    else:
+        formats = DEFAULT_OPTIONS["figure_formats"]
+    if detail is not None and (isinstance(detail, bool) or not isinstance(detail, int)
+                               or detail < 0):
+        raise InputError(f"{where}: structure_figures must be a non-negative integer or None "
+                         f"(every structure), got {detail!r}")
     holdout = opts["holdout"]
     if holdout is not None:
         holdout = tuple(float(w) for w in holdout)
@@ -149,7 +166,8 @@ def check_options(options: dict, where: str) -> dict:
             "sampler": opts["sampler"],
             "evidence_check": bool(opts["evidence_check"]),
             "max_steps": opts["max_steps"], "walkers": opts["walkers"],
-            "models": models, "figures": bool(opts["figures"])}
+            "models": models, "figures": bool(opts["figures"]),
+            "figure_formats": formats, "structure_figures": detail}
 
 
 #: Seeds are 32-bit: every random generator in the chain (numpy, scipy, emcee) accepts them.

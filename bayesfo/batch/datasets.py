@@ -21,7 +21,14 @@ from .._io import csv_cells, read_text_file, split_lines
 from ..data import is_contract_csv
 from ..data.temperature import parse_temperature, temperature_of_file
 from ..errors import InputError
-from ..options import DEFAULT_OPTIONS, EVIDENCE_ROUTES, KINDS, check_options, check_seed
+from ..options import (
+    DEFAULT_OPTIONS,
+    EVIDENCE_ROUTES,
+    KINDS,
+    LATER_OPTIONS,
+    check_options,
+    check_seed,
+)
 
 #: Manifest columns; ``invert`` is another name for ``reciprocal``.
 MANIFEST_COLUMNS = ("path", "id", "kind", "reciprocal", "invert", "structures", "noise", "prior",
@@ -99,7 +106,9 @@ class DataSet:
     def fingerprint(self) -> dict:
         """What makes a stored result valid for this data set: the data file's content, the
         options, the seed and the bayesfo version (and the data set of a lab file)."""
-        fp = {"sha256": _sha256(self.path), "options": _jsonable(self.options),
+        options = {k: v for k, v in self.options.items()
+                   if k not in LATER_OPTIONS or v != LATER_OPTIONS[k]}
+        fp = {"sha256": _sha256(self.path), "options": _jsonable(options),
               "seed": self.seed, "bayesfo": __version__}
         if self.block is not None:
             fp["block"] = self.block

@@ -97,7 +97,9 @@ def run_task(task: dict) -> dict:
             out["compare_seconds"] = time.perf_counter() - t1
             out["compare_cpu_seconds"] = time.process_time() - c1
             with tempfile.TemporaryDirectory(prefix="bayesfo-batch-") as tmp:
-                write_outputs(comparison, tmp, figures=opts["figures"])
+                write_outputs(comparison, tmp, figures=opts["figures"],
+                              formats=opts["figure_formats"],
+                              structure_figures=opts["structure_figures"])
                 # The outputs, without the bookkeeping of the run's own output directory
                 # (manifest, lock), which the store writes for the data set's directory.
                 out["files"] = {f.relative_to(tmp).as_posix(): f.read_bytes()

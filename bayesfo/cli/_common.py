@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from ..errors import InputError
 from ..options import (
     DEFAULT_STRUCTURES,
     EVIDENCE_ROUTES,
     KINDS,
     NOISE_MODELS,
     SAMPLERS,
+    STRUCTURE_FIGURES,
     seed_argument,
 )
 
@@ -105,3 +107,31 @@ def add_comparison_options(p, each: str = "the fit"):
                         "ridged and multimodal posteriors")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
+
+
+def add_figure_options(p, each: str = ""):
+    """``--figure-formats`` and ``--structure-figures`` (``each``: e.g. " of each data set")."""
+    p.add_argument("--figure-formats", default="png", metavar="F1,F2",
+                   help=f"file formats of the figures{each} (default png, which report.html "
+                        "embeds; png,pdf adds vector figures for publication, at about twice "
+                        "the time)")
+    p.add_argument("--structure-figures", default=str(STRUCTURE_FIGURES), metavar="N|all",
+                   help=f"how many structures{each}, the best by the ranking, get corner "
+                        "figures (and trace figures of walkers or ladder runs) (default "
+                        f"{STRUCTURE_FIGURES}; 'all' for every one; fewer is faster)")
+
+
+def figure_options(args) -> tuple[tuple[str, ...] | None, int | None]:
+    """The figure formats (None with ``--no-figures``) and how many structures get their own
+    figures (None: every one) of the command line, checked before any work."""
+    detail = args.structure_figures.strip().lower()
+    if detail != "all" and not detail.isdigit():
+        raise InputError(f"--structure-figures takes a number of structures or 'all', got "
+                         f"{args.structure_figures!r}")
+    if args.no_figures:
+        return None, None if detail == "all" else int(detail)
+    from ..plotting.output import check_formats
+
+    formats = check_formats([f for f in args.figure_formats.split(",") if f.strip()],
+                            "--figure-formats")
+    return formats, None if detail == "all" else int(detail)

@@ -10,7 +10,7 @@ from ..options import (
     KINDS,
     parse_floats,
 )
-from ._common import add_comparison_options
+from ._common import add_comparison_options, add_figure_options, figure_options
 from ._libraries import load_libraries
 
 
@@ -50,6 +50,7 @@ def add_parser(subparsers):
     p.add_argument("--no-figures", action="store_true",
                    help="skip each data set's figures and report.html (the combined figures "
                         "are still drawn)")
+    add_figure_options(p, each=" of each data set")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes running data sets side by side (default 0: one per CPU; "
                         "1: in this process); the numbers do not depend on it")
@@ -64,17 +65,20 @@ def run(args) -> int:
     """Run ``bayesfo batch``; returns the exit status (0 all compared, 2 bad input in some data
     set, 1 an internal error in some data set). Problems with the command itself (arguments,
     manifests, scheduler) raise :class:`~bayesfo.errors.InputError`."""
+    formats, detail = figure_options(args)
     options = {"kind": args.kind, "reciprocal": args.reciprocal, "structures": args.structures,
                "noise": args.noise, "priors": tuple(args.prior),
                "holdout": parse_floats(args.holdout, "--holdout") if args.holdout else None,
                "evidence": args.evidence, "evidence_check": args.evidence_check,
                "sampler": args.sampler, "max_steps": args.max_steps, "walkers": args.walkers,
                "models": tuple(getattr(args, "models", None) or ()),
-               "figures": not args.no_figures}
+               "figures": not args.no_figures, "figure_formats": formats or ("png",),
+               "structure_figures": detail}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,
                              seed=args.seed, exclude=args.out)
     progress = not args.quiet and sys.stderr.isatty()
-    load_libraries()  # the data sets are compared here or in processes forked from this one
+    # The data sets are compared (and drawn) here or in processes forked from this one.
+    load_libraries(formats or ())
     result = run_batch(datasets, args.out, workers=args.workers, scheduler=args.scheduler,
                        progress=progress)
     for o in result.failed:

@@ -8,13 +8,19 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..options import (
-    STRUCTURE_FIGURES,
     check_sampler_settings,
     parse_floats,
     parse_priors,
     sampler_options,
 )
-from ._common import add_comparison_options, add_data_options, library, read_data
+from ._common import (
+    add_comparison_options,
+    add_data_options,
+    add_figure_options,
+    figure_options,
+    library,
+    read_data,
+)
 
 
 def add_parser(subparsers):
@@ -33,13 +39,7 @@ def add_parser(subparsers):
                         "from this one); the numbers do not depend on it")
     p.add_argument("--no-figures", action="store_true",
                    help="skip the figures and report.html (faster; summary, table and NetCDF only)")
-    p.add_argument("--figure-formats", default="png", metavar="F1,F2",
-                   help="file formats of the figures (default png, which report.html embeds; "
-                        "png,pdf adds vector figures for publication, at about twice the time)")
-    p.add_argument("--structure-figures", default=str(STRUCTURE_FIGURES), metavar="N|all",
-                   help="how many structures, the best by the ranking, get corner figures (and "
-                        "trace figures of walkers or ladder runs) (default "
-                        f"{STRUCTURE_FIGURES}; 'all' for every one)")
+    add_figure_options(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar or table")
     return p
 
@@ -141,16 +141,7 @@ def run(args) -> int:
         raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
     settings = {"max_steps": args.max_steps, "walkers": args.walkers}
     check_sampler_settings(settings, "compare")
-    formats = None
-    if not args.no_figures:
-        from ..plotting.output import check_formats
-
-        formats = check_formats([f for f in args.figure_formats.split(",") if f.strip()],
-                                "--figure-formats")
-    detail = args.structure_figures.strip().lower()
-    if detail != "all" and not detail.isdigit():
-        raise InputError(f"--structure-figures takes a number of structures or 'all', got "
-                         f"{args.structure_figures!r}")
+    formats, detail = figure_options(args)
     holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
     if args.workers < 0:
         raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
@@ -159,7 +150,7 @@ def run(args) -> int:
                    evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,
                    sampler=args.sampler)
     options.update(sampler_options(settings))
-    options["structure_figures"] = None if detail == "all" else int(detail)
+    options["structure_figures"] = detail
     target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")
     created = not target.exists()
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))

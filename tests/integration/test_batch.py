@@ -403,7 +403,7 @@ def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch)
                                    "mean": 0.5, "sd": 0.1, "hdi_low": 0.3, "hdi_high": 0.7,
                                    "map": 0.5}}}]}
 
-    def fake_outputs(comparison, out, figures=True):
+    def fake_outputs(comparison, out, figures=True, **kwargs):
         out = Path(out)
         (out / "voigt.nc").write_bytes(b"nc")
         if figures:
@@ -427,6 +427,56 @@ def test_nested_outputs_are_stored_and_stale_ones_removed(tmp_path, monkeypatch)
               tmp_path / "out", workers=1, progress=False, write_combined=False)
     assert sorted(p.name for p in sub.iterdir() if not p.name.startswith(".bayesfo-")) == [
         "batch.json", "summary.json", "voigt.nc"]
+
+
+def test_figure_options_reach_each_data_set_and_defaults_keep_earlier_records(tmp_path,
+                                                                               monkeypatch,
+                                                                               capsys):
+    """``--figure-formats`` and ``--structure-figures`` apply to every data set's figures (as
+    compare's options); at their defaults a data set's record is the one written before the
+    options existed, so such a directory stays complete."""
+    import bayesfo.comparison
+    import bayesfo.output
+
+    shutil.copy(ADHESIVE / "Tp150C.csv", tmp_path / "a.csv")
+    seen = []
+
+    def fake_outputs(comparison, out, figures=True, **kwargs):
+        seen.append(kwargs)
+        (Path(out) / "summary.json").write_text(json.dumps(
+            {"data": {"kind": "modulus", "n_frequencies": 17}, "ranking": [],
+             "structures": []}))
+
+    monkeypatch.setattr(bayesfo.comparison, "compare", lambda *args, **kwargs: None)
+    monkeypatch.setattr(bayesfo.output, "write_outputs", fake_outputs)
+    status, _, err = _run_cli(capsys, "batch", tmp_path / "a.csv", "--out", tmp_path / "o1",
+                              "--structures", "voigt", "--quiet", "--workers", 1,
+                              "--structure-figures", "1", "--figure-formats", "png,PDF")
+    assert status == 0, err
+    assert seen == [{"formats": ("png", "pdf"), "structure_figures": 1}]
+    _run_cli(capsys, "batch", tmp_path / "a.csv", "--out", tmp_path / "o2", "--structures",
+             "voigt", "--quiet", "--workers", 1, "--structure-figures", "all")
+    assert seen[1] == {"formats": ("png",), "structure_figures": None}
+    default = expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"})[0]
+    assert default.options["figure_formats"] == ("png",)
+    assert default.options["structure_figures"] == 3
+    record = default.fingerprint()["options"]
+    assert "figure_formats" not in record and "structure_figures" not in record
+    fewer = expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt",
+                                                         "structure_figures": 1})[0]
+    assert fewer.fingerprint()["options"]["structure_figures"] == 1
+    status, _, err = _run_cli(capsys, "batch", tmp_path / "a.csv", "--out", tmp_path / "o3",
+                              "--figure-formats", "bmpx")
+    assert status == 2 and "--figure-formats: cannot write 'bmpx' figures" in err
+    status, _, err = _run_cli(capsys, "batch", tmp_path / "a.csv", "--out", tmp_path / "o3",
+                              "--structure-figures", "some")
+    assert status == 2
+    assert "--structure-figures takes a number of structures or 'all', got 'some'" in err
+    with pytest.raises(InputError, match="figure_formats: cannot write 'bmpx' figures"):
+        expand_inputs([tmp_path / "a.csv"], options={"figure_formats": ("bmpx",)})
+    with pytest.raises(InputError, match="structure_figures must be a non-negative integer"):
+        expand_inputs([tmp_path / "a.csv"], options={"structure_figures": -1})
+    assert not (tmp_path / "o3").exists()
 
 
 def test_tasks_carry_the_data_so_workers_need_no_shared_files(tmp_path):

@@ -176,25 +176,37 @@ def test_quick_posteriors_run_here_and_start_no_process():
     assert caught_serial == caught_auto
 
 
-def test_structures_without_the_promise_go_to_the_pool(monkeypatch, noisy_sampler):
-    """A structure whose screen does not promise a quick posterior has its posteriors and its
-    conclusion run by the pool, with the numbers and warnings of the serial path; the others
-    run here."""
+def _no_promise_for(monkeypatch, name: str) -> None:
+    """The screen of structure ``name`` promises no quick posterior (its steps then go to the
+    pool); the step is recorded as ``pessimistic``."""
     probe = schedule.fit_and_probe
 
     def pessimistic(s, data, options):
         prepared, quick = probe(s, data, options)
-        return prepared, quick and s.name != "maxwell-int"
+        return prepared, quick and s.name != name
 
     monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
+
+
+def _steps_in_pool(pool) -> list:
+    """The steps ``pool`` ran (sorted), after checking that the comparison through it gives the
+    numbers and warnings of the serial path."""
     serial, caught_serial = _compare(workers=1)
-    pool = _LazyRecorder()
     auto, caught_auto = _compare(pool=pool)
     assert _numbers(serial.results) == _numbers(auto.results)
     assert caught_serial == caught_auto
-    assert sorted(pool.steps) == [("conclude", "maxwell-int", None),
-                                           ("sample_held", "maxwell-int", "constant"),
-                                           ("sample_held", "maxwell-int", "proportional")]
+    return sorted(pool.steps)
+
+
+def test_structures_without_the_promise_go_to_the_pool(monkeypatch, noisy_sampler):
+    """A structure whose screen does not promise a quick posterior has its posteriors and its
+    conclusion run by the pool, with the numbers and warnings of the serial path; the others
+    run here."""
+    _no_promise_for(monkeypatch, "maxwell-int")
+    assert _steps_in_pool(_LazyRecorder()) == [
+        ("conclude", "maxwell-int", None),
+        ("sample_held", "maxwell-int", "constant"),
+        ("sample_held", "maxwell-int", "proportional")]
 
 
 class _StartingRecorder(_LazyRecorder):
@@ -215,37 +227,21 @@ def test_once_the_workers_have_started_every_step_still_to_come_goes_to_them(mon
     """The first structure (the larger) starts the workers; the other's fit, queued here
     before they started, and every later step then run in the workers, with the numbers and
     warnings of the serial path."""
-    probe = schedule.fit_and_probe
-
-    def pessimistic(s, data, options):
-        prepared, quick = probe(s, data, options)
-        return prepared, quick and s.name != "zener-int"
-
-    monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
-    serial, caught_serial = _compare(workers=1)
-    pool = _StartingRecorder()
-    auto, caught_auto = _compare(pool=pool)
-    assert _numbers(serial.results) == _numbers(auto.results)
-    assert caught_serial == caught_auto
-    assert sorted(pool.steps) == [("conclude", "maxwell-int", None),
-                                  ("conclude", "zener-int", None),
-                                  ("pessimistic", "maxwell-int", None),
-                                  ("sample_held", "maxwell-int", "constant"),
-                                  ("sample_held", "maxwell-int", "proportional"),
-                                  ("sample_held", "zener-int", "constant"),
-                                  ("sample_held", "zener-int", "proportional")]
+    _no_promise_for(monkeypatch, "zener-int")
+    assert _steps_in_pool(_StartingRecorder()) == [
+        ("conclude", "maxwell-int", None),
+        ("conclude", "zener-int", None),
+        ("pessimistic", "maxwell-int", None),
+        ("sample_held", "maxwell-int", "constant"),
+        ("sample_held", "maxwell-int", "proportional"),
+        ("sample_held", "zener-int", "constant"),
+        ("sample_held", "zener-int", "proportional")]
 
 
 def test_with_one_worker_the_quick_steps_stay_here(monkeypatch, noisy_sampler):
     """A pool of one worker (a machine with one CPU) takes only the long structure's steps:
     handing it the others would only add the shipping."""
-    probe = schedule.fit_and_probe
-
-    def pessimistic(s, data, options):
-        prepared, quick = probe(s, data, options)
-        return prepared, quick and s.name != "zener-int"
-
-    monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
+    _no_promise_for(monkeypatch, "zener-int")
     pool = _StartingRecorder()
     pool.workers = 1
     _compare(pool=pool)

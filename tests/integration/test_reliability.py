@@ -277,7 +277,7 @@ def fake_compare(monkeypatch):
     import bayesfo.comparison
     import bayesfo.output
 
-    def fake_outputs(comparison, out, figures=True):
+    def fake_outputs(comparison, out, figures=True, **figure_options):
         out = Path(out)
         (out / "voigt.nc").write_bytes(b"nc")
         (out / "figures").mkdir()

@@ -76,7 +76,7 @@ DEFAULT_OPTIONS = {
 
 #: Options added after batch directories were first written: a data set's record leaves them
 #: out at these values, so that directories written before they existed stay complete.
-LATER_OPTIONS = {"figure_formats": ("png",), "structure_figures": STRUCTURE_FIGURES}
+LATER_OPTIONS = {k: DEFAULT_OPTIONS[k] for k in ("figure_formats", "structure_figures")}
 
 EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
 SAMPLERS = ("auto", "emcee")

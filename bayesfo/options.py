@@ -142,12 +142,15 @@ def check_options(options: dict, where: str) -> dict:
         raise InputError(f"{where}: prior '{unused[0]}' names a parameter no selected "
                          "structure has")
     formats, detail = opts["figure_formats"], opts["structure_figures"]
-    if opts["figures"]:
-        from .plotting.output import check_formats
-
-        formats = check_formats(formats, f"{where}: figure_formats")
-    else:
+    if not opts["figures"]:
         formats = DEFAULT_OPTIONS["figure_formats"]
+    # Whether matplotlib writes each format is checked where the figures are drawn (and by the
+    # command line before any work): this layer does not import the plotting.
+    formats = tuple(dict.fromkeys(str(f).strip().lower().lstrip(".")
+                                  for f in ((formats,) if isinstance(formats, str) else formats)))
+    if not formats or not all(formats):
+        raise InputError(f"{where}: figure_formats must name one or more file formats (e.g. "
+                         f"png, pdf), got {opts['figure_formats']!r}")
     if detail is not None and (isinstance(detail, bool) or not isinstance(detail, int)
                                or detail < 0):
         raise InputError(f"{where}: structure_figures must be a non-negative integer or None "

@@ -146,8 +146,12 @@ def check_options(options: dict, where: str) -> dict:
         formats = DEFAULT_OPTIONS["figure_formats"]
     # Whether matplotlib writes each format is checked where the figures are drawn (and by the
     # command line before any work): this layer does not import the plotting.
-    formats = tuple(dict.fromkeys(str(f).strip().lower().lstrip(".")
-                                  for f in ((formats,) if isinstance(formats, str) else formats)))
+    if isinstance(formats, str):
+        formats = (formats,)
+    if not isinstance(formats, (tuple, list)):
+        raise InputError(f"{where}: figure_formats must be a sequence of file formats (e.g. "
+                         f"('png', 'pdf')), got {formats!r}")
+    formats = tuple(dict.fromkeys(str(f).strip().lower().lstrip(".") for f in formats))
     if not formats or not all(formats):
         raise InputError(f"{where}: figure_formats must name one or more file formats (e.g. "
                          f"png, pdf), got {opts['figure_formats']!r}")

@@ -474,6 +474,8 @@ def test_figure_options_reach_each_data_set_and_defaults_keep_earlier_records(tm
     assert "--structure-figures takes a number of structures or 'all', got 'some'" in err
     with pytest.raises(InputError, match="figure_formats must name one or more file formats"):
         expand_inputs([tmp_path / "a.csv"], options={"figure_formats": ()})
+    with pytest.raises(InputError, match="figure_formats must be a sequence of file formats"):
+        expand_inputs([tmp_path / "a.csv"], options={"figure_formats": 5})
     with pytest.raises(InputError, match="structure_figures must be a non-negative integer"):
         expand_inputs([tmp_path / "a.csv"], options={"structure_figures": -1})
     assert not (tmp_path / "o3").exists()

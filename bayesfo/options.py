@@ -85,6 +85,22 @@ SAMPLERS = ("auto", "emcee")
 NOISE_MODELS = ("auto", "known", "constant", "proportional", "relative_parts")
 
 
+def figure_format_names(formats, argument: str) -> tuple[str, ...]:
+    """Figure file formats as given (a name or a sequence of names) in lower case without dots,
+    each once; :class:`InputError` naming ``argument`` when none is given or ``formats`` is
+    not a name or a sequence of them. Whether matplotlib writes them is
+    :func:`bayesfo.plotting.output.check_formats`'s to say."""
+    if isinstance(formats, str):
+        formats = (formats,)
+    if not isinstance(formats, (tuple, list)):
+        raise InputError(f"{argument} must be a sequence of file formats (e.g. ('png', "
+                         f"'pdf')), got {formats!r}")
+    formats = tuple(dict.fromkeys(str(f).strip().lower().lstrip(".") for f in formats))
+    if not formats:
+        raise InputError(f"{argument} is empty")
+    return formats
+
+
 def check_options(options: dict, where: str) -> dict:
     """Check the options of one data set before any work and put them in canonical form.
 
@@ -141,20 +157,11 @@ def check_options(options: dict, where: str) -> dict:
     if unused:
         raise InputError(f"{where}: prior '{unused[0]}' names a parameter no selected "
                          "structure has")
-    formats, detail = opts["figure_formats"], opts["structure_figures"]
-    if not opts["figures"]:
-        formats = DEFAULT_OPTIONS["figure_formats"]
+    detail = opts["structure_figures"]
     # Whether matplotlib writes each format is checked where the figures are drawn (and by the
     # command line before any work): this layer does not import the plotting.
-    if isinstance(formats, str):
-        formats = (formats,)
-    if not isinstance(formats, (tuple, list)):
-        raise InputError(f"{where}: figure_formats must be a sequence of file formats (e.g. "
-                         f"('png', 'pdf')), got {formats!r}")
-    formats = tuple(dict.fromkeys(str(f).strip().lower().lstrip(".") for f in formats))
-    if not formats or not all(formats):
-        raise InputError(f"{where}: figure_formats must name one or more file formats (e.g. "
-                         f"png, pdf), got {opts['figure_formats']!r}")
+    formats = (figure_format_names(opts["figure_formats"], f"{where}: figure_formats")
+               if opts["figures"] else DEFAULT_OPTIONS["figure_formats"])
     if detail is not None and (isinstance(detail, bool) or not isinstance(detail, int)
                                or detail < 0):
         raise InputError(f"{where}: structure_figures must be a non-negative integer or None "

@@ -124,14 +124,14 @@ def add_figure_options(p, each: str = ""):
 def figure_options(args) -> tuple[tuple[str, ...] | None, int | None]:
     """The figure formats (None with ``--no-figures``) and how many structures get their own
     figures (None: every one) of the command line, checked before any work."""
-    detail = args.structure_figures.strip().lower()
-    if detail != "all" and not detail.isdigit():
+    text = args.structure_figures.strip().lower()
+    if text != "all" and not text.isdigit():
         raise InputError(f"--structure-figures takes a number of structures or 'all', got "
                          f"{args.structure_figures!r}")
+    detail = None if text == "all" else int(text)
     if args.no_figures:
-        return None, None if detail == "all" else int(detail)
+        return None, detail
     from ..plotting.output import check_formats
 
-    formats = check_formats([f for f in args.figure_formats.split(",") if f.strip()],
-                            "--figure-formats")
-    return formats, None if detail == "all" else int(detail)
+    return check_formats([f for f in args.figure_formats.split(",") if f.strip()],
+                         "--figure-formats"), detail

@@ -72,7 +72,7 @@ def run(args) -> int:
                "evidence": args.evidence, "evidence_check": args.evidence_check,
                "sampler": args.sampler, "max_steps": args.max_steps, "walkers": args.walkers,
                "models": tuple(getattr(args, "models", None) or ()),
-               "figures": not args.no_figures, "figure_formats": formats or ("png",),
+               "figures": not args.no_figures, "figure_formats": formats,
                "structure_figures": detail}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,
                              seed=args.seed, exclude=args.out)

@@ -8,7 +8,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import InputError
-from ..options import STRUCTURE_FIGURES
+from ..options import STRUCTURE_FIGURES, figure_format_names
 from ._compute import ok_results, order_parameter
 from .captions import file_stem
 from .material import plot_time_functions
@@ -62,11 +62,7 @@ def check_formats(formats, argument: str = "argument 'formats'") -> tuple[str, .
     ``argument`` when none is given or matplotlib cannot write one."""
     from matplotlib.backend_bases import FigureCanvasBase
 
-    if isinstance(formats, str):
-        formats = (formats,)
-    formats = tuple(dict.fromkeys(str(f).strip().lower().lstrip(".") for f in formats))
-    if not formats:
-        raise InputError(f"{argument} is empty")
+    formats = figure_format_names(formats, argument)
     supported = FigureCanvasBase.get_supported_filetypes()
     bad = [f for f in formats if f not in supported]
     if bad:

@@ -472,7 +472,7 @@ def test_figure_options_reach_each_data_set_and_defaults_keep_earlier_records(tm
                               "--structure-figures", "some")
     assert status == 2
     assert "--structure-figures takes a number of structures or 'all', got 'some'" in err
-    with pytest.raises(InputError, match="figure_formats must name one or more file formats"):
+    with pytest.raises(InputError, match="figure_formats is empty"):
         expand_inputs([tmp_path / "a.csv"], options={"figure_formats": ()})
     with pytest.raises(InputError, match="figure_formats must be a sequence of file formats"):
         expand_inputs([tmp_path / "a.csv"], options={"figure_formats": 5})

@@ -17,6 +17,7 @@ import numpy as np
 from .._io import publish
 from ._arviz import ess_min, from_dict, group_names, hdi, rhat_max, write_tree
 from .likelihood import Likelihood
+from .smc import unique_rows
 from .transform import _log_prob_fn, _Transform
 
 HDI_PROB = 0.94
@@ -169,7 +170,7 @@ def ladder_agreement(lik: Likelihood, runs, *, seed: int = 0) -> Agreement:
     chain_u = np.stack([c[rng.permutation(n_kept)] for c in chain_u])
     chains = tr.to_theta(chain_u)
     r_hat = rhat_max(chains)
-    distinct = float(len(np.unique(chain_u.reshape(-1, chain_u.shape[2]), axis=0)))
+    distinct = float(len(unique_rows(chain_u.reshape(-1, chain_u.shape[2]))))
     ess_bulk = min(distinct, ess_min(chains, "bulk"))
     ess_tail = min(distinct, ess_min(chains, "tail"))
     messages = []

@@ -424,10 +424,11 @@ class Structure(Parametrised):
         ok = np.zeros(n, dtype=bool)
         if self.pictures and self.pictures[0].network is not None:
             ok |= self.pictures[0].network.positive(self.pictures[0].physical_values(self, vals))
-        sums = springpot_sum_passive(self._side_arrays(self.numerator, vals, n),
-                                     self._side_arrays(self.denominator, vals, n))
-        if sums is not None:
-            ok |= sums
+        if not ok.all():  # the second condition only where the first leaves rows undecided
+            sums = springpot_sum_passive(self._side_arrays(self.numerator, vals, n),
+                                         self._side_arrays(self.denominator, vals, n))
+            if sums is not None:
+                ok |= sums
         return ok & np.all(np.isfinite(theta2), axis=1)
 
     @cached_property

@@ -261,3 +261,22 @@ def test_polynomial_plans_survive_pickling():
     assert again._polynomial_plans[1][0] is again.denominator
     for x, y in zip(before, again.polynomials(theta), strict=True):
         np.testing.assert_array_equal(x, y)
+
+
+@pytest.mark.parametrize("n,d", [(0, 3), (1, 3), (2, 4), (1000, 4), (1000, 6), (5000, 10)])
+def test_unique_rows_are_numpys(n, d):
+    # The ladder's distinct particles (its collapse check, the rows its mixtures are fitted
+    # to, the reweighted guide draws): numpy's unique rows, in the same order, from a
+    # lexicographic sort of the columns. Rows are repeated (resampling), share a column with
+    # another row (a coordinate a move left alone), and hold zeros of both signs.
+    from bayesfo.inference.smc import unique_rows
+
+    rng = np.random.default_rng(n + d)
+    base = rng.normal(size=(max(n // 3, 1), d))
+    k = len(base) // 2
+    base[k:2 * k, 0] = base[:k, 0]
+    base[::5, -1] = 0.0
+    x = base[rng.integers(0, len(base), size=n)] if n else np.empty((0, d))
+    _identical(unique_rows(x), np.unique(x, axis=0))
+    if n > 1:
+        assert len(unique_rows(x)) < n  # repeated rows were there to be removed

@@ -164,7 +164,7 @@ def _prior_particles(target: _Target, n: int, rng: np.random.Generator,
 def unique_rows(x: np.ndarray) -> np.ndarray:
     """The distinct rows of ``x`` (finite values) in lexicographic order: ``np.unique(x,
     axis=0)``, by a lexicographic sort of the columns instead of a sort of the rows as
-    records, which takes a third of the time on the ladder's particles (BENCHMARKS.md,
+    records, which is faster on the ladder's particles and guide draws (BENCHMARKS.md,
     "Twenty-third session")."""
     x = np.asarray(x)
     if len(x) < 2:

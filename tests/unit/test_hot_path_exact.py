@@ -268,7 +268,7 @@ def test_unique_rows_are_numpys(n, d):
     # The ladder's distinct particles (its collapse check, the rows its mixtures are fitted
     # to, the reweighted guide draws): numpy's unique rows, in the same order, from a
     # lexicographic sort of the columns. Rows are repeated (resampling), share a column with
-    # another row (a coordinate a move left alone), and hold zeros of both signs.
+    # another row (a coordinate a move left alone), and hold zeros.
     from bayesfo.inference.smc import unique_rows
 
     rng = np.random.default_rng(n + d)

@@ -217,8 +217,8 @@ def test_a_broad_guide_still_gives_the_narrow_modes_their_share():
     # The guide gives the narrow modes their share in a run (guided by the broad draws as they
     # were, no particle of either run reached them); a run that gives them less than their
     # share must not pass as certified: its disagreement with the other run is seen. (Not by
-    # every pair: over seeds 0-11, one pair was certified with the middle mode at a quarter of
-    # its share in one run; BENCHMARKS.md, "Twenty-third session".)
+    # every pair with this guide: over ladder seeds 0-11, one pair was certified with the
+    # middle mode at a quarter of its share in one run; BENCHMARKS.md, "Twenty-third session".)
     assert any(shares)
     if not all(shares):
         assert not posterior_from_particles(lik, runs, seed=0, predictive=False).converged

@@ -19,6 +19,7 @@ block that uses it raises.
 from __future__ import annotations
 
 import ctypes
+import gc
 import os
 import signal
 import sys
@@ -110,7 +111,10 @@ def init_worker(parent: int | None = None, forked: bool = False) -> None:
     workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL. A
     ``forked`` worker also sets the BLAS it inherited, already loaded with the parent's
     threads, to the threads a spawned worker gets from the environment (one unless the user
-    set another number).
+    set another number), and freezes the objects it inherited (the libraries the parent had
+    loaded, its data) out of the garbage collector (:func:`gc.freeze`): they outlive every
+    task, and the collector's full collections would otherwise walk them again and again,
+    touching (and so copying) pages the worker could share with its parent.
 
     ``parent`` is the process id of the parent that started the worker: a parent that died
     before the death signal was asked for (between the fork and the request) sends none, so
@@ -136,6 +140,7 @@ def init_worker(parent: int | None = None, forked: bool = False) -> None:
         from threadpoolctl import threadpool_limits
 
         threadpool_limits(limits=_worker_blas_threads(), user_api="blas")
+        gc.freeze()
 
 
 def new_pool(workers: int, *, fork: bool = False):

@@ -9,6 +9,7 @@ shell reports a process ended by SIGPIPE) when whatever reads the output closes 
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import os
 import re
@@ -147,6 +148,7 @@ def main(argv=None) -> int:
     os.environ.setdefault("MPLBACKEND", "agg")
     parser = build_parser()
     previous = None
+    thaw = not gc.get_freeze_count()  # a caller's own frozen objects stay frozen
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
@@ -193,7 +195,19 @@ def main(argv=None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        if thaw:  # what the command froze (load_libraries) is collectable again
+            gc.unfreeze()
+
+
+def script() -> None:
+    """The ``bayesfo`` executable: :func:`main`, then exit with its status. Every object is
+    frozen out of the garbage collector first, as the process ends anyway: its last
+    collections, at the interpreter's exit, would otherwise walk every object of the libraries
+    once more (files are closed and output flushed as usual)."""
+    status = main()
+    gc.freeze()
+    sys.exit(status)
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    script()

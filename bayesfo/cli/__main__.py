@@ -1,7 +1,5 @@
 """``python -m bayesfo.cli``: the command line."""
 
-import sys
+from . import script
 
-from . import main
-
-sys.exit(main())
+script()

@@ -2,13 +2,21 @@
 
 from __future__ import annotations
 
+import gc
+
 from .._signals import held
 
 
 def load_libraries(formats=()) -> None:
     """Import the compiled libraries that a comparison uses (with those that draw figures in
     ``formats``), with signals held: a Ctrl-C
-    during the imports ends the command after them, cleanly, instead of breaking one."""
+    during the imports ends the command after them, cleanly, instead of breaking one.
+
+    The objects that exist by then (the modules' functions, classes and tables, the data
+    read) live as long as the command: they are frozen out of the garbage collector
+    (:func:`gc.freeze`), whose full collections would otherwise walk them again and again in
+    this process and in the worker processes forked from it (BENCHMARKS.md, "Twenty-fourth
+    session"). :func:`bayesfo.cli.main` puts them back when the command returns."""
     with held():
         import emcee  # noqa: F401
         import netCDF4  # noqa: F401
@@ -23,3 +31,4 @@ def load_libraries(formats=()) -> None:
             from ..plotting.output import preload as preload_plotting
 
             preload_plotting(formats)
+    gc.freeze()

@@ -267,6 +267,32 @@ def test_figures_in_two_processes_only_with_a_spare_cpu(monkeypatch):
     assert parallel.figure_processes(since) == 1
 
 
+@pytest.mark.filterwarnings("ignore::bayesfo.errors.PredictiveWarning")
+def test_a_command_freezes_the_libraries_out_of_the_collector_while_it_runs(run_cli, tmp_path,
+                                                                              monkeypatch):
+    """Once the libraries are loaded, their objects are frozen out of the garbage collector
+    for the rest of the command (its full collections would walk them again and again);
+    when main returns, a caller in the same process has its collector back as it was."""
+    import gc
+
+    from bayesfo.cli import compare as compare_command
+
+    frozen, real = [], compare_command._compare
+
+    def spy(*args, **kwargs):
+        frozen.append(gc.get_freeze_count())
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(compare_command, "_compare", spy)
+    assert gc.get_freeze_count() == 0
+    status, _, err = run_cli("compare", ADHESIVE, "--structures", "voigt", "--out",
+                             tmp_path / "out", "--no-figures", "--quiet")
+    assert status == 0, err
+    # numpy, scipy, xarray and the package alone are tens of thousands of tracked objects
+    assert frozen and frozen[0] > 10_000
+    assert gc.get_freeze_count() == 0
+
+
 def test_writing_the_netcdf_files_does_not_import_dask_distributed(tmp_path):
     """xarray's to_netcdf asks dask for its scheduler, which imports distributed (a second on
     a busy machine); a process without it has no distributed client, so it is not needed."""

@@ -276,25 +276,36 @@ _MARK = {"set_in_parent": False}
 
 
 def _worker_state():
-    """In a worker: whether it has the parent's memory (a fork) and its BLAS thread counts."""
+    """In a worker: whether it has the parent's memory (a fork), its BLAS thread counts and
+    the number of objects frozen out of its garbage collector."""
+    import gc
+
     from threadpoolctl import threadpool_info
 
     return _MARK["set_in_parent"], [p["num_threads"] for p in threadpool_info()
-                                    if p["user_api"] == "blas"]
+                                    if p["user_api"] == "blas"], gc.get_freeze_count()
 
 
 def test_the_automatic_schedule_forks_its_workers_where_safe(monkeypatch):
     """The automatic schedule's workers are forked where that is safe (they then share the
     libraries this process has loaded instead of importing them again) and run one BLAS
-    thread each, as spawned ones do."""
+    thread each, as spawned ones do. A forked worker freezes what it inherited (every
+    module this process has loaded) out of its garbage collector; this process's collector
+    is left as it was."""
+    import gc
+
     if not parallel.fork_safe():
         pytest.skip("another thread runs in this process (e.g. left by a Dask test)")
     monkeypatch.setitem(_MARK, "set_in_parent", True)
+    before = gc.get_freeze_count()
     with lazy_process_pool(2) as pool:
-        forked, blas = pool.submit(_worker_state).result()
+        forked, blas, frozen = pool.submit(_worker_state).result()
         assert pool._pool._mp_context.get_start_method() == "fork"
     assert forked
     assert blas and set(blas) == {1}
+    # numpy, scipy and the package alone are tens of thousands of tracked objects
+    assert frozen > max(10_000, before)
+    assert gc.get_freeze_count() == before
 
 
 def test_the_automatic_schedule_spawns_while_another_thread_runs(monkeypatch):
@@ -307,12 +318,12 @@ def test_the_automatic_schedule_spawns_while_another_thread_runs(monkeypatch):
     try:
         assert not parallel.fork_safe()
         with lazy_process_pool(1) as pool:
-            forked, blas = pool.submit(_worker_state).result()
+            forked, blas, frozen = pool.submit(_worker_state).result()
             assert pool._pool._mp_context.get_start_method() == "spawn"
     finally:
         stop.set()
         other.join()
-    assert not forked
+    assert not forked and frozen == 0
     assert blas and set(blas) == {1}
 
 

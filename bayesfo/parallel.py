@@ -106,6 +106,25 @@ def _worker_blas_threads() -> int:
     return 1
 
 
+#: Whether this process is a worker of :func:`new_pool` (set by :func:`init_worker`), and
+#: whether :func:`settle_worker` has run in it.
+_WORKER = {"pool": False, "settled": False}
+
+
+def settle_worker(load=None) -> None:
+    """In a worker process of :func:`new_pool`, the first time it is called: ``load()``
+    (imports of the libraries its tasks use, e.g. those of the figures) and then
+    :func:`gc.freeze` of every object that exists: the modules outlive every task, and the
+    collector's full collections would otherwise walk them again in each. Elsewhere (this
+    process, a Dask worker) and later calls: nothing."""
+    if not _WORKER["pool"] or _WORKER["settled"]:
+        return
+    _WORKER["settled"] = True
+    if load is not None:
+        load()
+    gc.freeze()
+
+
 def init_worker(parent: int | None = None, forked: bool = False) -> None:
     """Initializer of every worker process: Ctrl-C goes to the parent alone (which ends the
     workers), and on Linux the worker gets SIGTERM when its parent dies, even by SIGKILL. A
@@ -123,6 +142,7 @@ def init_worker(parent: int | None = None, forked: bool = False) -> None:
 
     from tqdm import tqdm
 
+    _WORKER["pool"] = True
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     # tqdm's default lock is a multiprocessing semaphore; a worker ended by terminate() never

@@ -39,3 +39,38 @@ def test_the_inline_executor_runs_at_submit_and_keeps_errors_in_the_future():
 
     with pytest.raises(KeyboardInterrupt):  # not kept for later: Ctrl-C ends the run now
         pool.submit(interrupted)
+
+
+def _settle_twice():
+    """In a worker: settle_worker called twice; the loads it ran and the objects frozen after
+    the first call."""
+    import gc
+
+    from bayesfo.parallel import settle_worker
+
+    loads = []
+    settle_worker(lambda: loads.append("first"))
+    frozen = gc.get_freeze_count()
+    settle_worker(lambda: loads.append("second"))
+    return loads, frozen
+
+
+def test_a_pool_worker_settles_once_and_this_process_never():
+    """settle_worker loads and freezes in a worker process of new_pool, once; in any other
+    process (this one, as a batch run in-process) it leaves the collector alone."""
+    import gc
+
+    from bayesfo.parallel import new_pool, settle_worker, worker_environment
+
+    loads = []
+    before = gc.get_freeze_count()
+    settle_worker(lambda: loads.append("here"))
+    assert loads == [] and gc.get_freeze_count() == before
+    with worker_environment():
+        pool = new_pool(1)  # spawned: a worker starts with nothing frozen
+        try:
+            loads, frozen = pool.submit(_settle_twice).result(timeout=120)
+        finally:
+            pool.shutdown(wait=True)
+    assert loads == ["first"]
+    assert frozen > 1_000  # numpy and the package's modules at least

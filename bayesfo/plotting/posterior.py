@@ -191,11 +191,21 @@ def _shown_ticks(axis):
             if lo - eps <= t.get_loc() <= hi + eps]
 
 
+def _lay_out_ticks(left, bottom) -> None:
+    """The ticks and tick labels of the left column's y axes and of the bottom row's x axes
+    where the figure's present margins put them: what drawing the figure does to them, without
+    drawing the other panels' contours and histograms (most of a drawing's cost)."""
+    for ax in left:
+        ax.yaxis.get_majorticklabels()  # updates the axis's ticks
+    for ax in bottom:
+        ax.xaxis.get_majorticklabels()
+
+
 def _declutter(fig, left, bottom):
     """Hide the first tick label of a panel where it would run into the last one of its
     neighbour across the narrow gap between panels: x labels rotated by 45° need their ticks
     √2 text heights apart, horizontal y labels one text height."""
-    fig.draw_without_rendering()
+    _lay_out_ticks(left, bottom)
     px = fig.dpi / 72.0
 
     def height(label):
@@ -229,7 +239,7 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
     labels. Here the y tick labels are horizontal, the x tick labels rotated by 45° and
     right-aligned at their tick (so none reaches past the right edge of its panel), the axis
     labels of the left column and of the bottom row are placed :data:`LABEL_PAD` points beyond
-    all the tick labels of that column or row, as measured after drawing, and the margins are set so that the outermost text keeps
+    all the tick labels of that column or row, as measured with the ticks laid out, and the margins are set so that the outermost text keeps
     :data:`EDGE_PAD` points from the figure's edges. A tick label that would run into its
     neighbour's across the gap between two panels is hidden (:func:`_declutter`).
     """
@@ -246,10 +256,10 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
         # One x for the y labels of the left column and one y for the x labels of the bottom
         # row, beyond every tick label of the column or row: a label taller or wider than its
         # panel then clears the tick labels of its neighbours too, and the labels align.
-        # ``drawn``: the figure has been drawn since the panels last moved. An axis label
+        # ``drawn``: the ticks have been laid out since the panels last moved. An axis label
         # placed by set_label_coords has its extent without another drawing.
         if not drawn:
-            fig.draw_without_rendering()
+            _lay_out_ticks(left, bottom)
         renderer = fig.canvas.get_renderer()
         boxes = [b for ax in left for b in _tick_boxes(ax.get_yticklabels(), renderer)]
         x = min([b.x0 for b in boxes] + [ax.bbox.x0 for ax in left]) - LABEL_PAD * px
@@ -261,7 +271,7 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
             ax.xaxis.set_label_coords(0.5, (y - ax.bbox.y0) / ax.bbox.height)
         return renderer
 
-    _declutter(fig, left, bottom)  # draws the figure
+    _declutter(fig, left, bottom)  # lays out the ticks
     for i in range(iterations):
         renderer = place_labels(drawn=i == 0)
         boxes = [b for ax in left + bottom

@@ -52,13 +52,17 @@ import warnings
 from concurrent.futures.process import BrokenProcessPool
 
 from ..errors import InputError
+from ..inference._arviz import preload
+from ..parallel import settle_worker
 from .results import StructureResult
 from .steps import conclude, fit_and_probe, fit_and_screen, kept, sample_held
 
 
 def _task(step, *args):
     """One step in a worker: (value, InputError message or None, warnings as (category,
-    message))."""
+    message)). A worker process of a pool loads the ArviZ libraries at its first step and
+    freezes its objects out of the garbage collector (:func:`~bayesfo.parallel.settle_worker`)."""
+    settle_worker(preload)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:

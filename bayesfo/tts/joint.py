@@ -259,9 +259,13 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
 
     from ..identify.optimize import fit_structure
     from ..inference import Likelihood, certified_posterior
+    from ..inference._arviz import preload
     from ..inference.transform import _Transform
+    from ..parallel import settle_worker
     from ..structures import Scaling, get_structure
     from ..structures.response import dissipation_grid
+
+    settle_worker(preload)  # in a pool's worker: its libraries out of the collector, once
 
     spectral = structure == SPECTRUM or isinstance(structure, Spectrum)
     if not spectral:

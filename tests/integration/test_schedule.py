@@ -443,3 +443,28 @@ def test_figures_are_drawn_here_when_a_worker_dies(tmp_path):
     assert set(written) == {"ranking", "bode", "moduli", "time_functions", "nyquist",
                             "residuals", "q_posteriors", "corner_voigt"} | traced
     assert all(p.stat().st_size > 0 for paths in written.values() for p in paths)
+
+
+def _collector_state():
+    import gc
+    import sys
+
+    return gc.get_freeze_count(), "arviz_stats" in sys.modules
+
+
+def test_a_spawned_worker_settles_at_its_first_step():
+    """A spawned worker (``--workers 2``) loads the ArviZ libraries at its first step and
+    freezes what it has loaded out of its garbage collector, as a forked one does at start."""
+    from bayesfo.comparison.schedule import _task
+    from bayesfo.parallel import new_pool, worker_environment
+
+    with worker_environment():
+        pool = new_pool(1)
+        try:
+            before = pool.submit(_collector_state).result(timeout=120)
+            assert pool.submit(_task, int).result(timeout=120) == (0, None, [])
+            after = pool.submit(_collector_state).result(timeout=120)
+        finally:
+            pool.shutdown(wait=True)
+    assert before == (0, False)
+    assert after[1] and after[0] > 50_000  # numpy, scipy, xarray, ArviZ

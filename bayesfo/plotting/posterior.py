@@ -239,9 +239,10 @@ def _tidy_corner(fig, ndim, iterations: int = 4):
     labels. Here the y tick labels are horizontal, the x tick labels rotated by 45° and
     right-aligned at their tick (so none reaches past the right edge of its panel), the axis
     labels of the left column and of the bottom row are placed :data:`LABEL_PAD` points beyond
-    all the tick labels of that column or row, as measured with the ticks laid out, and the margins are set so that the outermost text keeps
-    :data:`EDGE_PAD` points from the figure's edges. A tick label that would run into its
-    neighbour's across the gap between two panels is hidden (:func:`_declutter`).
+    all the tick labels of that column or row, as measured with the ticks laid out, and the
+    margins are set so that the outermost text keeps :data:`EDGE_PAD` points from the
+    figure's edges. A tick label that would run into its neighbour's across the gap between
+    two panels is hidden (:func:`_declutter`).
     """
     left, bottom = _corner_text(fig, ndim)
     for ax in bottom:

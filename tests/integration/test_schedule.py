@@ -344,6 +344,25 @@ def test_a_worker_whose_parent_died_before_it_started_ends_itself():
     assert done.returncode == 0 and done.stdout.strip() == "ok"
 
 
+def test_a_forked_worker_freezes_what_it_inherited():
+    """init_worker of a forked worker freezes the objects it inherited out of its garbage
+    collector (a spawned one has inherited nothing); run in a fresh process, as this one may
+    hold threads that make the suite's pools spawn."""
+    import subprocess
+    import sys
+
+    code = ("import gc, os; import numpy; from bayesfo.parallel import init_worker; "
+            "init_worker(os.getppid(), forked={}); print(gc.get_freeze_count())")
+    counts = {}
+    for forked in (True, False):
+        done = subprocess.run([sys.executable, "-c", code.format(forked)], capture_output=True,
+                              text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        counts[forked] = int(done.stdout)
+    assert counts[False] == 0
+    assert counts[True] > 10_000  # numpy and the package's modules
+
+
 _POOLS_SCRIPT = '''
 import numpy  # the BLAS, loaded before any fork
 from threadpoolctl import threadpool_info

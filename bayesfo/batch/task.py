@@ -40,19 +40,6 @@ def _read_task_data(task: dict, read_csv):
     return data
 
 
-def _load_libraries(opts: dict) -> None:
-    """Import what every data set's comparison and outputs use (ArviZ and xarray; matplotlib
-    and corner where figures are drawn): in a worker process, before its objects are frozen
-    out of the garbage collector (:func:`~bayesfo.parallel.settle_worker`)."""
-    from ..inference._arviz import preload
-
-    preload()
-    if opts["figures"]:
-        from ..plotting.output import preload as preload_plotting
-
-        preload_plotting(opts["figure_formats"])
-
-
 def run_task(task: dict) -> dict:
     """Compare the structures on one data set: the function a worker runs.
 
@@ -90,10 +77,13 @@ def run_task(task: dict) -> dict:
             from ..comparison import compare
             from ..data import read_csv
             from ..output import write_outputs
+            from ..output.write import preload
             from ..parallel import settle_worker
             from ..structures import default_library, load_library, resolve_structures
 
-            settle_worker(lambda: _load_libraries(opts))
+            # In a pool's worker, once: what every data set's comparison and outputs use,
+            # then frozen out of the garbage collector.
+            settle_worker(lambda: preload(opts["figure_formats"] if opts["figures"] else ()))
 
             data = _read_task_data(task, read_csv)
             if opts["reciprocal"]:

@@ -18,17 +18,7 @@ def load_libraries(formats=()) -> None:
     this process and in the worker processes forked from it (BENCHMARKS.md, "Twenty-fourth
     session"). :func:`bayesfo.cli.main` puts them back when the command returns."""
     with held():
-        import emcee  # noqa: F401
-        import netCDF4  # noqa: F401
-        import scipy.optimize  # noqa: F401
-        import scipy.special  # noqa: F401
-        import scipy.stats  # noqa: F401
+        from ..output.write import preload
 
-        from ..inference._arviz import preload
-
-        preload()
-        if formats:
-            from ..plotting.output import preload as preload_plotting
-
-            preload_plotting(formats)
+        preload(formats)
     gc.freeze()

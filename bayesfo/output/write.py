@@ -105,6 +105,25 @@ def _write_netcdf(comparison: Comparison, stage: Path) -> dict[str, Path]:
     return written
 
 
+def preload(formats=()) -> None:
+    """Import now, not on first use, the compiled libraries that a comparison and its outputs
+    use (with those that draw figures in ``formats``): before a command forks its workers, or
+    in a worker before its objects are frozen out of the garbage collector."""
+    import emcee  # noqa: F401
+    import netCDF4  # noqa: F401
+    import scipy.optimize  # noqa: F401
+    import scipy.special  # noqa: F401
+    import scipy.stats  # noqa: F401
+
+    from ..inference._arviz import preload as preload_arviz
+
+    preload_arviz()
+    if formats:
+        from ..plotting.output import preload as preload_plotting
+
+        preload_plotting(formats)
+
+
 def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
                   formats=("png",), pool=None, figure_processes: int = 1,
                   structure_figures: int | None = STRUCTURE_FIGURES) -> dict[str, Path]:

@@ -16,6 +16,11 @@ from ..priors import LogUniform, Uniform
 from .likelihood import Likelihood
 
 
+#: Batches of at most this many rows are checked against the prior box in one comparison
+#: (:meth:`_Transform.in_box`).
+BOX_ROWS = 256
+
+
 class _Transform:
     """θ ↔ u (log for log-uniform priors) and the log-Jacobian.
 
@@ -34,8 +39,12 @@ class _Transform:
         self.other = [(i, p) for i, p in enumerate(priors) if not flat[i]]
 
     def in_box(self, u: np.ndarray) -> np.ndarray:
-        """Rows of ``u`` (2-D) inside the prior box (column by column: 35 µs at 2 000 rows of
-        seven, against 57 µs for the whole comparison at once)."""
+        """Rows of ``u`` (2-D) inside the prior box: the whole comparison at once for the
+        small batches of the optimisers and certificates (fewer calls), column by column for
+        a sampler's thousands of rows (fewer temporaries); the same decisions (BENCHMARKS.md,
+        "Twenty-fifth session")."""
+        if u.shape[0] <= BOX_ROWS:
+            return ((u >= self.lo_u) & (u <= self.hi_u)).all(axis=1)
         ok = np.ones(u.shape[0], dtype=bool)
         for j in range(u.shape[1]):
             column = u[:, j]

@@ -78,10 +78,12 @@ def positive_sum_zero_free(coef: np.ndarray, expo: np.ndarray) -> np.ndarray:
     (condition 1 of the module docstring): no zero in Re s ≥ 0 except at s = 0."""
     with np.errstate(invalid="ignore"):
         finite = np.all(np.isfinite(coef) & np.isfinite(expo), axis=1)
-        nonneg = np.all(coef >= 0, axis=1) & np.any(coef > 0, axis=1)
-        used = np.where(coef > 0, expo, np.nan)
-        spread = np.nanmax(np.where(np.isnan(used), -np.inf, used), axis=1) - np.nanmin(
-            np.where(np.isnan(used), np.inf, used), axis=1)
+        positive = coef > 0
+        nonneg = np.all(coef >= 0, axis=1) & np.any(positive, axis=1)
+        # The span of the exponents of the positive terms (rows with an exponent that is not
+        # finite are not ``finite``, whatever their span).
+        spread = (np.max(np.where(positive, expo, -np.inf), axis=1)
+                  - np.min(np.where(positive, expo, np.inf), axis=1))
     return finite & nonneg & (spread < 2.0)
 
 

@@ -190,14 +190,20 @@ class Structure(Parametrised):
 
     def _polynomial(self, terms, vals, n_sets):
         """Ascending coefficients of a side that is a polynomial in λ = s^q."""
-        plan = next((p for side, p in self._polynomial_plans if side is terms), None)
-        if plan is None:
+        for side, plan in self._polynomial_plans:
+            if side is terms:
+                break
+        else:
             plan = _polynomial_plan(terms)
         out = np.zeros((n_sets, plan[0] + 1))
-        with np.errstate(all="ignore"):
-            for degree, name, t in plan[1]:
-                # A coefficient that is one parameter (most terms) is its column as it is.
-                out[:, degree] += vals[name] if name is not None else t.coefficient(vals, n_sets)
+        if plan[2]:  # coefficients computed or added: arithmetic that may overflow
+            with np.errstate(all="ignore"):
+                for degree, name, t in plan[1]:
+                    out[:, degree] += vals[name] if name is not None else t.coefficient(vals, n_sets)
+            return out
+        for degree, name, _ in plan[1]:
+            # A coefficient that is one parameter (most terms) is its column as it is.
+            out[:, degree] += vals[name]
         return out
 
     @cached_property
@@ -399,23 +405,33 @@ class Structure(Parametrised):
         single = np.ndim(theta) != 2
         if kind == "generic":
             ok = np.ones(theta2.shape[0], dtype=bool)
-        elif self._first_degree:
-            den, num, q = self.polynomials(theta2)
-            d1 = den[:, 1] if den.shape[1] > 1 else 0.0
-            n1 = num[:, 1] if num.shape[1] > 1 else 0.0
-            lhs, rhs = n1 * den[:, 0], num[:, 0] * d1
-            scale = np.abs(lhs) + np.abs(rhs)
-            ok = (lhs <= rhs + 1e-12 * scale) | ~((q > 0) & (q < 2))
-            ok &= np.all(np.isfinite(theta2), axis=1)
-        elif self.commensurate_order is not None and passivity.EXACT_COMMENSURATE:
-            den, num, q = self.polynomials(theta2)
-            ok = commensurate_passive(den, num, q) & np.all(np.isfinite(theta2), axis=1)
+        elif self._passive_by_polynomials:
+            ok = self._passive_polynomials(*self.polynomials(theta2), theta2)
         else:
             ok = self._exactly_passive(theta2)
             rest = np.flatnonzero(~ok)
             if rest.size:
                 ok[rest] = is_dissipative(self.response(theta2[rest], omega_grid, kind), kind)
         return ok[0] if single else ok
+
+    @property
+    def _passive_by_polynomials(self) -> bool:
+        """Commensurate, with dissipation decided from the polynomials
+        (:meth:`_passive_polynomials`)."""
+        return self._first_degree or self._exact_commensurate
+
+    def _passive_polynomials(self, den, num, q, theta2) -> np.ndarray:
+        """:meth:`passive` of a commensurate structure from its polynomials
+        (:meth:`polynomials`) at the parameter sets ``theta2``: the closed form of degree ≤ 1,
+        else :func:`~bayesfo.structures.passivity.commensurate_passive`."""
+        if self._first_degree:
+            d1 = den[:, 1] if den.shape[1] > 1 else 0.0
+            n1 = num[:, 1] if num.shape[1] > 1 else 0.0
+            lhs, rhs = n1 * den[:, 0], num[:, 0] * d1
+            scale = np.abs(lhs) + np.abs(rhs)
+            ok = (lhs <= rhs + 1e-12 * scale) | ~((q > 0) & (q < 2))
+            return ok & np.all(np.isfinite(theta2), axis=1)
+        return commensurate_passive(den, num, q) & np.all(np.isfinite(theta2), axis=1)
 
     def _exactly_passive(self, theta2) -> np.ndarray:
         """Rows passive by an exact sufficient condition (the others may be passive too)."""
@@ -487,16 +503,20 @@ class Structure(Parametrised):
                 ok &= c.holds(vals)
         elif theta.shape[1] != self.n_params:
             self.values(theta)  # raises the error of a wrong shape
-        if "stable" in names and self._exact_commensurate and ok.any():
+        if "stable" in names and self._passive_by_polynomials and ok.any():
             # The polynomials once for both checks (all rows: no copy of theta).
             rows = np.flatnonzero(ok)
-            den, num, q = self.polynomials(theta if rows.size == ok.size else theta[rows])
+            kept = theta if rows.size == ok.size else theta[rows]
+            den, num, q = self.polynomials(kept)
             stable = self._stable_polynomials(den, num, q, kind)
             ok[rows] = stable
             if "passive" in names and kind != "generic" and stable.any():
-                keep = np.flatnonzero(stable)
-                ok[rows[keep]] = (commensurate_passive(den[keep], num[keep], q[keep])
-                                  & np.all(np.isfinite(theta[rows[keep]]), axis=1))
+                if stable.all():
+                    ok[rows] = self._passive_polynomials(den, num, q, kept)
+                else:
+                    keep = np.flatnonzero(stable)
+                    ok[rows[keep]] = self._passive_polynomials(den[keep], num[keep], q[keep],
+                                                               kept[keep])
             return ok
         if "stable" in names and ok.any():
             rows = np.flatnonzero(ok)
@@ -576,11 +596,15 @@ class Structure(Parametrised):
 
 
 def _polynomial_plan(terms) -> tuple:
-    """(degree, ((degree, name or None, term), ...)) of a side that is a polynomial in λ: name is
-    the parameter when the term's coefficient is one parameter, else None."""
+    """(degree, ((degree, name or None, term), ...), computed) of a side that is a polynomial in
+    λ: name is the parameter when the term's coefficient is one parameter, else None; computed
+    where a coefficient is computed or two terms add to one (arithmetic that may overflow),
+    false where each coefficient is one parameter's column, copied into zeros."""
     rows = tuple((_degree(t), t.coef if t.is_free and len(t.factors) == 1 else None, t)
                  for t in terms)
-    return max(d for d, _, _ in rows), rows
+    degrees = [d for d, _, _ in rows]
+    computed = any(name is None for _, name, _ in rows) or len(set(degrees)) < len(degrees)
+    return max(degrees), rows, computed
 
 
 def _degree(t: Term) -> int:

@@ -235,6 +235,83 @@ def test_constraints_hold_on_small_batches_as_on_one_large(name):
         assert whole.any() and not whole.all()
 
 
+@pytest.mark.parametrize("name", ["voigt", "zener", "zener-int", "max-n1m1", "max-n2m1",
+                                  "max-n3m3", "fractional_kelvin_voigt", "maxwell"])
+def test_constraints_hold_as_the_separate_checks(name):
+    # The former code: the inequalities, then stable() and passive() on the rows still in,
+    # each computing its own polynomials; the checks that share them decide every row alike.
+    s = get_structure(name)
+    rng = np.random.default_rng(len(name))
+    theta = np.column_stack([p.prior.sample(rng, 2000) for p in s.parameters])
+    theta[:300] *= rng.choice([-1.0, 1.0], (300, s.n_params))
+    theta[300:310, 0] = np.inf
+    grid = np.logspace(-3, 3, 40)
+    for kind in ("compliance", "modulus"):
+        with np.errstate(all="ignore"):  # the infinite coefficients, in both
+            ok, held = _separate_checks(s, theta, kind, grid), s.constraints_hold(theta, kind, grid)
+        np.testing.assert_array_equal(held, ok)
+        assert held.any() and not held.all()
+
+
+def _separate_checks(s, theta, kind, grid):
+    ok = np.ones(len(theta), dtype=bool)
+    vals, _ = s.values(theta)
+    for c in s._constraint_plan[0]:
+        ok &= c.holds(vals)
+    rows = np.flatnonzero(ok)
+    ok[rows] = s.stable(theta[rows], kind)
+    rows = np.flatnonzero(ok)
+    ok[rows] = s.passive(theta[rows], kind, grid)
+    return ok
+
+
+def test_polynomials_of_parameter_columns_as_the_former_code():
+    # The coefficients copied without the floating-point guard where each is one parameter's
+    # column of its own degree, computed under it otherwise: the same arrays, with no warning
+    # for coefficients that overflow (the suite turns warnings into errors).
+    def former(side, vals, n):
+        plan = side_plan[id(side)]
+        out = np.zeros((n, plan[0] + 1))
+        with np.errstate(all="ignore"):
+            for degree, name, t in plan[1]:
+                out[:, degree] += vals[name] if name is not None else t.coefficient(vals, n)
+        return out
+
+    for name in ("zener", "max-n2m1", "max-n3m3", "voigt-int", "fractional_zener_sl"):
+        s = get_structure(name)
+        if s.commensurate_order is None:
+            continue
+        side_plan = {id(side): plan for side, plan in s._polynomial_plans}
+        rng = np.random.default_rng(3)
+        theta = np.column_stack([p.prior.sample(rng, 50) for p in s.parameters])
+        theta[:5] = 1e308
+        theta[5:10, 0] = np.nan
+        vals, _ = s.values(theta)
+        for side in (s.numerator, s.denominator):
+            _identical(s._polynomial(side, vals, len(theta)), former(side, vals, len(theta)))
+
+
+@pytest.mark.parametrize("rows", [0, 1, 9, 255, 256, 257, 2000])
+def test_prior_box_of_small_and_large_batches_as_column_by_column(rows):
+    from bayesfo.inference.transform import _Transform
+
+    lik = Likelihood(get_structure("zener"), g_spec_data(0), noise="constant")
+    tr = _Transform(lik)
+    rng = np.random.default_rng(rows)
+    span = tr.hi_u - tr.lo_u
+    u = tr.lo_u - 0.05 * span + rng.random((rows, span.size)) * 1.1 * span
+    if rows > 3:
+        u[0] = tr.lo_u
+        u[1] = tr.hi_u
+        u[2, 1] = np.nan
+    ok = np.ones(rows, dtype=bool)
+    for j in range(u.shape[1]):
+        ok &= (u[:, j] >= tr.lo_u[j]) & (u[:, j] <= tr.hi_u[j])
+    np.testing.assert_array_equal(tr.in_box(u), ok)
+    if rows > 3:
+        assert ok[:2].all() and not ok[2]
+
+
 def test_power_sums_of_a_scalar_or_two_dimensional_omega_keep_their_shapes():
     # As the former einsum: a scalar ω gives one value per set, an (sets, n) ω a table.
     s = get_structure("maxwell")

@@ -131,7 +131,7 @@ def test_shortfall_is_zero_inside_and_implies_passive():
 
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import given, settings  # noqa: E402
+from hypothesis import assume, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 _coef = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
@@ -143,6 +143,14 @@ _coef = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 def test_fuzz_exact_against_grid(den, num, q):
     # Magnitudes below 1e-6 are 0: a coefficient of 1e-300 moves the sign change beyond the
     # grid's 1e30 (the exact check is right there, the grid cannot see it).
+    # Orders where a sine of the dissipation polynomial, sin(kqπ/2), nearly vanishes without
+    # vanishing to rounding (q = 0.99999: sin(qπ) = 3e-5; q = 1: 1e-16, kept) are left out:
+    # there a coefficient of a few 1e-5 decides the sign far out on the grid, below its
+    # rounding tolerance (the exact check is right, the grid cannot see it). Hypothesis mixes
+    # in numbers written in the modules loaded so far, so which examples it draws depends on
+    # the tests run before this one.
+    sines = np.abs(np.sin(np.arange(1, len(den) + len(num) - 1) * q * np.pi / 2))
+    assume(not np.any((sines > 1e-9) & (sines < 1e-3)))
     den = np.array([[1.0] + [c if abs(c) > 1e-6 else 0.0 for c in den[1:]]])
     num = np.array([[c if abs(c) > 1e-6 else 0.0 for c in num]])
     exact = commensurate_passive(den, num, np.array([q]))

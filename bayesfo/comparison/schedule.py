@@ -31,7 +31,11 @@ structures' (2) and (3) go to the pool, whose processes start with the first of 
 have started (two or more), every step still to come goes to them as well, those queued here
 included: this process then only waits, so the comparison never runs more processes than CPUs
 while the workers are busy, nor leaves a CPU idle while this process works alone
-(BENCHMARKS.md, "Twenty-second session"). A wrong promise costs time, never a different number.
+(BENCHMARKS.md, "Twenty-second session"). The steps for the workers wait here and go to them
+one per free worker, the longest first: a posterior without the promise, then the fits (which
+find the other long posteriors), then the quick posteriors and the conclusions; a long
+posterior found late thus starts before quick steps queued earlier (BENCHMARKS.md,
+"Twenty-fifth session"). A wrong promise costs time, never a different number.
 
 Every step uses the comparison's seed wherever it runs, so the numbers do not depend on the pool
 or the worker count. A worker process that dies (killed, out of memory) breaks the pool: its
@@ -104,6 +108,10 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
     in_pool = [not here] * n  # where (2) and (3) of each structure run
     order = itertools.count()
     broken = []  # the pool's failure, once a worker died
+    # On the automatic schedule the steps for the workers wait here until one is free
+    # (``waiting``, by rank); elsewhere they go to the executor as they come.
+    waiting = []  # (rank, order, structure index, what, step and its arguments)
+    cap = pool.workers if here else None
 
     def run_here(i, what, args):
         # Step (1) first; otherwise first come, first run.
@@ -118,6 +126,31 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
     def submit(i, what, *args):
         if broken or not (in_pool[i] or pool_open()):
             return run_here(i, what, args)
+        if cap is None:
+            return send(i, what, args)
+        heapq.heappush(waiting, (rank(i, what), next(order), i, what, args))
+        dispatch()
+
+    def rank(i, what):
+        # The longest steps first: a posterior not promised to be quick, then the fits (which
+        # find the other long posteriors), then the quick posteriors and the conclusions.
+        if what == "first":
+            return 1
+        return 0 if what != "conclude" and in_pool[i] else 2
+
+    def dispatch():
+        # Steps go to the workers one per free worker, the first by rank, so that a long
+        # posterior found late does not wait behind quick steps queued before it.
+        while waiting and (broken or len(live) < cap):
+            _, _, i, what, args = heapq.heappop(waiting)
+            if outcomes[i] is not None:  # its structure has ended
+                continue
+            if broken:
+                run_here(i, what, args)
+            else:
+                send(i, what, args)
+
+    def send(i, what, args):
         try:
             future = pool.submit(_task, *args)
         except BrokenProcessPool as exc:
@@ -194,12 +227,13 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 submit(i, "first", fit_and_probe, structures[i], data, options)
             else:
                 submit(i, "first", _first, structures[i], data, options)
-        while live or local:
+        while live or local or waiting:
             while True:  # what the pool has finished, without waiting
                 try:
                     collect(finished.get_nowait())
                 except queue.Empty:
                     break
+            dispatch()
             if local:
                 _, _, i, what, args = heapq.heappop(local)
                 if outcomes[i] is None:

@@ -86,6 +86,15 @@ def _first(s, data, options):
     return "result", conclude(s, data, fit, screened, runs, options)
 
 
+def _rank(what: str, *, quick: bool) -> int:
+    """The order in which the automatic schedule hands steps to free workers (lowest first):
+    a posterior (``what`` a noise model) of a structure without the quick promise, then a fit
+    (``"first"``; it finds the other long posteriors), then quick posteriors and conclusions."""
+    if what == "first":
+        return 1
+    return 0 if what != "conclude" and not quick else 2
+
+
 def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> list:
     """Run the structures' steps as tasks of ``pool``; returns (result, warnings) per structure
     in the order given.
@@ -128,15 +137,9 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
             return run_here(i, what, args)
         if cap is None:
             return send(i, what, args)
-        heapq.heappush(waiting, (rank(i, what), next(order), i, what, args))
+        rank = _rank(what, quick=not in_pool[i])
+        heapq.heappush(waiting, (rank, next(order), i, what, args))
         dispatch()
-
-    def rank(i, what):
-        # The longest steps first: a posterior not promised to be quick, then the fits (which
-        # find the other long posteriors), then the quick posteriors and the conclusions.
-        if what == "first":
-            return 1
-        return 0 if what != "conclude" and in_pool[i] else 2
 
     def dispatch():
         # Steps go to the workers one per free worker, the first by rank, so that a long

@@ -15,7 +15,6 @@ from scipy.special import expit
 from ..priors import LogUniform, Uniform
 from .likelihood import Likelihood
 
-
 #: Batches of at most this many rows are checked against the prior box in one comparison
 #: (:meth:`_Transform.in_box`).
 BOX_ROWS = 256

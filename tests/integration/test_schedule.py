@@ -238,6 +238,25 @@ def test_once_the_workers_have_started_every_step_still_to_come_goes_to_them(mon
         ("sample_held", "zener-int", "proportional")]
 
 
+def test_free_workers_take_the_long_posteriors_first():
+    """Steps waiting for a worker go out by rank, in the order they came within a rank: the
+    posteriors without the quick promise, then the fits, then quick posteriors and
+    conclusions."""
+    import heapq
+    import itertools
+
+    order = itertools.count()
+    came = [("conclude", True), ("constant", True), ("first", True), ("proportional", False),
+            ("first", False), ("constant", False), ("conclude", False)]
+    waiting = []
+    for what, quick in came:
+        heapq.heappush(waiting, (schedule._rank(what, quick=quick), next(order), what, quick))
+    out = [heapq.heappop(waiting)[2:] for _ in came]
+    assert out == [("proportional", False), ("constant", False), ("first", True),
+                   ("first", False), ("conclude", True), ("constant", True),
+                   ("conclude", False)]
+
+
 def test_with_one_worker_the_quick_steps_stay_here(monkeypatch, noisy_sampler):
     """A pool of one worker (a machine with one CPU) takes only the long structure's steps:
     handing it the others would only add the shipping."""

@@ -31,10 +31,10 @@ structures' (2) and (3) go to the pool, whose processes start with the first of 
 have started (two or more), every step still to come goes to them as well, those queued here
 included: this process then only waits, so the comparison never runs more processes than CPUs
 while the workers are busy, nor leaves a CPU idle while this process works alone
-(BENCHMARKS.md, "Twenty-second session"). The steps for the workers wait here and go to them
-one per free worker, the longest first: a posterior without the promise, then the fits (which
-find the other long posteriors), then the quick posteriors and the conclusions; a long
-posterior found late thus starts before quick steps queued earlier (BENCHMARKS.md,
+(BENCHMARKS.md, "Twenty-second session"). The steps for the workers wait here and go to them as
+they free up (one queued ahead), the longest first: a posterior without the promise, then the
+fits (which find the other long posteriors), then the quick posteriors and the conclusions; a
+long posterior found late thus starts before quick steps queued earlier (BENCHMARKS.md,
 "Twenty-fifth session"). A wrong promise costs time, never a different number.
 
 Every step uses the comparison's seed wherever it runs, so the numbers do not depend on the pool
@@ -117,10 +117,12 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
     in_pool = [not here] * n  # where (2) and (3) of each structure run
     order = itertools.count()
     broken = []  # the pool's failure, once a worker died
-    # On the automatic schedule the steps for the workers wait here until one is free
-    # (``waiting``, by rank); elsewhere they go to the executor as they come.
+    # On the automatic schedule the steps for the workers wait here (``waiting``, by rank)
+    # until fewer than ``cap`` are with the executor: one per worker and one queued ahead,
+    # which a worker starts without waiting for this process to send it (the executor's own
+    # queue is first come, first served); elsewhere they go to the executor as they come.
     waiting = []  # (rank, order, structure index, what, step and its arguments)
-    cap = pool.workers if here else None
+    cap = pool.workers + 1 if here else None
 
     def run_here(i, what, args):
         # Step (1) first; otherwise first come, first run.
@@ -142,7 +144,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
         dispatch()
 
     def dispatch():
-        # Steps go to the workers one per free worker, the first by rank, so that a long
+        # Steps go to the workers as they free up, the first by rank, so that a long
         # posterior found late does not wait behind quick steps queued before it.
         while waiting and (broken or len(live) < cap):
             _, _, i, what, args = heapq.heappop(waiting)

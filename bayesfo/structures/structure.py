@@ -4,6 +4,7 @@ and the scaling between physical units and the scaled problem."""
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -196,14 +197,11 @@ class Structure(Parametrised):
         else:
             plan = _polynomial_plan(terms)
         out = np.zeros((n_sets, plan[0] + 1))
-        if plan[2]:  # coefficients computed or added: arithmetic that may overflow
-            with np.errstate(all="ignore"):
-                for degree, name, t in plan[1]:
-                    out[:, degree] += vals[name] if name is not None else t.coefficient(vals, n_sets)
-            return out
-        for degree, name, _ in plan[1]:
-            # A coefficient that is one parameter (most terms) is its column as it is.
-            out[:, degree] += vals[name]
+        # The floating-point guard only where coefficients are computed or added (arithmetic
+        # that may overflow); a coefficient that is one parameter is its column as it is.
+        with np.errstate(all="ignore") if plan[2] else nullcontext():
+            for degree, name, t in plan[1]:
+                out[:, degree] += vals[name] if name is not None else t.coefficient(vals, n_sets)
         return out
 
     @cached_property
@@ -417,8 +415,10 @@ class Structure(Parametrised):
     @property
     def _passive_by_polynomials(self) -> bool:
         """Commensurate, with dissipation decided from the polynomials
-        (:meth:`_passive_polynomials`)."""
-        return self._first_degree or self._exact_commensurate
+        (:meth:`_passive_polynomials`): always for degree ≤ 1, else where
+        ``passivity.EXACT_COMMENSURATE``."""
+        return self.commensurate_order is not None and (self._first_degree
+                                                        or passivity.EXACT_COMMENSURATE)
 
     def _passive_polynomials(self, den, num, q, theta2) -> np.ndarray:
         """:meth:`passive` of a commensurate structure from its polynomials
@@ -460,13 +460,6 @@ class Structure(Parametrised):
         tempered ladder on batches of tens of rows, where its fixed cost counts."""
         return (tuple(c for c in self.constraints if isinstance(c, Inequality)),
                 frozenset(c for c in self.constraints if isinstance(c, str)))
-
-    @property
-    def _exact_commensurate(self) -> bool:
-        """Commensurate of degree > 1, whose dissipation :meth:`passive` decides with
-        :func:`~bayesfo.structures.passivity.commensurate_passive`."""
-        return (self.commensurate_order is not None and not self._first_degree
-                and passivity.EXACT_COMMENSURATE)
 
     @cached_property
     def _first_degree(self) -> bool:
@@ -511,12 +504,9 @@ class Structure(Parametrised):
             stable = self._stable_polynomials(den, num, q, kind)
             ok[rows] = stable
             if "passive" in names and kind != "generic" and stable.any():
-                if stable.all():
-                    ok[rows] = self._passive_polynomials(den, num, q, kept)
-                else:
-                    keep = np.flatnonzero(stable)
-                    ok[rows[keep]] = self._passive_polynomials(den[keep], num[keep], q[keep],
-                                                               kept[keep])
+                keep = np.flatnonzero(stable)
+                ok[rows[keep]] = self._passive_polynomials(den[keep], num[keep], q[keep],
+                                                           kept[keep])
             return ok
         if "stable" in names and ok.any():
             rows = np.flatnonzero(ok)

@@ -18,9 +18,13 @@ from .data.frequency_response import KINDS  # noqa: F401  (the kinds an option m
 from .errors import InputError
 
 DEFAULT_STRUCTURES = "voigt,zener,maxwell,fractional_kelvin_voigt,voigt-int,zener-int,maxwell-int"
-#: Structures that get their own corner (and trace) figures by default: the leading ones by the
-#: ranking (the combined figures show every structure).
-STRUCTURE_FIGURES = 3
+#: Which structures get their own corner (and trace) figures by default: the leading ones (the
+#: combined figures show every structure). Besides it, a number (the best that many by the
+#: ranking) or None (every structure).
+LEADING = "leading"
+STRUCTURE_FIGURES = LEADING
+#: Of the structures that the evidence does not rule out, at most this many lead.
+LEADING_STRUCTURES = 3
 
 
 def parse_floats(text: str, option: str) -> list[float]:
@@ -71,7 +75,7 @@ DEFAULT_OPTIONS = {
     "models": (),            # extra structure cards (paths)
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
     "figure_formats": ("png",),  # their file formats
-    "structure_figures": STRUCTURE_FIGURES,  # structures with corner (trace) figures; None: all
+    "structure_figures": STRUCTURE_FIGURES,  # corner (trace) figures: "leading", N best, None: all
 }
 
 #: Options added after batch directories were first written: a data set's record leaves them
@@ -83,6 +87,18 @@ SAMPLERS = ("auto", "emcee")
 
 
 NOISE_MODELS = ("auto", "known", "constant", "proportional", "relative_parts")
+
+
+#: What ``structure_figures`` takes, for the messages that refuse another value.
+STRUCTURE_FIGURES_TAKES = (f"'{LEADING}', a non-negative integer (the best that many) or None "
+                           "(every structure)")
+
+
+def structure_figures_ok(value) -> bool:
+    """Whether ``value`` is a ``structure_figures`` option: :data:`LEADING`, a non-negative
+    integer or None."""
+    return value is None or value == LEADING or (
+        isinstance(value, int) and not isinstance(value, bool) and value >= 0)
 
 
 def figure_format_names(formats, argument: str) -> tuple[str, ...]:
@@ -162,10 +178,9 @@ def check_options(options: dict, where: str) -> dict:
     # command line before any work): this layer does not import the plotting.
     formats = (figure_format_names(opts["figure_formats"], f"{where}: figure_formats")
                if opts["figures"] else DEFAULT_OPTIONS["figure_formats"])
-    if detail is not None and (isinstance(detail, bool) or not isinstance(detail, int)
-                               or detail < 0):
-        raise InputError(f"{where}: structure_figures must be a non-negative integer or None "
-                         f"(every structure), got {detail!r}")
+    if not structure_figures_ok(detail):
+        raise InputError(f"{where}: structure_figures must be {STRUCTURE_FIGURES_TAKES}, got "
+                         f"{detail!r}")
     holdout = opts["holdout"]
     if holdout is not None:
         holdout = tuple(float(w) for w in holdout)

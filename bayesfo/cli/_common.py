@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from ..comparison.table import VERY_STRONG
 from ..errors import InputError
 from ..options import (
     DEFAULT_STRUCTURES,
     EVIDENCE_ROUTES,
     KINDS,
+    LEADING,
+    LEADING_STRUCTURES,
     NOISE_MODELS,
     SAMPLERS,
     STRUCTURE_FIGURES,
@@ -115,20 +118,24 @@ def add_figure_options(p, each: str = ""):
                    help=f"file formats of the figures{each} (default png, which report.html "
                         "embeds; png,pdf adds vector figures for publication, at about twice "
                         "the time)")
-    p.add_argument("--structure-figures", default=str(STRUCTURE_FIGURES), metavar="N|all",
-                   help=f"how many structures{each}, the best by the ranking, get corner "
-                        "figures (and trace figures of walkers or ladder runs) (default "
-                        f"{STRUCTURE_FIGURES}; 'all' for every one; fewer is faster)")
+    p.add_argument("--structure-figures", default=STRUCTURE_FIGURES, metavar="leading|N|all",
+                   help=f"which structures{each} get corner figures (and trace figures of "
+                        f"walkers or ladder runs): {LEADING} (default: of the best "
+                        f"{LEADING_STRUCTURES}, those the evidence does not rule out, ln Z "
+                        f"within {VERY_STRONG:g} of the best, and each structure an information "
+                        "criterion ranks first), N (the best N by the ranking; fewer is "
+                        "faster) or all")
 
 
-def figure_options(args) -> tuple[tuple[str, ...] | None, int | None]:
-    """The figure formats (None with ``--no-figures``) and how many structures get their own
-    figures (None: every one) of the command line, checked before any work."""
+def figure_options(args) -> tuple[tuple[str, ...] | None, int | str | None]:
+    """The figure formats (None with ``--no-figures``) and which structures get their own
+    figures (``"leading"``, a number, or None: every one) of the command line, checked before
+    any work."""
     text = args.structure_figures.strip().lower()
-    if text != "all" and not text.isdigit():
-        raise InputError(f"--structure-figures takes a number of structures or 'all', got "
-                         f"{args.structure_figures!r}")
-    detail = None if text == "all" else int(text)
+    if text not in ("all", LEADING) and not text.isdigit():
+        raise InputError(f"--structure-figures takes '{LEADING}', a number of structures or "
+                         f"'all', got {args.structure_figures!r}")
+    detail = None if text == "all" else text if text == LEADING else int(text)
     if args.no_figures:
         return None, detail
     from ..plotting.output import check_formats

@@ -16,6 +16,12 @@ from .parameters import flagged_names, natural_block, physical_text
 ORDER_PARAMS = ("q", "beta", "alpha")
 #: The symbols in text of every parameter that is a fractional order (the cards' exponents).
 ORDER_SYMBOLS = {"q": "q", "alpha": "α", "beta": "β", "delta": "δ", "kappa": "κ", "gamma": "γ"}
+#: ln B from which the evidence for one structure over another is "very strong" (Kass & Raftery
+#: 1995: 2 ln B above 10): a structure that far below the best is ruled out.
+VERY_STRONG = 5.0
+#: The criteria besides the evidence that the verdict and the figures name (elpd: higher is
+#: better; AIC, BIC: lower), as the attributes of :class:`~bayesfo.comparison.Criteria`.
+CRITERIA = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
 
 
 def order_parameter(parameters) -> str | None:

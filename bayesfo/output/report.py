@@ -479,6 +479,19 @@ def _figures_section(figures: dict, comparison=None, captions: dict | None = Non
     return "".join(parts)
 
 
+def _without_corner(figures: dict, comparison) -> str:
+    """A note naming the structures that have no corner figure among ``figures``, if any."""
+    from ..plotting.captions import file_stem
+
+    missing = [n for n in comparison.ranking if f"corner_{file_stem(n)}" not in figures]
+    if not missing:
+        return ""
+    return (f"<p class='small'>No corner figure of {_e(', '.join(missing))}: by default only "
+            "the leading structures get one (of the best three, those the evidence does not "
+            "rule out, and each structure an information criterion ranks first); "
+            "<code>--structure-figures all</code> draws every one.</p>")
+
+
 def render_report(comparison, figures: dict | None = None) -> str:
     """The report of a comparison as one self-contained HTML document.
 
@@ -518,7 +531,8 @@ def render_report(comparison, figures: dict | None = None) -> str:
         f"<h2 id='ranking'>Ranking</h2>{_ranking_table(comparison)}{_families(comparison)}",
     ]
     if figures:
-        sections.append(f"<h2 id='figures'>Figures</h2>{_figures_section(figures, comparison)}")
+        sections.append(f"<h2 id='figures'>Figures</h2>{_figures_section(figures, comparison)}"
+                        f"{_without_corner(figures, comparison)}")
     sections += [
         f"<h2 id='parameters'>Parameters</h2>{_parameters_section(comparison)}",
         f"<h2 id='priors'>Priors</h2>{_priors_section(comparison)}",

@@ -18,13 +18,13 @@ from __future__ import annotations
 import math
 
 from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names, shown_hdi
-from ..comparison.table import ORDER_SYMBOLS
+from ..comparison.table import CRITERIA, ORDER_SYMBOLS, VERY_STRONG
 from ..data.symbols import in_symbol, parameter_label
 
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
 EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
-                  (5.0, "strong"), (math.inf, "very strong"))
-CRITERIA_NAMES = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
+                  (VERY_STRONG, "strong"), (math.inf, "very strong"))
+CRITERIA_NAMES = CRITERIA
 HDI_PERCENT = 94
 
 def _finite(x) -> bool:

@@ -126,7 +126,7 @@ def preload(formats=()) -> None:
 
 def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
                   formats=("png",), pool=None, figure_processes: int = 1,
-                  structure_figures: int | None = STRUCTURE_FIGURES) -> dict[str, Path]:
+                  structure_figures: int | str | None = STRUCTURE_FIGURES) -> dict[str, Path]:
     """Write everything a comparison produced into ``out_dir``.
 
     One NetCDF per structure (an ArviZ DataTree with the attributes that :func:`load` needs,
@@ -158,9 +158,10 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
         Without a pool (or with a lazy pool not started): 2 draws the figures in this process
         and in one forked from it, which starts drawing while this one writes the NetCDF files
         (:func:`bayesfo.plotting.output.draw_forked`); 1 draws them here.
-    structure_figures : int or None
-        How many structures (the best by the ranking) get corner (and trace) figures (every one
-        for None).
+    structure_figures : "leading", int or None
+        Which structures get corner (and trace) figures: the leading ones (the default; see
+        :func:`bayesfo.plotting.output.leading`), the best that many by the ranking, or every
+        one (None).
 
     Returns
     -------

@@ -2,13 +2,22 @@
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 import warnings
 from pathlib import Path
 
+from ..comparison.table import CRITERIA, VERY_STRONG
 from ..errors import InputError
-from ..options import STRUCTURE_FIGURES, figure_format_names
+from ..options import (
+    LEADING,
+    LEADING_STRUCTURES,
+    STRUCTURE_FIGURES,
+    STRUCTURE_FIGURES_TAKES,
+    figure_format_names,
+    structure_figures_ok,
+)
 from ._compute import ok_results, order_parameter
 from .captions import file_stem
 from .material import plot_time_functions
@@ -110,24 +119,46 @@ def _structure_makers(result, color) -> dict:
 
 
 
-def _detailed(comparison, structure_figures) -> list:
-    """The structures that get their own figures: the best ``structure_figures`` (all for
-    None)."""
+def leading(comparison) -> list:
+    """The leading structures, in the order of the ranking: of the best
+    :data:`~bayesfo.options.LEADING_STRUCTURES`, those that the evidence does not rule out (ln Z
+    less than :data:`~bayesfo.comparison.table.VERY_STRONG` below the best: the best always,
+    and any without a ln Z), and every structure that PSIS-LOO, WAIC, AIC or BIC ranks first."""
     ranked = ok_results(comparison)
-    if structure_figures is None:
-        return ranked
-    if isinstance(structure_figures, bool) or not isinstance(structure_figures, int) \
-            or structure_figures < 0:
-        raise InputError("argument 'structure_figures' must be a non-negative integer or None "
-                         f"(every structure), got {structure_figures!r}")
-    return ranked[:structure_figures]
+    if not ranked:
+        return []
+    best = ranked[0].log_z
+    keep = {ranked[0].name}
+    for r in ranked[1:LEADING_STRUCTURES]:
+        z = r.log_z
+        if best is None or z is None or not best - z >= VERY_STRONG:
+            keep.add(r.name)
+    for criterion in CRITERIA:
+        sign = 1.0 if criterion in ("loo", "waic") else -1.0
+        scores = [(sign * v, r.name) for r in ranked
+                  if (v := getattr(r.criteria, criterion)) is not None and math.isfinite(v)]
+        if scores:
+            keep.add(max(scores, key=lambda t: t[0])[1])
+    return [r for r in ranked if r.name in keep]
+
+
+def _detailed(comparison, structure_figures) -> list:
+    """The structures that get their own figures: the leading ones (:data:`LEADING`, see
+    :func:`leading`), the best ``structure_figures`` (a number) or all (None)."""
+    if not structure_figures_ok(structure_figures):
+        raise InputError(f"argument 'structure_figures' must be {STRUCTURE_FIGURES_TAKES}, got "
+                         f"{structure_figures!r}")
+    if structure_figures == LEADING:
+        return leading(comparison)
+    ranked = ok_results(comparison)
+    return ranked if structure_figures is None else ranked[:structure_figures]
 
 
 def figure_jobs(comparison, *, seed: int = 0,
-                structure_figures: int | None = STRUCTURE_FIGURES) -> list[tuple[str, object]]:
+                structure_figures: int | str | None = STRUCTURE_FIGURES) -> list[tuple[str, object]]:
     """``(name, make)`` for every figure of a comparison, ``make()`` returning a
-    :class:`~bayesfo.plotting.Drawn`; structures that failed are left out, and only the best
-    ``structure_figures`` structures (all for None) get corner figures, and trace figures
+    :class:`~bayesfo.plotting.Drawn`; structures that failed are left out, and only the
+    structures of ``structure_figures`` (see :func:`write_figures`) get corner figures, and trace figures
     where :func:`has_trace`."""
     jobs = list(_combined_makers(comparison, seed).items())
     styles = comparison_styles(comparison)
@@ -175,13 +206,13 @@ def _draw_in_worker(task: tuple, out_dir: Path, formats, seed: int) -> dict[str,
 
 def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=None,
                   processes: int = 1, meanwhile=None,
-                  structure_figures: int | None = STRUCTURE_FIGURES) -> dict[str, list[Path]]:
+                  structure_figures: int | str | None = STRUCTURE_FIGURES) -> dict[str, list[Path]]:
     """Draw every figure of a comparison and write each in every format.
 
     Figures: ``ranking``, ``bode``, ``moduli`` (modulus or compliance data), ``nyquist``,
     ``residuals``, ``q_posteriors`` (when some structure has a free fractional order), and
-    ``corner_<structure>`` for the best ``structure_figures`` structures by the ranking (every
-    one for None; structures with ``error`` are skipped), with ``trace_<structure>`` where the
+    ``corner_<structure>`` for the structures of ``structure_figures`` (by default the leading
+    ones; structures with ``error`` are skipped), with ``trace_<structure>`` where the
     posterior has walkers or ladder runs to show (:func:`has_trace`; not for draws resampled
     from importance weights).
     Each file is written through a temporary file and a rename
@@ -211,8 +242,11 @@ def write_figures(comparison, out_dir, formats=("png",), *, seed: int = 0, pool=
     meanwhile : callable, optional
         Called once in this process before it draws (with two processes or a pool: while the
         forked process or the workers already draw), e.g. to write other files.
-    structure_figures : int or None
-        How many structures (the best by the ranking) get corner (and trace) figures.
+    structure_figures : "leading", int or None
+        Which structures get corner (and trace) figures: the leading ones (:func:`leading`:
+        of the best three, those the evidence does not rule out, and each structure that an
+        information criterion ranks first), the best that many by the ranking, or every one
+        (None).
 
     Returns
     -------
@@ -394,7 +428,7 @@ def _load_before_fork(formats) -> None:
 
 
 def draw_forked(comparison, out_dir, formats=("png",), *, seed: int = 0,
-                meanwhile=None, structure_figures: int | None = STRUCTURE_FIGURES
+                meanwhile=None, structure_figures: int | str | None = STRUCTURE_FIGURES
                 ) -> dict[str, list[Path]]:
     """Draw every figure of a comparison in this process and in one forked from it.
 

@@ -459,7 +459,7 @@ def test_figure_options_reach_each_data_set_and_defaults_keep_earlier_records(tm
     assert seen[1] == {"formats": ("png",), "structure_figures": None}
     default = expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt"})[0]
     assert default.options["figure_formats"] == ("png",)
-    assert default.options["structure_figures"] == 3
+    assert default.options["structure_figures"] == "leading"
     record = default.fingerprint()["options"]
     assert "figure_formats" not in record and "structure_figures" not in record
     fewer = expand_inputs([tmp_path / "a.csv"], options={"structures": "voigt",
@@ -471,12 +471,14 @@ def test_figure_options_reach_each_data_set_and_defaults_keep_earlier_records(tm
     status, _, err = _run_cli(capsys, "batch", tmp_path / "a.csv", "--out", tmp_path / "o3",
                               "--structure-figures", "some")
     assert status == 2
-    assert "--structure-figures takes a number of structures or 'all', got 'some'" in err
+    assert ("--structure-figures takes 'leading', a number of structures or 'all', got 'some'"
+            in err)
     with pytest.raises(InputError, match="figure_formats is empty"):
         expand_inputs([tmp_path / "a.csv"], options={"figure_formats": ()})
     with pytest.raises(InputError, match="figure_formats must be a sequence of file formats"):
         expand_inputs([tmp_path / "a.csv"], options={"figure_formats": 5})
-    with pytest.raises(InputError, match="structure_figures must be a non-negative integer"):
+    with pytest.raises(InputError, match="structure_figures must be 'leading', a non-negative "
+                                         "integer"):
         expand_inputs([tmp_path / "a.csv"], options={"structure_figures": -1})
     assert not (tmp_path / "o3").exists()
 

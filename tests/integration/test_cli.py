@@ -163,11 +163,12 @@ def test_figure_formats_png_alone(run_cli, tmp_path):
     assert (out / "report.html").read_text().count("data:image/png;base64,") == len(names)
 
 
-def test_structure_figures_takes_a_number_or_all(run_cli, tmp_path):
+def test_structure_figures_takes_leading_a_number_or_all(run_cli, tmp_path):
     status, _, err = run_cli("compare", ADHESIVE, "--structures", "voigt", "--out",
                              tmp_path / "x", "--structure-figures", "some")
     assert status == 2
-    assert "--structure-figures takes a number of structures or 'all', got 'some'" in err
+    assert ("--structure-figures takes 'leading', a number of structures or 'all', got 'some'"
+            in err)
     assert not (tmp_path / "x").exists()
 
 

@@ -476,7 +476,7 @@ def test_write_figures_skips_failed_structures_and_closes_figures(comparison, tm
     failed = StructureResult(get_structure("maxwell"), error="could not be run (test)")
     with_failure = replace(comparison, results=comparison.results + (failed,))
     before = plt.get_fignums()
-    written = write_figures(with_failure, tmp_path, formats=("png",))
+    written = write_figures(with_failure, tmp_path, formats=("png",), structure_figures=None)
     assert plt.get_fignums() == before
     expected = ["ranking", "bode", "moduli", "time_functions", "nyquist", "residuals",
                 "q_posteriors"]
@@ -692,7 +692,15 @@ def test_only_the_leading_structures_get_corner_and_trace_figures(comparison, tm
     every = write_figures(comparison, tmp_path / "all", structure_figures=None)
     assert {n for n in every if n.startswith("corner_")} == {
         f"corner_{n}" for n in comparison.ranking}
-    with pytest.raises(InputError, match="'structure_figures' must be a non-negative integer"):
+    # By default, the leading structures, from the ranking table's columns: of the best three,
+    # those within 5 of the best ln Z, and each that a criterion ranks first.
+    rows = [r for r in comparison.table() if r["rank"] is not None]
+    expected = [r["structure"] for r in rows
+                if (r["rank"] <= 3 and r["delta_log_evidence"] > -5)
+                or 1 in (r["rank_loo"], r["rank_waic"], r["rank_aic"], r["rank_bic"])]
+    default = write_figures(comparison, tmp_path / "default")
+    assert [n for n in default if n.startswith("corner_")] == [f"corner_{n}" for n in expected]
+    with pytest.raises(InputError, match="'structure_figures' must be 'leading', a non-negative"):
         write_figures(comparison, tmp_path / "bad", structure_figures=-1)
     assert not (tmp_path / "bad").exists() or not list((tmp_path / "bad").iterdir())
 

@@ -262,14 +262,30 @@ class LazyPool:
     comparison that has none never starts a process. Use it through :func:`lazy_process_pool`.
     """
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, prepare=None):
         self.workers = workers
         self._pool = None
+        self._prepare = prepare
 
     @property
     def started(self) -> bool:
         """Whether the worker processes have been started."""
         return self._pool is not None
+
+    @property
+    def prepared(self) -> bool:
+        """Whether the pool's preparation (``prepare`` of :func:`lazy_process_pool`) has run,
+        or there is none."""
+        return self._prepare is None
+
+    def prepare(self) -> None:
+        """Run the pool's preparation now if it has not run: e.g. the imports that the
+        workers, forked from this process, then share. The schedule calls it once it has
+        started what needs no libraries (:mod:`bayesfo.comparison.early`); :meth:`start`
+        calls it at the latest."""
+        if self._prepare is not None:
+            prepare, self._prepare = self._prepare, None
+            prepare()
 
     def start(self):
         """The pool, started now if it was not (inside :func:`worker_environment`); its
@@ -277,6 +293,7 @@ class LazyPool:
         the pool lives within the block of :func:`lazy_process_pool`, and is started at its
         first task, after which the executor starts its manager thread)."""
         if self._pool is None:
+            self.prepare()
             self._pool = new_pool(self.workers, fork=True)
         return self._pool
 
@@ -294,14 +311,16 @@ class LazyPool:
 
 
 @contextmanager
-def lazy_process_pool(workers: int = 0):
+def lazy_process_pool(workers: int = 0, prepare=None):
     """A :class:`LazyPool` of ``workers`` processes (0: one per CPU): none is started until a
-    task is submitted. Like :func:`process_pool`, its workers are ended at once if the block
-    raises (Ctrl-C included)."""
+    task is submitted. ``prepare`` (optional, called once in this process before any process
+    is forked, see :meth:`LazyPool.prepare`) is e.g. the import of the libraries the workers
+    share. Like :func:`process_pool`, its workers are ended at once if the block raises
+    (Ctrl-C included)."""
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
         raise InputError(f"workers must be a non-negative integer, got {workers!r}")
     with worker_environment():
-        lazy = LazyPool(workers or available_cpus())
+        lazy = LazyPool(workers or available_cpus(), prepare)
         try:
             yield lazy
         except BaseException:
@@ -336,11 +355,13 @@ def runs_here(pool) -> bool:
 
 
 @contextmanager
-def executor(workers: int, n_tasks: int | None = None):
+def executor(workers: int, n_tasks: int | None = None, prepare=None):
     """The executor of a job that asks for ``workers`` processes: 0, the automatic choice (a
     :class:`LazyPool` of one process per CPU, started only when a task needs it); 1 (or a job of
     one task), this process (:class:`InlineExecutor`); more, a :func:`process_pool` of that many
-    processes, at most one per task.
+    processes, at most one per task. ``prepare`` (optional) is called once in this process
+    before any task runs or process starts: by the :class:`LazyPool` when its user says
+    (:meth:`LazyPool.prepare`), else at once.
 
     Yields
     ------
@@ -350,9 +371,12 @@ def executor(workers: int, n_tasks: int | None = None):
         raise InputError(f"workers must be a non-negative integer, got {workers!r}")
     n = min(workers or available_cpus(), n_tasks or available_cpus())
     if workers == 0:
-        with lazy_process_pool(n) as pool:
+        with lazy_process_pool(n, prepare) as pool:
             yield pool
-    elif n <= 1:
+        return
+    if prepare is not None:
+        prepare()
+    if n <= 1:
         yield InlineExecutor()
     else:
         with process_pool(n) as pool:

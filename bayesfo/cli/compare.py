@@ -54,12 +54,17 @@ def _compare(data, structures, out, workers, formats, no_figures, options):
     from ..comparison import compare
     from ..output import write_outputs
     from ..parallel import InlineExecutor, cpu_times, executor, figure_processes
+    from ._libraries import load_libraries
 
     figures = {} if formats is None else {"formats": formats,
                                           "structure_figures": options.pop("structure_figures")}
     options.pop("structure_figures", None)
     start = cpu_times()
-    with executor(workers, len(structures)) as pool:
+    # The libraries are loaded before any process is forked from this one, so that the
+    # workers share them: with the automatic choice, once the comparison has begun the
+    # optimisations, which need none of them (bayesfo.comparison.early).
+    with executor(workers, len(structures),
+                  prepare=lambda: load_libraries(formats or ())) as pool:
         result = compare(data, structures, pool=pool, **options)
         inline = isinstance(pool, InlineExecutor)
         extra = {} if workers != 0 or no_figures else {"figure_processes":
@@ -130,7 +135,6 @@ def run(args) -> int:
     from ..comparison.table import ranking_lines
     from ..outdir import check_output_directory
     from ..structures import resolve_structures
-    from ._libraries import load_libraries
 
     data = read_data(args)
     structures = resolve_structures(args.structures, library(args))
@@ -159,7 +163,6 @@ def run(args) -> int:
     # batch's summary shows its own result. Nothing outside --out is touched.
     batch_of = (out.parent if (out / "batch.json").is_file()
                 and (out.parent / "batch_summary.csv").is_file() else None)
-    load_libraries(formats or ())
     try:
         result = _compare(data, structures, out, args.workers, formats, args.no_figures,
                           options)

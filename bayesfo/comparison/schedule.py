@@ -35,7 +35,10 @@ while the workers are busy, nor leaves a CPU idle while this process works alone
 they free up (one queued ahead), the longest first: a posterior without the promise, then the
 fits (which find the other long posteriors), then the quick posteriors and the conclusions; a
 long posterior found late thus starts before quick steps queued earlier (BENCHMARKS.md,
-"Twenty-fifth session"). A wrong promise costs time, never a different number.
+"Twenty-fifth session"). A wrong promise costs time, never a different number. Where the
+pool has a preparation still to run (:meth:`~bayesfo.parallel.LazyPool.prepare`: the command
+loads the libraries then), the optimisations begin first, in a process forked from this one
+(:mod:`.early`), and each step (1) takes its optimum from there once it has come.
 
 Every step uses the comparison's seed wherever it runs, so the numbers do not depend on the pool
 or the worker count. A worker process that dies (killed, out of memory) breaks the pool: its
@@ -58,6 +61,7 @@ from concurrent.futures.process import BrokenProcessPool
 from ..errors import InputError
 from ..inference._arviz import preload
 from ..parallel import settle_worker
+from .early import EarlyFits
 from .results import StructureResult
 from .steps import conclude, fit_and_probe, fit_and_screen, kept, sample_held
 
@@ -123,6 +127,22 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
     # queue is first come, first served); elsewhere they go to the executor as they come.
     waiting = []  # (rank, order, structure index, what, step and its arguments)
     cap = pool.workers + 1 if here else None
+    # Larger structures first (they take longest); results keep the order given.
+    first = sorted(range(n), key=lambda i: -structures[i].n_params)
+    early = None
+    if here and not getattr(pool, "prepared", True):
+        # The optimisations begin in a process forked before this one loads the libraries
+        # that the pool's workers share (LazyPool.prepare).
+        early = EarlyFits.start([structures[i] for i in first], data, options)
+        pool.prepare()
+
+    def with_fit(i, args, *, wait):
+        # Step (1) with the optimum of the early process where it has come; when a worker
+        # would wait for it, the workers have overtaken that process, which is then ended.
+        fitted = early.take(structures[i].name, wait=wait)
+        if fitted is None and not wait:
+            early.stop()
+        return args if fitted is None else (*args, fitted)
 
     def run_here(i, what, args):
         # Step (1) first; otherwise first come, first run.
@@ -156,6 +176,8 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 send(i, what, args)
 
     def send(i, what, args):
+        if what == "first" and early is not None:
+            args = with_fit(i, args, wait=False)
         try:
             future = pool.submit(_task, *args)
         except BrokenProcessPool as exc:
@@ -226,8 +248,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
         done(i, what, *value)
 
     try:
-        # Larger structures first (they take longest); results keep the order given.
-        for i in sorted(range(n), key=lambda i: -structures[i].n_params):
+        for i in first:
             if here:
                 submit(i, "first", fit_and_probe, structures[i], data, options)
             else:
@@ -245,6 +266,8 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                     if pool_open():  # queued here before the workers started
                         submit(i, what, *args)
                     else:
+                        if what == "first" and early is not None:
+                            args = with_fit(i, args, wait=True)
                         done(i, what, *_task(*args))
             elif live:
                 collect(finished.get())
@@ -252,4 +275,7 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
         for future in live:
             future.cancel()
         raise
+    finally:
+        if early is not None:
+            early.stop()
     return outcomes

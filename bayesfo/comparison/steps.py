@@ -314,7 +314,7 @@ def fit_and_screen(s: Structure, data: FrequencyResponse, options: RunOptions):
     return fit, screened, [n for n in candidates if screened is None or n == screened.leader]
 
 
-def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions):
+def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions, fitted=None):
     """Step 1 as :func:`fit_and_screen`, and whether the rest promises to be quick: the
     screen's raw importance weights of every noise model still to sample have a Pareto k̂ below
     :data:`~bayesfo.inference.importance.K_HAT_MAX` and leave no order undetermined, so that
@@ -322,8 +322,15 @@ def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions):
     neither the ladder nor emcee will run. Returns ((fit, screened, noise models), quick).
     The numbers and the warnings are those of :func:`fit_and_screen`: the estimates that the
     screen does not make itself are made with their warnings discarded, and they only guide
-    where the next steps run."""
-    candidates, fit = _fit(s, data, options)
+    where the next steps run. ``fitted``: the optimisation already made elsewhere, as
+    :meth:`~bayesfo.comparison.early.EarlyFits.take` gives it (its warnings are issued
+    here)."""
+    if fitted is None:
+        candidates, fit = _fit(s, data, options)
+    else:
+        candidates, fit, caught = fitted
+        for category, message in caught:
+            warnings.warn(message, category, stacklevel=2)
     quick = (_quick_estimates(s, data, candidates, fit, options)
              if len(candidates) > 1 and fit.optima.size else {})
     screened = screen(s, data, candidates, fit, options, quick=quick)

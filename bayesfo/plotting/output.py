@@ -66,12 +66,19 @@ def save_figure(fig, path, *, close: bool = False) -> None:
 _file_stem = file_stem
 
 
+#: Formats that matplotlib's own backends (Agg, PDF, SVG, PostScript) always write: these are
+#: checked without importing matplotlib, which the command loads later, beside other work.
+ALWAYS_WRITTEN = frozenset({"png", "pdf", "svg", "eps", "ps"})
+
+
 def check_formats(formats, argument: str = "argument 'formats'") -> tuple[str, ...]:
     """Figure file formats, lower case without dots, each once; :class:`InputError` naming
     ``argument`` when none is given or matplotlib cannot write one."""
+    formats = figure_format_names(formats, argument)
+    if ALWAYS_WRITTEN.issuperset(formats):
+        return formats
     from matplotlib.backend_bases import FigureCanvasBase
 
-    formats = figure_format_names(formats, argument)
     supported = FigureCanvasBase.get_supported_filetypes()
     bad = [f for f in formats if f not in supported]
     if bad:

@@ -276,15 +276,15 @@ def test_a_command_freezes_the_libraries_out_of_the_collector_while_it_runs(run_
     when main returns, a caller in the same process has its collector back as it was."""
     import gc
 
-    from bayesfo.cli import compare as compare_command
+    import bayesfo.comparison.steps as steps
 
-    frozen, real = [], compare_command._compare
+    frozen, real = [], steps.sample
 
-    def spy(*args, **kwargs):
+    def spy(*args, **kwargs):  # a posterior: the libraries are loaded by then
         frozen.append(gc.get_freeze_count())
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(compare_command, "_compare", spy)
+    monkeypatch.setattr(steps, "sample", spy)
     assert gc.get_freeze_count() == 0
     status, _, err = run_cli("compare", ADHESIVE, "--structures", "voigt", "--out",
                              tmp_path / "out", "--no-figures", "--quiet")

@@ -181,8 +181,8 @@ def _no_promise_for(monkeypatch, name: str) -> None:
     pool); the step is recorded as ``pessimistic``."""
     probe = schedule.fit_and_probe
 
-    def pessimistic(s, data, options):
-        prepared, quick = probe(s, data, options)
+    def pessimistic(s, data, options, *fitted):
+        prepared, quick = probe(s, data, options, *fitted)
         return prepared, quick and s.name != name
 
     monkeypatch.setattr(schedule, "fit_and_probe", pessimistic)
@@ -506,3 +506,74 @@ def test_a_spawned_worker_settles_at_its_first_step():
             pool.shutdown(wait=True)
     assert before == (0, False)
     assert after[1] and after[0] > 50_000  # numpy, scipy, xarray, ArviZ
+
+
+class _Taken(schedule.EarlyFits):
+    """EarlyFits that records what the schedule took: (structure, waited, got an optimum)."""
+
+    taken: list = []
+
+    def take(self, name, *, wait):
+        fitted = super().take(name, wait=wait)
+        self.taken.append((name, wait, fitted is not None))
+        return fitted
+
+
+@pytest.fixture
+def early_fits(monkeypatch):
+    """The schedule's early optimisations recorded (:class:`_Taken`); every optimisation warns
+    which structure it fitted, wherever it runs."""
+    import bayesfo.comparison.early as early
+
+    fit = steps._fit
+
+    def warning_fit(s, data, options):
+        warnings.warn(f"{s.name}: optimised", UserWarning, stacklevel=1)
+        return fit(s, data, options)
+
+    monkeypatch.setattr(steps, "_fit", warning_fit)
+    monkeypatch.setattr(early, "_fit", warning_fit)
+    monkeypatch.setattr(schedule, "EarlyFits", _Taken)
+    monkeypatch.setattr(_Taken, "taken", [])
+    return _Taken.taken
+
+
+def test_the_optimisations_begin_in_a_process_forked_before_the_libraries_load(early_fits):
+    """With a pool to prepare (the command's: the libraries load then), the optimisations run
+    in a forked process meanwhile; the structures take them from it, with the numbers and
+    warnings (the optimisations' included) of the serial path."""
+    serial, caught_serial = _compare(workers=1)
+    assert early_fits == []  # the serial path forks nothing
+    assert (UserWarning, "zener-int: optimised") in caught_serial
+    prepared = []
+    with lazy_process_pool(2, prepare=lambda: prepared.append(len(early_fits))) as pool:
+        auto, caught_auto = _compare(pool=pool)
+        assert not pool.started
+    assert prepared == [0]  # once, before any structure was taken up
+    assert early_fits == [("zener-int", True, True), ("maxwell-int", True, True)]
+    assert _numbers(serial.results) == _numbers(auto.results)
+    assert json.dumps(serial.to_summary(), sort_keys=True, default=str) == \
+        json.dumps(auto.to_summary(), sort_keys=True, default=str)
+    assert caught_serial == caught_auto
+
+
+def test_workers_that_overtake_the_early_optimisations_end_them(monkeypatch, early_fits):
+    """Once the workers have started, a structure whose optimum has not come is optimised by
+    the worker, and the early process (here stuck on it) is ended: same numbers."""
+    import time
+
+    import bayesfo.comparison.early as early
+
+    fit = early._fit
+
+    def stuck(s, data, options):
+        if s.name == "maxwell-int":
+            time.sleep(120)
+        return fit(s, data, options)
+
+    monkeypatch.setattr(early, "_fit", stuck)
+    _no_promise_for(monkeypatch, "zener-int")
+    pool = _StartingRecorder()
+    pool._prepare = lambda: None
+    assert _steps_in_pool(pool)[2] == ("pessimistic", "maxwell-int", None)
+    assert early_fits == [("zener-int", True, True), ("maxwell-int", False, False)]

@@ -76,3 +76,16 @@ def test_a_run_whose_figures_meet_a_full_disk_ends_with_one_line(full_disk, tmp_
         with staged_run(out) as new:
             save_figure(_figure(), new / "figures" / "bode.pdf", close=True)
     assert not out.exists()  # a first run that fails leaves no directory behind
+
+
+def test_the_formats_checked_without_matplotlib_are_ones_it_writes():
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    from bayesfo.errors import InputError
+    from bayesfo.plotting.output import ALWAYS_WRITTEN, check_formats
+
+    assert ALWAYS_WRITTEN <= set(FigureCanvasBase.get_supported_filetypes())
+    assert check_formats(["PNG", ".pdf", "png"]) == ("png", "pdf")
+    assert check_formats(["png", "webp"]) == ("png", "webp")  # asks matplotlib
+    with pytest.raises(InputError, match="cannot write 'bmpx' figures; use one of .*png"):
+        check_formats(["png", "bmpx"])

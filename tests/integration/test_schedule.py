@@ -5,6 +5,7 @@ path."""
 from __future__ import annotations
 
 import json
+import os
 import warnings
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
@@ -519,61 +520,83 @@ class _Taken(schedule.EarlyFits):
         return fitted
 
 
-@pytest.fixture
-def early_fits(monkeypatch):
-    """The schedule's early optimisations recorded (:class:`_Taken`); every optimisation warns
-    which structure it fitted, wherever it runs."""
-    import bayesfo.comparison.early as early
-
-    fit = steps._fit
-
-    def warning_fit(s, data, options):
-        warnings.warn(f"{s.name}: optimised", UserWarning, stacklevel=1)
-        return fit(s, data, options)
-
-    monkeypatch.setattr(steps, "_fit", warning_fit)
-    monkeypatch.setattr(early, "_fit", warning_fit)
-    monkeypatch.setattr(schedule, "EarlyFits", _Taken)
-    monkeypatch.setattr(_Taken, "taken", [])
-    return _Taken.taken
-
-
-def test_the_optimisations_begin_in_a_process_forked_before_the_libraries_load(early_fits):
-    """With a pool to prepare (the command's: the libraries load then), the optimisations run
-    in a forked process meanwhile; the structures take them from it, with the numbers and
-    warnings (the optimisations' included) of the serial path."""
-    serial, caught_serial = _compare(workers=1)
-    assert early_fits == []  # the serial path forks nothing
-    assert (UserWarning, "zener-int: optimised") in caught_serial
-    prepared = []
-    with lazy_process_pool(2, prepare=lambda: prepared.append(len(early_fits))) as pool:
-        auto, caught_auto = _compare(pool=pool)
-        assert not pool.started
-    assert prepared == [0]  # once, before any structure was taken up
-    assert early_fits == [("zener-int", True, True), ("maxwell-int", True, True)]
-    assert _numbers(serial.results) == _numbers(auto.results)
-    assert json.dumps(serial.to_summary(), sort_keys=True, default=str) == \
-        json.dumps(auto.to_summary(), sort_keys=True, default=str)
-    assert caught_serial == caught_auto
-
-
-def test_workers_that_overtake_the_early_optimisations_end_them(monkeypatch, early_fits):
-    """Once the workers have started, a structure whose optimum has not come is optimised by
-    the worker, and the early process (here stuck on it) is ended: same numbers."""
+def _early_fits(overtaken: bool):
+    """In a fresh process (no thread left by other tests, so that forking is safe): the
+    comparison through a pool to prepare, every optimisation warning which structure it
+    fitted wherever it runs, the early optimisations recorded (:class:`_Taken`). With
+    ``overtaken``, zener-int promises no quick posterior (its steps start the workers: a
+    :class:`_StartingRecorder`) and the early process is stuck on maxwell-int. Returns (what
+    was taken, what the serial path took, the preparations seen, whether the numbers and the
+    warnings are the serial path's, the pool's steps, the structures optimised in this
+    process)."""
     import time
 
     import bayesfo.comparison.early as early
 
-    fit = early._fit
+    assert parallel.fork_safe()
+    fit = steps._fit
 
-    def stuck(s, data, options):
-        if s.name == "maxwell-int":
-            time.sleep(120)
+    def warning_fit(s, data, options):
+        warnings.warn(f"{s.name}: optimised", UserWarning, stacklevel=1)
+        if os.getpid() == parent:
+            here.append(s.name)
+        elif overtaken and s.name == "maxwell-int":
+            time.sleep(120)  # the early process never delivers it
         return fit(s, data, options)
 
-    monkeypatch.setattr(early, "_fit", stuck)
-    _no_promise_for(monkeypatch, "zener-int")
-    pool = _StartingRecorder()
-    pool._prepare = lambda: None
-    assert _steps_in_pool(pool)[2] == ("pessimistic", "maxwell-int", None)
-    assert early_fits == [("zener-int", True, True), ("maxwell-int", False, False)]
+    parent, here = os.getpid(), []
+    steps._fit = early._fit = warning_fit
+    schedule.EarlyFits = _Taken
+    serial, caught_serial = _compare(workers=1)
+    taken_serial = list(_Taken.taken)
+    del here[:]
+    assert (UserWarning, "zener-int: optimised") in caught_serial
+    prepared = []
+    if overtaken:
+        probe = schedule.fit_and_probe
+        schedule.fit_and_probe = lambda s, *args: (
+            lambda out: (out[0], out[1] and s.name != "zener-int"))(probe(s, *args))
+        pool = _StartingRecorder()
+        pool._prepare = lambda: prepared.append(len(_Taken.taken))
+        auto, caught_auto = _compare(pool=pool)
+        ran = sorted(pool.steps)
+    else:
+        with lazy_process_pool(2, prepare=lambda: prepared.append(len(_Taken.taken))) as pool:
+            auto, caught_auto = _compare(pool=pool)
+            ran = pool.started
+    same = (_numbers(serial.results) == _numbers(auto.results)
+            and json.dumps(serial.to_summary(), sort_keys=True, default=str)
+            == json.dumps(auto.to_summary(), sort_keys=True, default=str)
+            and caught_serial == caught_auto)
+    return list(_Taken.taken), taken_serial, prepared, same, ran, here
+
+
+def _in_fresh_process(fn, *args):
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    # (a process of its own: a multiprocessing.Pool's are daemons, which may not fork)
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as fresh:
+        return fresh.submit(fn, *args).result()
+
+
+def test_the_optimisations_begin_in_a_process_forked_before_the_libraries_load():
+    """With a pool to prepare (the command's: the libraries load then), the optimisations run
+    in a forked process meanwhile; the structures take them from it, with the numbers and
+    warnings (the optimisations' included) of the serial path."""
+    taken, taken_serial, prepared, same, started, here = _in_fresh_process(_early_fits, False)
+    assert taken_serial == []  # the serial path forks nothing
+    assert prepared == [0]  # once, before any structure was taken up
+    assert taken == [("zener-int", True, True), ("maxwell-int", True, True)]
+    assert here == []  # both optima came from the early process
+    assert same and not started
+
+
+def test_workers_that_overtake_the_early_optimisations_end_them():
+    """Once the workers have started, a structure whose optimum has not come is optimised by
+    the worker, and the early process (here stuck on it) is ended: same numbers."""
+    taken, _, prepared, same, ran, here = _in_fresh_process(_early_fits, True)
+    assert prepared == [0]
+    assert taken == [("zener-int", True, True), ("maxwell-int", False, False)]
+    assert here == ["maxwell-int"]  # by the (here: in-process) worker
+    assert same and ("<lambda>", "maxwell-int", None) in ran

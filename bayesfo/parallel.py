@@ -211,7 +211,7 @@ def terminate(pool) -> None:
 
 
 @contextmanager
-def process_pool(workers: int = 0):
+def process_pool(workers: int = 0, *, fork: bool = False):
     """Worker processes (spawn, one BLAS thread each) that :func:`~bayesfo.comparison.compare` and
     :func:`~bayesfo.output.write_outputs` can share through their ``pool`` argument: the
     figures are then drawn by processes that have already loaded the libraries.
@@ -220,6 +220,9 @@ def process_pool(workers: int = 0):
     ----------
     workers : int
         Number of processes (0: one per CPU).
+    fork : bool
+        Fork the processes from this one at the first task where that is safe (see
+        :func:`new_pool`): only for a pool that lives within one call, as :func:`executor`'s.
 
     Yields
     ------
@@ -229,7 +232,7 @@ def process_pool(workers: int = 0):
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
         raise InputError(f"workers must be a non-negative integer, got {workers!r}")
     with worker_environment():  # processes are spawned as tasks are submitted
-        pool = new_pool(workers or available_cpus())
+        pool = new_pool(workers or available_cpus(), fork=fork)
         try:
             yield pool
         except BaseException:
@@ -359,7 +362,8 @@ def executor(workers: int, n_tasks: int | None = None, prepare=None):
     """The executor of a job that asks for ``workers`` processes: 0, the automatic choice (a
     :class:`LazyPool` of one process per CPU, started only when a task needs it); 1 (or a job of
     one task), this process (:class:`InlineExecutor`); more, a :func:`process_pool` of that many
-    processes, at most one per task. ``prepare`` (optional) is called once in this process
+    processes, at most one per task, forked where safe (they then share what ``prepare``
+    loaded instead of importing it again). ``prepare`` (optional) is called once in this process
     before any task runs or process starts: by the :class:`LazyPool` when its user says
     (:meth:`LazyPool.prepare`), else at once.
 
@@ -379,7 +383,7 @@ def executor(workers: int, n_tasks: int | None = None, prepare=None):
     if n <= 1:
         yield InlineExecutor()
     else:
-        with process_pool(n) as pool:
+        with process_pool(n, fork=True) as pool:
             yield pool
 
 

@@ -397,20 +397,23 @@ def state():
 
 if __name__ == "__main__":
     MARK.append(1)  # set in this process only: a forked worker has it, a spawned one not
-    from bayesfo.parallel import lazy_process_pool, process_pool
+    from bayesfo.parallel import executor, lazy_process_pool, process_pool
 
     with lazy_process_pool(1) as pool:
         print("lazy", *pool.submit(state).result())
     with process_pool(1) as pool:
         print("process_pool", *pool.submit(state).result())
+    with executor(2, 2, prepare=lambda: MARK.append(2)) as pool:  # --workers 2
+        print("executor", *pool.submit(state).result(), MARK == [1, 2])
 '''
 
 
 @pytest.mark.parametrize("blas_env, threads", [(None, 1), ("2", 2)])
 def test_pool_workers_in_a_fresh_command(tmp_path, blas_env, threads):
-    """In a fresh process (as the command line runs), the automatic schedule's pool forks its
-    workers and a process_pool spawns them; both run the BLAS threads of the worker
-    environment: one, or the number the user set."""
+    """In a fresh process (as the command line runs), the automatic schedule's pool and the
+    pool of an explicit number of workers (prepared first) fork their workers, and a
+    process_pool spawns them by default; all run the BLAS threads of the worker environment:
+    one, or the number the user set."""
     import os
     import subprocess
     import sys
@@ -425,7 +428,8 @@ def test_pool_workers_in_a_fresh_command(tmp_path, blas_env, threads):
                           env=env, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == [f"lazy True [{threads}]",
-                                        f"process_pool False [{threads}]"]
+                                        f"process_pool False [{threads}]",
+                                        f"executor True [{threads}] True"]
 
 
 class _KillingPool:

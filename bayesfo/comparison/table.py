@@ -19,8 +19,10 @@ ORDER_SYMBOLS = {"q": "q", "alpha": "α", "beta": "β", "delta": "δ", "kappa": 
 #: ln B from which the evidence for one structure over another is "very strong" (Kass & Raftery
 #: 1995: 2 ln B above 10): a structure that far below the best is ruled out.
 VERY_STRONG = 5.0
-#: The criteria besides the evidence that the verdict and the figures name (elpd: higher is
-#: better; AIC, BIC: lower), as the attributes of :class:`~bayesfo.comparison.Criteria`.
+#: The criteria besides the evidence that the ranking table ranks by, as the attributes of
+#: :class:`~bayesfo.comparison.Criteria`: +1 where higher is better (elpd), -1 where lower is.
+CRITERIA_DIRECTION = {"loo": 1, "waic": 1, "aic": -1, "aicc": -1, "bic": -1}
+#: Those of them that the verdict and the figures name.
 CRITERIA = {"loo": "PSIS-LOO", "waic": "WAIC", "aic": "AIC", "bic": "BIC"}
 
 
@@ -84,9 +86,9 @@ def ranking_rows(structures, ranking) -> list[dict]:
     best_z = max((s["log_evidence"] for s in ok if s.get("log_evidence") is not None),
                  default=math.nan)
     ranks = {}
-    for crit, sign in (("loo", -1), ("waic", -1), ("aic", 1), ("aicc", 1), ("bic", 1)):
+    for crit, better in CRITERIA_DIRECTION.items():
         # An undefined criterion (NaN, with its reason among the warnings) ranks last.
-        ordered = sorted(ok, key=lambda s, c=crit, g=sign: (
+        ordered = sorted(ok, key=lambda s, c=crit, g=-better: (
             not _finite_or_none(s.get(c)), g * s[c] if _finite_or_none(s.get(c)) else 0))
         ranks[crit] = {s["name"]: i + 1 for i, s in enumerate(ordered)}
     rows = []

@@ -24,7 +24,6 @@ from ..data.symbols import in_symbol, parameter_label
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
 EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),
                   (VERY_STRONG, "strong"), (math.inf, "very strong"))
-CRITERIA_NAMES = CRITERIA
 HDI_PERCENT = 94
 
 def _finite(x) -> bool:
@@ -164,19 +163,19 @@ def verdict(comparison) -> list[tuple[str, bool]]:
                 out.append((f"The difference from {second['structure']} is within twice its "
                             "estimation error: the evidence does not separate the two.", True))
     if len(rows) > 1:
-        agree = [c for c in CRITERIA_NAMES if best.get(f"rank_{c}") == 1]
+        agree = [c for c in CRITERIA if best.get(f"rank_{c}") == 1]
         disagree = {}
-        for c in CRITERIA_NAMES:
+        for c in CRITERIA:
             if c not in agree:
                 top = next((r["structure"] for r in rows if r.get(f"rank_{c}") == 1), None)
-                disagree.setdefault(top, []).append(CRITERIA_NAMES[c])
+                disagree.setdefault(top, []).append(CRITERIA[c])
         if not disagree:
             out.append(("The information criteria agree: PSIS-LOO, WAIC, AIC and BIC all rank "
                         f"{name} first.", False))
         else:
             parts = [f"{_join(crit)} prefer{'s' if len(crit) == 1 else ''} {other}"
                      for other, crit in disagree.items()]
-            lead = (f"{_join([CRITERIA_NAMES[c] for c in agree])} also rank {name} first, but "
+            lead = (f"{_join([CRITERIA[c] for c in agree])} also rank {name} first, but "
                     if agree else "The information criteria disagree with the evidence: ")
             out.append((lead + "; ".join(parts) + ".", False))
     orders = _orders(result)

@@ -8,7 +8,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from ..comparison.table import CRITERIA, VERY_STRONG
+from ..comparison.table import CRITERIA, CRITERIA_DIRECTION, VERY_STRONG
 from ..errors import InputError
 from ..options import (
     LEADING,
@@ -141,7 +141,7 @@ def leading(comparison) -> list:
         if best is None or z is None or not best - z >= VERY_STRONG:
             keep.add(r.name)
     for criterion in CRITERIA:
-        sign = 1.0 if criterion in ("loo", "waic") else -1.0
+        sign = CRITERIA_DIRECTION[criterion]
         scores = [(sign * v, r.name) for r in ranked
                   if (v := getattr(r.criteria, criterion)) is not None and math.isfinite(v)]
         if scores:

@@ -579,9 +579,13 @@ def _in_fresh_process(fn, *args):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    # (a process of its own: a multiprocessing.Pool's are daemons, which may not fork)
-    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as fresh:
-        return fresh.submit(fn, *args).result()
+    # (a process of its own: a multiprocessing.Pool's are daemons, which may not fork; ended
+    # without waiting, so that a hang fails the test instead of stalling the suite)
+    fresh = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        return fresh.submit(fn, *args).result(timeout=600)
+    finally:
+        parallel.terminate(fresh)
 
 
 def test_the_optimisations_begin_in_a_process_forked_before_the_libraries_load():

@@ -192,6 +192,7 @@ def terminate(pool) -> None:
     # ProcessPoolExecutor.shutdown waits for running tasks (minutes for a posterior);
     # Python 3.14 has terminate_workers(), 3.11 only the executor's own process table.
     processes = list((getattr(pool, "_processes", None) or {}).values())
+    results = getattr(pool, "_result_queue", None)  # (shutdown forgets it)
     pool.shutdown(wait=False, cancel_futures=True)
     for p in processes:
         try:
@@ -202,6 +203,16 @@ def terminate(pool) -> None:
         try:
             p.join(timeout=2)
         except (OSError, ValueError, AssertionError):
+            pass
+    # A worker ended while it was sending a result leaves the start of a message in the result
+    # pipe, and the manager thread waits for the rest for as long as a writer is open, this
+    # process's included (the interpreter's exit would then wait for that thread for ever).
+    # The workers are gone: closing this process's end lets the thread read the pipe's end.
+    writer = getattr(results, "_writer", None)
+    if writer is not None:
+        try:
+            writer.close()
+        except OSError:
             pass
     # The executor's manager thread sees the dead workers and releases the queues' semaphores;
     # without waiting for it, the resource tracker reports them as leaked at exit.

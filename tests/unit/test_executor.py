@@ -74,3 +74,39 @@ def test_a_pool_worker_settles_once_and_this_process_never():
             pool.shutdown(wait=True)
     assert loads == ["first"]
     assert frozen > 1_000  # numpy and the package's modules at least
+
+
+_PARTIAL_RESULT = '''
+import os, struct, time
+from bayesfo import parallel
+
+if __name__ == "__main__":
+    with parallel.worker_environment():
+        pool = parallel.new_pool(1, fork=True)
+        pool.submit(time.sleep, 600)
+        manager = pool._executor_manager_thread
+        # The start of a result whose sender is ended before the rest (as SIGTERM may end a
+        # worker): the manager thread reads it and waits for the rest.
+        os.write(pool._result_queue._writer.fileno(), struct.pack("!i", 1_000_000) + b"x" * 10)
+        time.sleep(1)
+        parallel.terminate(pool)
+        manager.join(timeout=60)
+        print("manager ended" if not manager.is_alive() else "manager waits", flush=True)
+'''
+
+
+def test_terminate_frees_a_manager_waiting_for_the_rest_of_a_result(tmp_path):
+    """A pool whose worker was ended while sending a result: terminate() leaves no thread
+    waiting for the rest, so the process exits (the interpreter's exit joins that thread)."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "partial.py"
+    script.write_text(_PARTIAL_RESULT)
+    try:
+        done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                              timeout=240)
+    except subprocess.TimeoutExpired:
+        pytest.fail("the process did not exit: its pool's manager thread still waits")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "manager ended\n"

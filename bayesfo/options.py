@@ -25,6 +25,10 @@ LEADING = "leading"
 STRUCTURE_FIGURES = LEADING
 #: Of the structures that the evidence does not rule out, at most this many lead.
 LEADING_STRUCTURES = 3
+#: ln B from which the evidence for one structure over another is "very strong" (Kass & Raftery
+#: 1995: 2 ln B above 10): a structure that far below the best is ruled out (here, where the
+#: command line's help can name it without importing the comparison).
+VERY_STRONG = 5.0
 
 
 def parse_floats(text: str, option: str) -> list[float]:

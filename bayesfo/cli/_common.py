@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from ..comparison.table import VERY_STRONG
 from ..errors import InputError
 from ..options import (
     DEFAULT_STRUCTURES,
@@ -13,6 +12,7 @@ from ..options import (
     NOISE_MODELS,
     SAMPLERS,
     STRUCTURE_FIGURES,
+    VERY_STRONG,
     seed_argument,
 )
 

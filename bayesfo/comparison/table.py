@@ -16,9 +16,6 @@ from .parameters import flagged_names, natural_block, physical_text
 ORDER_PARAMS = ("q", "beta", "alpha")
 #: The symbols in text of every parameter that is a fractional order (the cards' exponents).
 ORDER_SYMBOLS = {"q": "q", "alpha": "α", "beta": "β", "delta": "δ", "kappa": "κ", "gamma": "γ"}
-#: ln B from which the evidence for one structure over another is "very strong" (Kass & Raftery
-#: 1995: 2 ln B above 10): a structure that far below the best is ruled out.
-VERY_STRONG = 5.0
 #: The criteria besides the evidence that the ranking table ranks by, as the attributes of
 #: :class:`~bayesfo.comparison.Criteria`: +1 where higher is better (elpd), -1 where lower is.
 CRITERIA_DIRECTION = {"loo": 1, "waic": 1, "aic": -1, "aicc": -1, "bic": -1}

@@ -28,6 +28,7 @@ from ..comparison.parameters import UNDETERMINED_DECADES, shown_hdi
 from ..comparison.table import number
 from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
+from ..options import LEADING_STRUCTURES, VERY_STRONG
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
     _bayes_factor,
@@ -487,8 +488,9 @@ def _without_corner(figures: dict, comparison) -> str:
     if not missing:
         return ""
     return (f"<p class='small'>No corner figure of {_e(', '.join(missing))}: by default only "
-            "the leading structures get one (of the best three, those the evidence does not "
-            "rule out, and each structure an information criterion ranks first); "
+            f"the leading structures get one (of the best {LEADING_STRUCTURES}, those the "
+            f"evidence does not rule out, ln Z within {VERY_STRONG:g} of the best, and each "
+            "structure an information criterion ranks first); "
             "<code>--structure-figures all</code> draws every one.</p>")
 
 

@@ -18,8 +18,9 @@ from __future__ import annotations
 import math
 
 from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names, shown_hdi
-from ..comparison.table import CRITERIA, ORDER_SYMBOLS, VERY_STRONG
+from ..comparison.table import CRITERIA, ORDER_SYMBOLS
 from ..data.symbols import in_symbol, parameter_label
+from ..options import VERY_STRONG
 
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
 EVIDENCE_SCALE = ((1.0, "not worth more than a bare mention"), (3.0, "positive"),

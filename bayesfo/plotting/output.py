@@ -8,13 +8,14 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from ..comparison.table import CRITERIA, CRITERIA_DIRECTION, VERY_STRONG
+from ..comparison.table import CRITERIA, CRITERIA_DIRECTION
 from ..errors import InputError
 from ..options import (
     LEADING,
     LEADING_STRUCTURES,
     STRUCTURE_FIGURES,
     STRUCTURE_FIGURES_TAKES,
+    VERY_STRONG,
     figure_format_names,
     structure_figures_ok,
 )
@@ -129,7 +130,7 @@ def _structure_makers(result, color) -> dict:
 def leading(comparison) -> list:
     """The leading structures, in the order of the ranking: of the best
     :data:`~bayesfo.options.LEADING_STRUCTURES`, those that the evidence does not rule out (ln Z
-    less than :data:`~bayesfo.comparison.table.VERY_STRONG` below the best: the best always,
+    less than :data:`~bayesfo.options.VERY_STRONG` below the best: the best always,
     and any without a ln Z), and every structure that PSIS-LOO, WAIC, AIC or BIC ranks first."""
     ranked = ok_results(comparison)
     if not ranked:

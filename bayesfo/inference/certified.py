@@ -22,8 +22,9 @@ The routes, in order, with ``sampler="auto"``:
    (:mod:`~bayesfo.inference._configurations`: a coefficient at its lower prior bound, the
    others maximised), which no optimum seeds, are searched, and the posterior mass they hold
    beyond the draws' range must be at most :data:`CONFIGURATIONS_MISSED`;
-2. where the weights do not certify it (ridges, several regions), two independent runs of the
-   tempered ladder guided by the proposal's draws (and proposing in the configurations where
+2. where the weights do not certify it (ridges, several regions), or no optimum is admissible
+   (no proposal: the posterior lies against a constraint), two independent runs of the
+   tempered ladder guided by the proposal's draws where there is one (and proposing in the configurations where
    an element vanishes that the search found, as every ladder of this module does): their
    final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400), and their
    ln Z the evidence; where they do not, two more runs, and the four where the new pair agrees
@@ -109,9 +110,12 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         Or any object with its interface (``pointwise``, ``in_support``, priors, scaling).
     modes : ndarray, shape (n_modes, ndim_structure)
         The optima found (scaled coordinates of ``lik``, without the noise parameter): the
-        centres of the importance proposal and starts of emcee.
+        centres of the importance proposal and starts of emcee. Empty where none is
+        admissible: the tempered ladder then starts from the prior (route 2), and emcee, if it
+        runs, from ``starts``.
     starts : ndarray, optional
-        More starting points for emcee (e.g. linear estimates); ``modes`` are always used.
+        More starting points for emcee (e.g. linear estimates, an inadmissible best fit);
+        ``modes`` are always used.
     sampler : {"auto", "emcee"}
     evidence : {"auto", "bridge", "ladder"}
     seed : int
@@ -139,20 +143,29 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
     modes = np.atleast_2d(np.asarray(modes, dtype=float))
     name = lik.structure.name
     post = ev = tried = info = more = slabs = None
+    notes = []
     # Bridge sampling is defined on emcee's draws: a forced bridge route takes emcee.
-    if sampler == "auto" and evidence != "bridge" and modes.size:
-        try:
-            post, ev, info = importance_posterior(lik, modes, seed=seed)
-        except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
-            post, ev, info = None, None, {}
-        if post is not None and ev is not None and evidence == "auto" and not sampler_options:
-            post, ev, slabs = _configurations_checked(lik, modes, post, ev, info, seed)
+    if sampler == "auto" and evidence != "bridge":
+        if modes.size:
+            try:
+                post, ev, info = importance_posterior(lik, modes, seed=seed)
+            except (np.linalg.LinAlgError, FloatingPointError):  # to the samplers
+                post, ev, info = None, None, {}
+            if post is not None and ev is not None and evidence == "auto" \
+                    and not sampler_options:
+                post, ev, slabs = _configurations_checked(lik, modes, post, ev, info, seed)
         if post is None and evidence == "auto" and not sampler_options:
-            guide = info.get("proposal_draws")
+            # Without optima (none admissible: the posterior lies against a constraint) there
+            # is no importance proposal, and the ladder starts from the prior unguided.
+            guide = (info or {}).get("proposal_draws")
             if slabs is None:
                 slabs = configurations(lik, modes, guide)
             post, ev, tried, more = _ladder_first(lik, seed, guide, slabs)
-    notes = []
+            if post is not None and not modes.size:
+                notes.append(f"{name}: no optimum found lies in the posterior's support "
+                             "(each is unstable, not dissipative or breaks an inequality of the "
+                             "structure); the tempered ladder, started from the prior, gave "
+                             "the posterior")
     # The warnings of emcee's draws are held until it is known whether they are the posterior
     # reported: a ladder that certifies it instead replaces them.
     with warnings.catch_warnings(record=True) as held:
@@ -245,9 +258,9 @@ def _configurations_checked(lik, modes, post, ev, info: dict, seed: int):
 
 
 def _ladder_first(lik, seed: int, guide=None, slabs=()):
-    """Where importance sampling does not certify the posterior (ridges, several regions), the
-    tempered ladder's two independent runs: their final particles are the posterior when the
-    runs agree (R-hat < 1.01, ESS ≥ 400; see
+    """Where importance sampling does not certify the posterior (ridges, several regions) or
+    has no proposal (no admissible optimum), the tempered ladder's two independent runs: their
+    final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400; see
     :func:`~bayesfo.inference.results.posterior_from_particles`), and their ln Z the evidence.
 
     Where the two do not agree, two more runs are made: the four are the posterior when the two

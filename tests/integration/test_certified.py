@@ -206,3 +206,34 @@ def test_a_ladder_pair_that_disagrees_is_joined_by_a_second_pair(monkeypatch):
     assert len(note) == 1 and note[0].startswith(
         "zener: the first two tempered-ladder runs did not certify the posterior (the "
         "tempered-ladder runs disagree (R-hat 1.012 is not below 1.01)); two more runs agree")
+
+
+def test_without_an_admissible_optimum_the_ladder_from_the_prior_gives_the_posterior():
+    # On the -20 °C isotherm no optimum of the fractional Maxwell model is admissible (each
+    # lies outside the posterior's support): there is no importance proposal, and the two
+    # ladder runs, started from the prior unguided, give the posterior and ln Z.
+    # Known answers, from the independent routes on the same likelihood (seed 0): emcee's
+    # walkers from the best fit converged, ln Z by bridge sampling -526.23 ± 0.02, medians
+    # alpha 0.4536, beta 0.4660; dynesty nested sampling -526.32 ± 0.27 and -526.37 ± 0.27
+    # (seeds 0 and 1).
+    data = bf.read(DATA.with_name("Tm020C.csv"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PredictiveWarning)
+        r = bf.compare(data, "maxwell", seed=0, workers=1, progress=False,
+                       noise="constant")["maxwell"]
+    assert not r.fit.admissible and r.fit.optima.size == 0  # the premise
+    post = r.posterior
+    assert post.sampler == "ladder" and post.converged and post.n_walkers == 2
+    assert r.criteria.evidence.method == "ladder"
+    assert ("maxwell: no optimum found lies in the posterior's support (each is unstable, not "
+            "dissipative or breaks an inequality of the structure); the tempered ladder, "
+            "started from the prior, gave the posterior") in r.criteria.warnings
+    # Within twice the bridge estimate's and the ladder's combined errors, plus the spread
+    # between runs of other seeds (0.02); nested sampling's error is ten times larger.
+    assert abs(r.log_z - (-526.23)) < 0.1
+    names = list(post.param_names)
+    medians = np.median(post.samples, axis=0)
+    # A third of each posterior standard deviation (0.009, 0.006): far beyond the Monte Carlo
+    # error of the medians, far below a missed or misweighted region.
+    assert abs(medians[names.index("alpha")] - 0.4536) < 0.003
+    assert abs(medians[names.index("beta")] - 0.4660) < 0.002

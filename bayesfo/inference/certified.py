@@ -23,9 +23,11 @@ The routes, in order, with ``sampler="auto"``:
    others maximised), which no optimum seeds, are searched, and the posterior mass they hold
    beyond the draws' range must be at most :data:`CONFIGURATIONS_MISSED`;
 2. where the weights do not certify it (ridges, several regions), or no optimum is admissible
-   (no proposal: the posterior lies against a constraint), two independent runs of the
-   tempered ladder guided by the proposal's draws where there is one (and proposing in the configurations where
-   an element vanishes that the search found, as every ladder of this module does): their
+   (no proposal: the posterior lies against a constraint; the runs must then reach the
+   optimiser's best fit moved into the support within :data:`LADDER_SHORTFALL`), two
+   independent runs of the tempered ladder guided by the proposal's draws where there is one
+   (and proposing in the configurations where an element vanishes that the search found, as
+   every ladder of this module does): their
    final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400), and their
    ln Z the evidence; where they do not, two more runs, and the four where the new pair agrees
    and all four agree;
@@ -54,7 +56,7 @@ from ._ridge import PROBE_MAX_DIM
 from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
 from .importance import importance_posterior
 from .likelihood import Likelihood
-from .posterior import sample_posterior
+from .posterior import sample_posterior, support_seeds
 from .results import PosteriorResult, ladder_agreement, posterior_from_particles
 from .transform import _Transform
 
@@ -161,6 +163,9 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
             if slabs is None:
                 slabs = configurations(lik, modes, guide)
             post, ev, tried, more = _ladder_first(lik, seed, guide, slabs)
+            if post is not None and not modes.size \
+                    and (tried := _short_of_seeds(lik, starts, ev, seed)) is not None:
+                post = ev = more = None
             if post is not None and not modes.size:
                 notes.append(f"{name}: no optimum found lies in the posterior's support "
                              "(each is unstable, not dissipative or breaks an inequality of the "
@@ -303,6 +308,25 @@ def _ladder_first(lik, seed: int, guide=None, slabs=()):
             f"{second.rhat_max:.3f}) and with them (R-hat {post.rhat_max:.3f} over the four, "
             f"ESS {post.ess_min:.0f}), and the four give the posterior")
     return post, ev, None, note
+
+
+def _short_of_seeds(lik, starts, ev: Evidence, seed: int) -> str | None:
+    """Where no optimum is admissible, the ladder runs that started from the prior unguided
+    must reach, within :data:`LADDER_SHORTFALL`, the log-likelihood of the best of ``starts``
+    (the optimiser's best fit among them) moved into the support: a run that ends further below
+    missed the region around it, which emcee, started there, explores. Returns why the runs
+    are set aside, or None."""
+    if starts is None or not np.size(starts):
+        return None
+    try:
+        _, ll = support_seeds(lik, starts, np.random.default_rng(seed))
+    except InputError:  # no start in the support, nor any prior draw: nothing to compare
+        return None
+    gap = float(ll[0]) - ev.reached_log_likelihood
+    if not gap > LADDER_SHORTFALL:
+        return None
+    return (f"a run ended {gap:.1f} nats below the best fit moved into the posterior's support, "
+            "missing the region around it")
 
 
 #: Share of the particles of the tempered ladder run for ln Z beside an importance posterior

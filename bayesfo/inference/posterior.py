@@ -43,15 +43,13 @@ __all__ = ["ConvergenceWarning", "PosteriorResult", "initial_walkers", "posterio
            "result_from_draws", "sample_posterior", "save_netcdf"]
 
 
-def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.random.Generator,
-                    *, mode_window: float = 10.0, jitter: float = 1e-3) -> np.ndarray:
-    """Walker positions (θ, scaled) around the seeds' modes, inside the support.
-
-    ``seeds_scaled`` holds structure parameters (without noise) on the scaled problem. Seeds whose
-    best log-likelihood is more than ``mode_window`` below the best seed are dropped; the rest
-    share the walkers round-robin, each walker a Gaussian jitter of relative size up to
-    ``jitter`` in the sampling coordinates that lies in the support.
-    """
+def support_seeds(lik: Likelihood, seeds_scaled, rng: np.random.Generator, *,
+                  mode_window: float = 10.0) -> tuple[np.ndarray, np.ndarray]:
+    """The seeds (structure parameters, scaled; the noise parameter is added) moved into the
+    support, those within ``mode_window`` of the best log-likelihood, best first, with their
+    log-likelihoods: a seed outside the support is moved onto its boundary
+    (:func:`_into_support`); without any seed in the support, the most likely of 2 000 prior
+    draws in it join them."""
     seeds = np.atleast_2d(np.asarray(seeds_scaled, dtype=float))
     if lik.noise_param:
         seeds = np.column_stack([seeds, lik.noise_estimate(seeds)])
@@ -84,7 +82,21 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
         seeds = np.vstack([seeds, best])
     ll = lik(seeds)
     keep = ll >= ll.max() - mode_window
-    seeds = seeds[keep][np.argsort(-ll[keep])]
+    order = np.argsort(-ll[keep])
+    return seeds[keep][order], ll[keep][order]
+
+
+def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.random.Generator,
+                    *, mode_window: float = 10.0, jitter: float = 1e-3) -> np.ndarray:
+    """Walker positions (θ, scaled) around the seeds' modes, inside the support.
+
+    ``seeds_scaled`` holds structure parameters (without noise) on the scaled problem. Seeds whose
+    best log-likelihood is more than ``mode_window`` below the best seed are dropped; the rest
+    share the walkers round-robin, each walker a Gaussian jitter of relative size up to
+    ``jitter`` in the sampling coordinates that lies in the support.
+    """
+    tr = _Transform(lik)
+    seeds, _ = support_seeds(lik, seeds_scaled, rng, mode_window=mode_window)
     u_seeds = tr.to_u(seeds)
     # Jittered copies of every seed, the jitter shrinking from ``jitter`` to 1e-4 of it: a seed
     # on the boundary of the support (a coefficient at zero, q at its bound) keeps only the

@@ -237,3 +237,54 @@ def test_without_an_admissible_optimum_the_ladder_from_the_prior_gives_the_poste
     # error of the medians, far below a missed or misweighted region.
     assert abs(medians[names.index("alpha")] - 0.4536) < 0.003
     assert abs(medians[names.index("beta")] - 0.4660) < 0.002
+
+
+def test_ladder_runs_short_of_the_best_fit_moved_into_the_support_hand_over_to_emcee(
+        monkeypatch):
+    # The runs from the prior (no admissible optimum) agree, but their best particle ends more
+    # than LADDER_SHORTFALL below a point of the support that the optimiser's best fit leads
+    # to: they missed the region around it, and emcee, started there, gives the posterior.
+    import bayesfo.inference.certified as route
+
+    real = route.support_seeds
+    seen = []
+
+    def far_better(lik, seeds, rng, **kwargs):
+        seeds, ll = real(lik, seeds, rng, **kwargs)
+        seen.append(ll[0])
+        # As if the best fit led to a point of log-likelihood -400: about 100 nats above the
+        # posterior's maximum (-499.8 by emcee and by the ladder).
+        return seeds[:1], np.array([-400.0])
+
+    monkeypatch.setattr(route, "support_seeds", far_better)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bf.compare(bf.read(DATA.with_name("Tm020C.csv")), "maxwell", seed=0, workers=1,
+                       progress=False, noise="constant")["maxwell"]
+    assert len(seen) == 1 and seen[0] < -499.8 and r.fit.optima.size == 0
+    assert r.posterior.sampler == "emcee" and r.posterior.converged  # as the seed-0 reference
+    note = next(w for w in r.criteria.warnings if "tried first did not certify" in w)
+    gap = float(note.split("a run ended ")[1].split(" nats")[0])
+    assert 95.0 < gap < 105.0
+    assert "emcee ran instead" in note
+    assert not any("no optimum found lies" in w for w in r.criteria.warnings)
+
+
+@pytest.mark.slow
+def test_runs_from_the_prior_that_miss_the_best_fit_region_are_set_aside_on_silk():
+    # The generalised Maxwell max-n1m2-inv on the silk feedstock (GPL, read in place): no
+    # optimum is admissible, and the two ladder runs from the prior agree on a region whose
+    # best log-likelihood is about 45 nats below the best fit moved into the support (ln Z
+    # about -265.7): the check sends the posterior to emcee from there, whose route gives
+    # ln Z -235.97 ± 0.17 (seed 0, the code before the ladder came first).
+    src = (Path(__file__).parents[3] / "shared" / "data" / "reference-gpl"
+           / "reptate_silk_feedstock" / "original" / "silk_feedstock.tts")
+    if not src.is_file():
+        pytest.skip("GPL reference data not available")
+    data = bf.read(src)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bf.compare(data, "max-n1m2-inv", seed=0, workers=1, progress=False)["max-n1m2-inv"]
+    assert r.fit.optima.size == 0
+    assert r.posterior.converged
+    assert abs(r.log_z - (-235.97)) < 0.5

@@ -27,10 +27,9 @@ The routes, in order, with ``sampler="auto"``:
    optimiser's best fit moved into the support within :data:`LADDER_SHORTFALL`), two
    independent runs of the tempered ladder guided by the proposal's draws where there is one
    (and proposing in the configurations where an element vanishes that the search found, as
-   every ladder of this module does): their
-   final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400), and their
-   ln Z the evidence; where they do not, two more runs, and the four where the new pair agrees
-   and all four agree;
+   every ladder of this module does): their final particles are the posterior when the runs
+   agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do not, two more
+   runs, and the four where the new pair agrees and all four agree;
 3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its
    draws where the walkers converged, else by a tempered ladder guided by them, whose
    particles replace the walkers' draws when its runs agree. A posterior that no route

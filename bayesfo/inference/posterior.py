@@ -40,7 +40,7 @@ from .results import (
 from .transform import _log_prob_fn, _Transform
 
 __all__ = ["ConvergenceWarning", "PosteriorResult", "initial_walkers", "posterior_from_particles",
-           "result_from_draws", "sample_posterior", "save_netcdf"]
+           "result_from_draws", "sample_posterior", "save_netcdf", "support_seeds"]
 
 
 def support_seeds(lik: Likelihood, seeds_scaled, rng: np.random.Generator, *,

@@ -55,8 +55,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
     InputError
         For generic (transfer-function) data, or an unknown or failed structure.
     """
-    from ..predictions import evaluate
-    from ..predictions.functions import _unit
+    from ..predictions.functions import _unit, evaluate_together
 
     data = comparison.data
     if data.kind not in ("modulus", "compliance"):
@@ -80,8 +79,9 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
         for r in results:
             theta = structure_draws(r, n_draws, seed)
             st = styles[r.name]
+            both = evaluate_together(r.structure, theta, quantities, t)
             for ax, q in zip(axes, quantities, strict=True):
-                v = evaluate(r.structure, theta, q, t)
+                v = both[q]
                 positive_band(ax, t, np.where(np.isfinite(v), v, np.nan), st, r.name, q,
                               values, artists)
             handles.append(_band_handle(st))

@@ -424,19 +424,50 @@ def _evaluate(structure, theta, quantity: str, x) -> np.ndarray:
             if quantity == "relaxation_spectrum":
                 return (1.0 / c).imag / np.pi
             return -c.imag / np.pi
-        out = np.empty((theta.shape[0], np.shape(x)[-1]))
-        for i in range(0, theta.shape[0], _CHUNK):
-            part = theta[i:i + _CHUNK]
-            if own:
-                f = ((lambda s: 1.0 / (structure.laplace(part, s, per_set=True) * s))
-                     if quantity == "relaxation_modulus"
-                     else (lambda s: structure.laplace(part, s, per_set=True) / s))
-                out[i:i + _CHUNK] = laplace.invert_per_set(f, x[i:i + _CHUNK])
-            elif quantity == "relaxation_modulus":
-                out[i:i + _CHUNK] = laplace.invert(lambda s: 1.0 / (structure.laplace(part, s) * s), x)
-            else:
-                out[i:i + _CHUNK] = laplace.invert(lambda s: structure.laplace(part, s) / s, x)
-        return out
+        return _time_domain(structure, theta, (quantity,), x)[0]
+
+
+#: The time-domain quantities from the compliance's transform C(s): G(t) = L⁻¹[1/(s C(s))],
+#: J(t) = L⁻¹[C(s)/s].
+_FROM_COMPLIANCE = {"relaxation_modulus": lambda c, s: 1.0 / (c * s),
+                    "creep_compliance": lambda c, s: c / s}
+
+
+def _time_domain(structure, theta, quantities, x) -> np.ndarray:
+    """The time-domain ``quantities`` at ``x`` (shared, shape (n_x,), or each set's own, shape
+    (n_sets, n_x)) for each parameter set: shape (n_quantities, n_sets, n_x). C(s) is evaluated
+    once on the inversion contour for all of them."""
+    own = np.ndim(x) == 2
+    maps = [_FROM_COMPLIANCE[q] for q in quantities]
+    out = np.empty((len(quantities), theta.shape[0], np.shape(x)[-1]))
+    for i in range(0, theta.shape[0], _CHUNK):
+        part = theta[i:i + _CHUNK]
+
+        def transform(s, part=part):
+            c = structure.laplace(part, s, per_set=own)
+            return np.stack([f(c, s) for f in maps])
+
+        out[:, i:i + _CHUNK] = (laplace.invert_per_set(transform, x[i:i + _CHUNK]) if own
+                                else laplace.invert(transform, x))
+    return out
+
+
+def evaluate_together(structure, theta, quantities, x) -> dict[str, np.ndarray]:
+    """:func:`evaluate` for several ``quantities`` of one domain at the same ``x``: ``{quantity:
+    values (n_sets, n_x)}``; G(t) and J(t) together invert one evaluation of C(s)."""
+    quantities = [_check_quantity(q) for q in quantities]
+    domains = {QUANTITIES[q][0] for q in quantities}
+    if len(domains) != 1:
+        raise InputError("evaluate_together: the quantities must share their argument "
+                         f"(frequency, time or relaxation time); got {', '.join(quantities)}")
+    domain = domains.pop()
+    theta = np.atleast_2d(np.asarray(theta, float))
+    x = _check_x(x, domain)
+    if domain != "time":
+        return {q: _evaluate(structure, theta, q, x) for q in quantities}
+    with np.errstate(all="ignore"):
+        values = _time_domain(structure, theta, quantities, x)
+    return dict(zip(quantities, values, strict=True))
 
 
 def _band(values) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -117,6 +117,25 @@ def test_vectorised_over_parameter_sets():
         np.testing.assert_array_equal(row, evaluate(z, theta, "relaxation_modulus", T)[0])
 
 
+def test_time_functions_together_are_the_same_numbers_as_one_by_one():
+    # G(t) and J(t) from one evaluation of C(s) on the contour: the same arithmetic per
+    # quantity, so the same numbers to the last bit as evaluate's, which the tests above hold
+    # to the closed forms.
+    from bayesfo.predictions.functions import evaluate_together
+
+    z = get_structure("zener")
+    sets = np.array([[2.0, 3.0, 0.5, 0.6], [1.0, 2.0, 0.1, 0.9], [0.5, 1.0, 2.0, 0.3]])
+    sets = np.repeat(sets, 100, axis=0)  # more sets than one chunk of the inversion
+    pair = evaluate_together(z, sets, ("relaxation_modulus", "creep_compliance"), T)
+    for q in ("relaxation_modulus", "creep_compliance"):
+        np.testing.assert_array_equal(pair[q], evaluate(z, sets, q, T))
+    # Frequency-domain quantities one by one, as evaluate gives them.
+    parts = evaluate_together(z, sets[:3], ("storage", "loss"), [1.0, 10.0])
+    np.testing.assert_array_equal(parts["loss"], evaluate(z, sets[:3], "loss", [1.0, 10.0]))
+    with pytest.raises(InputError, match="must share their argument"):
+        evaluate_together(z, sets[:1], ("storage", "creep_compliance"), T)
+
+
 @pytest.mark.parametrize("x, message", [
     ([], "give one or more times"), ([0.0, 1.0], "finite and > 0; got 0"),
     ([1.0, np.inf], "finite and > 0; got inf"), (["a"], "must be numbers")])

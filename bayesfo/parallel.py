@@ -5,7 +5,9 @@
 choice (:class:`LazyPool`, whose processes start only when a task needs them, so that a job of
 quick tasks pays no start-up); every one has ``submit``, and the schedule that drives them is the
 same. :func:`figure_processes` says from the CPU time left idle whether figures can be drawn
-in a second process. A batch runs its data sets on the same worker processes
+in a second process; :class:`SpareCPU` tells a worker that a CPU has been idle of late, and
+:class:`Helper` runs part of its work (half of a tempered ladder's runs) in a process forked
+from it. A batch runs its data sets on the same worker processes
 (:func:`new_pool`) through its own schedule (:mod:`bayesfo.batch.executors`: one data set per
 task, resumable, or a Dask cluster).
 
@@ -449,3 +451,97 @@ def figure_processes(since) -> int:
         return 1
     idle = idle_cpus(since)
     return 2 if idle is not None and idle >= SPARE_CPU_FOR_FIGURES else 1
+
+
+#: Idle CPUs over the last :data:`SPARE_CHECK` seconds for a worker to borrow one for a helper
+#: process (:class:`Helper`): most of a CPU, so that a helper never shares a busy core.
+SPARE_CPU_FOR_HELPER = 0.8
+#: Seconds between a worker's looks at the idle CPUs (:class:`SpareCPU`).
+SPARE_CHECK = 0.05
+
+
+class SpareCPU:
+    """Whether a CPU has been idle of late, for a worker process of a pool that could hand part
+    of its work to a helper (:class:`Helper`): :meth:`now` is True once at least
+    :data:`SPARE_CPU_FOR_HELPER` of a CPU was idle over the last :data:`SPARE_CHECK` seconds (or
+    more). Only in a pool's worker (never in a process the user runs alone, nor with
+    ``--workers 1``), with two CPUs or more, and where forking is safe."""
+
+    def __init__(self):
+        import time
+
+        self._clock = time.monotonic
+        self.usable = (_WORKER["pool"] and available_cpus() >= 2 and fork_safe()
+                       and cpu_times() is not None)
+        self._since, self._at = (cpu_times(), self._clock()) if self.usable else (None, 0.0)
+
+    def now(self) -> bool:
+        if not self.usable or self._clock() - self._at < SPARE_CHECK:
+            return False
+        idle = idle_cpus(self._since)
+        self._since, self._at = cpu_times(), self._clock()
+        return idle is not None and idle >= SPARE_CPU_FOR_HELPER
+
+
+class Helper:
+    """``fn()`` run in a process forked from this one now, its return value sent back
+    (pickled) through a pipe: :meth:`result` waits for it. The helper ignores Ctrl-C and ends
+    when this process dies, as a worker does; it never runs this process's exit handlers.
+
+    Use it for work whose result does not depend on where it runs; :meth:`result` returns
+    None where the helper failed (raised, died, could not send), and the caller then does the
+    work itself."""
+
+    def __init__(self, fn):
+        import pickle
+
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the helper
+            code = 1
+            try:
+                os.close(read)
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+                try:
+                    ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL,
+                                                            0, 0, 0)
+                except (OSError, AttributeError):
+                    pass
+                data = pickle.dumps(fn(), protocol=pickle.HIGHEST_PROTOCOL)
+                with os.fdopen(write, "wb") as out:
+                    out.write(data)
+                code = 0
+            except BaseException:  # noqa: BLE001  (the caller does the work itself)
+                pass
+            finally:
+                os._exit(code)
+        os.close(write)
+        self._pid, self._read = pid, read
+
+    def result(self):
+        """The helper's return value, or None where it failed."""
+        import pickle
+
+        try:
+            with os.fdopen(self._read, "rb") as pipe:
+                data = pipe.read()
+        finally:
+            _, status = os.waitpid(self._pid, 0)
+        if status != 0 or not data:
+            return None
+        try:
+            return pickle.loads(data)
+        except Exception:  # noqa: BLE001
+            return None
+
+    def stop(self) -> None:
+        """End the helper now (its result is not wanted)."""
+        try:
+            os.kill(self._pid, signal.SIGKILL)
+            os.waitpid(self._pid, 0)
+        except (ProcessLookupError, ChildProcessError):
+            pass
+        try:
+            os.close(self._read)
+        except OSError:
+            pass

@@ -280,7 +280,16 @@ def _drive(target: _Target, runs: list) -> list:
     """Advance generators that yield evaluation requests ``(kind, points)`` (``kind`` one of
     ``"call"``, ``"unchecked"``, ``"holds"``: the methods of :class:`_Target`) until each
     returns; the requests of the same kind pending at once are evaluated in one call. Returns
-    the generators' return values."""
+    the generators' return values.
+
+    In a pool's worker, once a CPU has been idle of late (:class:`~bayesfo.parallel.SpareCPU`:
+    the other workers have run out of work), half of the runs still going move to a process
+    forked from this one (:class:`~bayesfo.parallel.Helper`), which finishes them and sends
+    their results back; a run's result does not depend on the runs it is advanced with, so the
+    numbers are the same. Where the helper fails, the runs go on here from where it took them.
+    """
+    from ..parallel import Helper, SpareCPU
+
     out = [None] * len(runs)
     pending = {}
 
@@ -291,9 +300,7 @@ def _drive(target: _Target, runs: list) -> list:
             out[i] = stop.value
             pending.pop(i, None)
 
-    for i in range(len(runs)):
-        advance(i, None)
-    while pending:
+    def step():
         kinds = {}
         for i, (kind, _) in pending.items():
             kinds.setdefault(kind, []).append(i)
@@ -308,6 +315,37 @@ def _drive(target: _Target, runs: list) -> list:
                 parts = np.split(values, cuts)
             for i, part in zip(members, parts, strict=True):
                 advance(i, part)
+
+    def finish(moved):  # in the helper: the moved runs alone
+        for i in [i for i in pending if i not in moved]:
+            del pending[i]
+        while pending:
+            step()
+        return {i: out[i] for i in moved}
+
+    for i in range(len(runs)):
+        advance(i, None)
+    spare = SpareCPU() if len(runs) > 1 else None
+    helper = moved = None
+    try:
+        while pending:
+            if helper is None and len(pending) > 1 and spare is not None and spare.now():
+                moved = sorted(pending)[len(pending) // 2:]
+                helper = Helper(lambda moved=tuple(moved): finish(moved))
+                moved = {i: pending.pop(i) for i in moved}  # their requests, kept
+            step()
+        if helper is not None:
+            done, helper = helper.result(), None
+            if done is None:  # the helper failed: the moved runs go on here
+                pending.update(moved)
+                while pending:
+                    step()
+            else:
+                for i, value in done.items():
+                    out[i] = value
+    finally:
+        if helper is not None:  # a run here raised: the helper's work is not wanted
+            helper.stop()
     return out
 
 

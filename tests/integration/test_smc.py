@@ -242,3 +242,76 @@ def test_runs_in_lock_step_are_the_runs_made_one_at_a_time():
         assert a.log_z == b.log_z and a.n_likelihood == b.n_likelihood
     with pytest.raises(ValueError, match="one entry per generator"):
         ladder_runs_together(lik, [np.random.default_rng(1)], guides=[None, None])
+
+
+def _runs_with_a_helper(fail: bool):
+    """In a fresh process (no thread: forking is safe), as a pool's worker with a CPU found
+    idle at the first look: lock-step runs, half of which move to a helper process (made to
+    fail with ``fail``), against the same runs made one at a time. Returns (whether each run is
+    the same, the helpers made, this process's id, the ids of the helpers' results)."""
+    import os
+
+    import bayesfo.parallel as parallel
+
+    lik = _TwoModes(widths=[1.0, 1e-3])
+    guide = MEANS[1] + 1e-3 * np.random.default_rng(3).normal(size=(500, 2))
+    rngs = [21, 22, 23]
+    alone = [ladder_run(lik, np.random.default_rng(r), guide=guide) for r in rngs]
+    parallel._WORKER["pool"] = True
+    parallel.available_cpus = lambda: 2  # (also on a machine of one CPU)
+    parallel.SpareCPU.now = lambda self: self.usable
+    made, sent = [], []
+    real = parallel.Helper
+
+    class Recorded(real):
+        def __init__(self, fn):
+            def work():
+                if fail:
+                    raise RuntimeError("the helper fails")
+                done = fn()
+                return {i: dataclasses.replace(run, bridge=(os.getpid(), 0.0))
+                        for i, run in done.items()}
+            made.append(1)
+            super().__init__(work)
+
+        def result(self):
+            done = super().result()
+            sent.append(None if done is None else sorted(done))
+            return done
+
+    parallel.Helper = Recorded
+    together = ladder_runs_together(lik, [np.random.default_rng(r) for r in rngs],
+                                    guides=[guide] * 3)
+    same = [np.array_equal(a.particles, b.particles) and np.array_equal(a.betas, b.betas)
+            and a.log_z == b.log_z and a.n_likelihood == b.n_likelihood
+            for a, b in zip(alone, together, strict=True)]
+    helped = [r.bridge[0] if r.bridge is not None else None for r in together]
+    return same, len(made), os.getpid(), helped, sent
+
+
+def _in_fresh_process(fn, *args):
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    import bayesfo.parallel as parallel
+
+    fresh = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        return fresh.submit(fn, *args).result(timeout=600)
+    finally:
+        parallel.terminate(fresh)
+
+
+def test_runs_moved_to_a_helper_process_where_a_cpu_is_idle_are_the_same_runs():
+    # A pool's worker that finds a CPU idle hands half of its lock-step runs to a forked
+    # helper: each run is still the run made alone (its generator and guide decide it).
+    same, helpers, pid, helped, sent = _in_fresh_process(_runs_with_a_helper, False)
+    assert helpers == 1 and sent == [[1, 2]]  # the later half of the three
+    assert all(same)
+    assert helped[0] is None and helped[1] == helped[2] and helped[1] not in (None, pid)
+
+
+def test_runs_of_a_helper_that_fails_go_on_where_they_were():
+    same, helpers, pid, helped, sent = _in_fresh_process(_runs_with_a_helper, True)
+    assert helpers == 1 and sent == [None]
+    assert all(same) and helped == [None, None, None]

@@ -527,6 +527,7 @@ class Helper:
                 data = pipe.read()
         finally:
             _, status = os.waitpid(self._pid, 0)
+            self._pid = None  # reaped: its number may be another process's from now on
         if status != 0 or not data:
             return None
         try:
@@ -536,6 +537,8 @@ class Helper:
 
     def stop(self) -> None:
         """End the helper now (its result is not wanted)."""
+        if self._pid is None:  # already reaped by result()
+            return
         try:
             os.kill(self._pid, signal.SIGKILL)
             os.waitpid(self._pid, 0)

@@ -326,18 +326,18 @@ def _drive(target: _Target, runs: list) -> list:
     for i in range(len(runs)):
         advance(i, None)
     spare = SpareCPU() if len(runs) > 1 else None
-    helper = moved = None
+    helper = kept = None
     try:
         while pending:
             if helper is None and len(pending) > 1 and spare is not None and spare.now():
-                moved = sorted(pending)[len(pending) // 2:]
-                helper = Helper(lambda moved=tuple(moved): finish(moved))
-                moved = {i: pending.pop(i) for i in moved}  # their requests, kept
+                moved = tuple(sorted(pending)[len(pending) // 2:])
+                helper = Helper(lambda: finish(moved))
+                kept = {i: pending.pop(i) for i in moved}  # their requests, for a failure
             step()
         if helper is not None:
             done, helper = helper.result(), None
             if done is None:  # the helper failed: the moved runs go on here
-                pending.update(moved)
+                pending.update(kept)
                 while pending:
                     step()
             else:

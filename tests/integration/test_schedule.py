@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fresh_process import in_fresh_process
 
 import bayesfo as bf
 import bayesfo.comparison.schedule as schedule
@@ -575,24 +576,11 @@ def _early_fits(overtaken: bool):
     return list(_Taken.taken), taken_serial, prepared, same, ran, here
 
 
-def _in_fresh_process(fn, *args):
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    # (a process of its own: a multiprocessing.Pool's are daemons, which may not fork; ended
-    # without waiting, so that a hang fails the test instead of stalling the suite)
-    fresh = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
-    try:
-        return fresh.submit(fn, *args).result(timeout=600)
-    finally:
-        parallel.terminate(fresh)
-
-
 def test_the_optimisations_begin_in_a_process_forked_before_the_libraries_load():
     """With a pool to prepare (the command's: the libraries load then), the optimisations run
     in a forked process meanwhile; the structures take them from it, with the numbers and
     warnings (the optimisations' included) of the serial path."""
-    taken, taken_serial, prepared, same, started, here = _in_fresh_process(_early_fits, False)
+    taken, taken_serial, prepared, same, started, here = in_fresh_process(_early_fits, False)
     assert taken_serial == []  # the serial path forks nothing
     assert prepared == [0]  # once, before any structure was taken up
     assert taken == [("zener-int", True, True), ("maxwell-int", True, True)]
@@ -603,7 +591,7 @@ def test_the_optimisations_begin_in_a_process_forked_before_the_libraries_load()
 def test_workers_that_overtake_the_early_optimisations_end_them():
     """Once the workers have started, a structure whose optimum has not come is optimised by
     the worker, and the early process (here stuck on it) is ended: same numbers."""
-    taken, _, prepared, same, ran, here = _in_fresh_process(_early_fits, True)
+    taken, _, prepared, same, ran, here = in_fresh_process(_early_fits, True)
     assert prepared == [0]
     assert taken == [("zener-int", True, True), ("maxwell-int", False, False)]
     assert here == ["maxwell-int"]  # by the (here: in-process) worker

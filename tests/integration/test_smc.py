@@ -9,6 +9,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from fresh_process import in_fresh_process
 from scipy.special import logsumexp
 
 from bayesfo.errors import InputError
@@ -289,29 +290,16 @@ def _runs_with_a_helper(fail: bool):
     return same, len(made), os.getpid(), helped, sent
 
 
-def _in_fresh_process(fn, *args):
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    import bayesfo.parallel as parallel
-
-    fresh = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
-    try:
-        return fresh.submit(fn, *args).result(timeout=600)
-    finally:
-        parallel.terminate(fresh)
-
-
 def test_runs_moved_to_a_helper_process_where_a_cpu_is_idle_are_the_same_runs():
     # A pool's worker that finds a CPU idle hands half of its lock-step runs to a forked
     # helper: each run is still the run made alone (its generator and guide decide it).
-    same, helpers, pid, helped, sent = _in_fresh_process(_runs_with_a_helper, False)
+    same, helpers, pid, helped, sent = in_fresh_process(_runs_with_a_helper, False)
     assert helpers == 1 and sent == [[1, 2]]  # the later half of the three
     assert all(same)
     assert helped[0] is None and helped[1] == helped[2] and helped[1] not in (None, pid)
 
 
 def test_runs_of_a_helper_that_fails_go_on_where_they_were():
-    same, helpers, pid, helped, sent = _in_fresh_process(_runs_with_a_helper, True)
+    same, helpers, pid, helped, sent = in_fresh_process(_runs_with_a_helper, True)
     assert helpers == 1 and sent == [None]
     assert all(same) and helped == [None, None, None]

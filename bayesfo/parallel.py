@@ -496,6 +496,7 @@ class Helper:
         import pickle
 
         read, write = os.pipe()
+        parent = os.getpid()
         pid = os.fork()
         if pid == 0:  # the helper
             code = 1
@@ -507,6 +508,8 @@ class Helper:
                                                             0, 0, 0)
                 except (OSError, AttributeError):
                     pass
+                if os.getppid() != parent:  # it died before the death signal was asked for
+                    os._exit(1)
                 data = pickle.dumps(fn(), protocol=pickle.HIGHEST_PROTOCOL)
                 with os.fdopen(write, "wb") as out:
                     out.write(data)

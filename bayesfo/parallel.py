@@ -502,14 +502,7 @@ class Helper:
             code = 1
             try:
                 os.close(read)
-                signal.signal(signal.SIGINT, signal.SIG_IGN)
-                try:
-                    ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL,
-                                                            0, 0, 0)
-                except (OSError, AttributeError):
-                    pass
-                if os.getppid() != parent:  # it died before the death signal was asked for
-                    os._exit(1)
+                init_worker(parent)  # Ctrl-C ignored; ends with this process
                 data = pickle.dumps(fn(), protocol=pickle.HIGHEST_PROTOCOL)
                 with os.fdopen(write, "wb") as out:
                     out.write(data)

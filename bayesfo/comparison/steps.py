@@ -138,10 +138,6 @@ def sample(s: Structure, data: FrequencyResponse, noise: str, fit,
     """Posterior, criteria and evidence of one structure under one noise model."""
     lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
     modes, starts = starting_points(lik, fit)
-    if not fit.optima.size:
-        # None admissible: no importance proposal; the ladder from the prior, and emcee, if it
-        # must run, from the best fit.
-        modes, starts = modes[:0], np.vstack([modes, starts])
     found = certified_posterior(
         lik, modes, starts=starts, sampler=options.sampler, evidence=options.evidence,
         seed=options.seed, fit_log_likelihood=fit_log_likelihood(lik, fit), remedy=remedy(lik),

@@ -23,15 +23,19 @@ __all__ = [
 
 
 def starting_points(lik: Likelihood, fit) -> tuple[np.ndarray, np.ndarray]:
-    """(modes, more starts) of a posterior in the scaled coordinates of ``lik``: the optima of
-    the global optimisation ``fit`` (its best point where it kept none) and the linear
-    estimates of the structure's coefficients (none where the structure has no linear form)."""
+    """(modes, more starts) of a posterior in the scaled coordinates of ``lik``: the admissible
+    optima of the global optimisation ``fit``, and the linear estimates of the structure's
+    coefficients (none where the structure has no linear form). Where the fit kept no optimum
+    (none admissible), there are no modes, and its best point leads the starts: the posterior
+    then has no importance proposal (see :func:`certified_posterior`)."""
     # Through physical units: the fit may have used another scaling than the likelihood.
-    modes = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
-    modes = lik.structure.to_scaled(lik.structure.to_physical(modes, fit.scaling), lik.scaling)
+    best = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
+    best = lik.structure.to_scaled(lik.structure.to_physical(best, fit.scaling), lik.scaling)
     lin = linear_seeds(lik.structure, lik.data)
-    starts = lik.structure.to_scaled(lin, lik.scaling) if lin.size else np.empty((0, modes.shape[1]))
-    return modes, starts
+    starts = lik.structure.to_scaled(lin, lik.scaling) if lin.size else np.empty((0, best.shape[1]))
+    if not fit.optima.size:
+        return best[:0], np.vstack([best, starts])
+    return best, starts
 
 
 def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: int = 0,

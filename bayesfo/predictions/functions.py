@@ -400,9 +400,7 @@ def evaluate(structure, theta, quantity: str, x) -> np.ndarray:
     >>> bool(np.isclose(g[0, 0], 2.0 / np.sqrt(np.pi)))
     True
     """
-    quantity = _check_quantity(quantity)
-    return _evaluate(structure, np.atleast_2d(np.asarray(theta, float)), quantity,
-                     _check_x(x, QUANTITIES[quantity][0]))
+    return evaluate_together(structure, theta, (quantity,), x)[quantity]
 
 
 def _evaluate(structure, theta, quantity: str, x) -> np.ndarray:

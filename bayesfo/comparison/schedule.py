@@ -63,7 +63,7 @@ from ..inference._arviz import preload
 from ..parallel import settle_worker
 from .early import EarlyFits
 from .results import StructureResult
-from .steps import conclude, fit_and_probe, fit_and_screen, kept, sample_held
+from .steps import conclude, fit_and_probe, fit_and_screen, kept, sample_held, settle
 
 
 def _task(step, *args):
@@ -84,10 +84,15 @@ def _first(s, data, options):
     """Step (1); with a single noise model to sample, (2) and (3) follow in the same task.
     Returns ("result", StructureResult) or ("sample", (fit, screened, noise models))."""
     fit, screened, noises = fit_and_screen(s, data, options)
-    if len(noises) > 1:
+    if len(noises) > 1 or _deferred(screened) is not None:
         return "sample", (fit, screened, noises)
     runs = [sample_held(s, data, noises[0], fit, options)]
     return "result", conclude(s, data, fit, screened, runs, options)
+
+
+def _deferred(screened):
+    """The noise model that waits for the leader's ln Z (:func:`~.steps.settle`), or None."""
+    return None if screened is None else screened.deferred
 
 
 def _rank(what: str, *, quick: bool) -> int:
@@ -201,6 +206,14 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
             if j == i:  # e.g. the other noise model's posterior, after an error in one
                 future.cancel()
 
+    def sample(i):
+        # Step (2) of every noise model to sample now; the leader's run also bounds the
+        # deferred one's evidence.
+        fit, screened, noises = prepared[i]
+        for noise in noises:
+            submit(i, noise, sample_held, structures[i], data, noise, fit, options,
+                   _deferred(screened))
+
     def after_sample(i):
         s, (fit, screened, noises) = structures[i], prepared[i]
         for noise in noises:  # in order, so the error reported is the serial path's
@@ -208,6 +221,12 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 return
             if runs[i][noise][1] is not None:
                 return end(i, StructureResult(s, error=runs[i][noise][1]))
+        if (other := _deferred(screened)) is not None:
+            settled = settle(screened, runs[i][noises[0]][0])
+            if settled is None:  # not set aside: sampled after all
+                prepared[i] = (fit, None, [*noises, other.noise])
+                return submit(i, other.noise, sample_held, s, data, other.noise, fit, options)
+            screened = settled
         submit(i, "conclude", conclude, s, data, fit, screened,
                [runs[i][noise][0] for noise in noises], options)
 
@@ -225,16 +244,12 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
         elif here:
             prepared[i], quick = value
             in_pool[i] = not quick
-            for noise in prepared[i][2]:
-                submit(i, noise, sample_held, structures[i], data, noise, prepared[i][0],
-                       options)
+            sample(i)
         elif value[0] == "result":
             end(i, value[1])
         else:
             prepared[i] = value[1]
-            fit, _, noises = prepared[i]
-            for noise in noises:
-                submit(i, noise, sample_held, structures[i], data, noise, fit, options)
+            sample(i)
 
     def collect(future):
         i, what, args = live.pop(future)

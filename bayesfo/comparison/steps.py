@@ -2,9 +2,11 @@
 
 (1) :func:`fit_and_screen`: the global optimisation (the modes) and, without σ in the data,
 the quick noise screen (:func:`screen`), which may set aside a noise model that trails far
-behind; :func:`fit_and_probe` does the same and says whether the rest promises to be quick.
+behind, or defer one until the other's ln Z is known (:class:`Deferred`);
+:func:`fit_and_probe` does the same and says whether the rest promises to be quick.
 (2) :func:`sample_held`: one certified posterior per noise model still in the running
-(:func:`~bayesfo.inference.certified.certified_posterior`), its warnings held back.
+(:func:`~bayesfo.inference.certified.certified_posterior`), its warnings held back; a deferred
+noise model is sampled only where :func:`settle` cannot set it aside.
 (3) :func:`conclude`: the noise model chosen by evidence (:func:`choose_noise`), the evidence
 check, the adequacy checks, the held-out points, and the :class:`StructureResult`.
 :mod:`.schedule` runs them as tasks of an executor (this process or worker processes).
@@ -85,14 +87,27 @@ class NoiseRun:
     post: Any
     criteria: dict
     caught: list = field(default_factory=list)
+    bound: float | None = None
+
+
+class Deferred(NamedTuple):
+    """A noise model whose posterior waits for the leader's certified ln Z (:func:`settle`):
+    ``best``, the highest log-likelihood under it (with the maximum-likelihood noise scale)
+    found by polishing the structure's optima under its weighting."""
+
+    noise: str
+    best: float
 
 
 class Screen(NamedTuple):
     """The noise screen's decision: the leading noise model and every candidate's quick
-    estimate (:func:`~bayesfo.inference.importance.screen_noise`)."""
+    estimate (:func:`~bayesfo.inference.importance.screen_noise`), as records of
+    ``{"log_z", "method", "intervals"}``. With ``deferred``, the other noise model is not set
+    aside yet: the leader is sampled first, and :func:`settle` decides."""
 
     leader: str
     quick: dict
+    deferred: Deferred | None = None
 
 
 class _Entry(NamedTuple):
@@ -184,21 +199,94 @@ def _quick_estimates(s, data, candidates, fit, options: RunOptions) -> dict:
 
 def screen(s, data, candidates, fit, options: RunOptions, quick=None) -> Screen | None:
     """The quick ln Z of each candidate noise model, and the leader where it is decisive (see
-    :data:`SCREEN_MARGIN`); None when all candidates must be sampled. ``quick``: the estimates
-    of :func:`_quick_estimates`, when already made."""
-    if len(candidates) < 2 or not fit.optima.size:
+    :data:`SCREEN_MARGIN`); where it is not, and some candidate's quick estimate does not
+    promise a quick posterior, the one to defer (:func:`_deferral`); None when all candidates
+    must be sampled at once. ``quick``: the estimates of :func:`_quick_estimates`, when already
+    made."""
+    if len(candidates) < 2:
         return None
     if quick is None:
-        quick = _quick_estimates(s, data, candidates, fit, options)
-    if any(quick.get(noise) is None for noise in candidates):
+        quick = _quick_estimates(s, data, candidates, fit, options) if fit.optima.size else {}
+    if all(quick.get(noise) is not None for noise in candidates):
+        order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
+        leader, other = order[0], order[1]
+        if (quick[leader]["log_z"] - quick[other]["log_z"] >= SCREEN_MARGIN
+                and quick[other]["k_hat"] < K_HAT_MAX):
+            return Screen(leader, {noise: quick[noise] for noise in candidates})
+    if all(_quick_promise(quick.get(noise)) for noise in candidates):
+        return None  # both posteriors promise to be quick: sampled at once
+    return _deferral(s, data, candidates, fit, options, quick)
+
+
+def _quick_promise(estimate) -> bool:
+    """Whether a quick estimate promises that importance sampling will certify the posterior:
+    its Pareto k̂ below :data:`~bayesfo.inference.importance.K_HAT_MAX` and no order left
+    undetermined."""
+    return (estimate is not None and estimate["k_hat"] < K_HAT_MAX
+            and not estimate.get("undetermined"))
+
+
+#: Where each noise model's maximum likelihood is sought: the residual weights of
+#: :func:`~bayesfo.identify.optimize.fit_structure` under which its likelihood is a sum of
+#: squares (σ the same at every point, or proportional to |G|).
+NOISE_WEIGHTING = {"constant": "none", "proportional": "relative"}
+
+
+def _best_log_likelihood(s, data, noise, fit, options: RunOptions, *,
+                         search: bool = False) -> float:
+    """The highest log-likelihood of ``s`` under ``noise`` (with the maximum-likelihood noise
+    scale) at the admissible optima of a least-squares fit under its weighting
+    (:data:`NOISE_WEIGHTING`) started from the structure's optima: polished from them alone, or,
+    with ``search``, by the global optimisation of :func:`_fit` (random and linear-method
+    starts besides). −inf where no optimum is admissible."""
+    lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
+    known = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
+    starts = lik.structure.to_physical(known, fit.scaling)
+    found = (fit_structure(lik.structure, data, rng=options.seed, starts=starts,
+                           weighting=NOISE_WEIGHTING[noise], seed_methods=True) if search else
+             fit_structure(lik.structure, data, rng=options.seed, starts=starts, n_starts=1,
+                           weighting=NOISE_WEIGHTING[noise], stop_after=None))
+    if not found.optima.size:
+        return -np.inf
+    theta = lik.structure.to_scaled(lik.structure.to_physical(found.optima, found.scaling),
+                                    lik.scaling)
+    return float(np.max(lik(np.column_stack([theta, lik.noise_estimate(theta)]))))
+
+
+def _deferral(s, data, candidates, fit, options: RunOptions, quick) -> Screen | None:
+    """Where the screen does not decide and a posterior promises to be slow (a tempered ladder
+    or emcee), the noise model whose likelihood reaches higher (polished optima,
+    :func:`_best_log_likelihood`) is sampled first, and the other waits for its ln Z
+    (:func:`settle`): ln Z = ln ∫ L π ≤ ln max L, so a model whose maximum log-likelihood
+    trails the leader's certified ln Z by :data:`SCREEN_MARGIN` cannot hold more than e^-5 of
+    their sum. None (both sampled at once) where no optimum is admissible under the other."""
+    best = {n: _best_log_likelihood(s, data, n, fit, options) for n in candidates}
+    leader, other = sorted(candidates, key=lambda n: -best[n])
+    if not np.isfinite(best[other]):
         return None
-    quick = {noise: quick[noise] for noise in candidates}
-    order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
-    leader, other = order[0], order[1]
-    if (quick[leader]["log_z"] - quick[other]["log_z"] < SCREEN_MARGIN
-            or not quick[other]["k_hat"] < K_HAT_MAX):
+    return Screen(leader, {n: q for n, q in quick.items() if q is not None},
+                  Deferred(other, best[other]))
+
+
+#: How the record of a noise model set aside by :func:`settle` names its ln Z.
+BOUND_METHOD = "upper bound (maximum likelihood)"
+
+
+def settle(screened: Screen, run: NoiseRun) -> Screen | None:
+    """After the leader's posterior (``run``), the deferred noise model of ``screened``: set
+    aside (a :class:`Screen` without ``deferred``, whose record for it holds its upper bound,
+    :data:`BOUND_METHOD`) where the leader's certified ln Z exceeds that bound
+    (``run.bound``, :func:`sample_held`) by :data:`SCREEN_MARGIN`; else None: it is sampled
+    too."""
+    other = screened.deferred.noise
+    evidence = run.criteria["evidence"]
+    if (run.bound is None or evidence is None or not run.post.converged
+            or not evidence.log_z - run.bound >= SCREEN_MARGIN):
         return None
-    return Screen(leader, quick)
+    quick = screened.quick.get(other) or {}
+    record = {"log_z": run.bound, "method": BOUND_METHOD,
+              "intervals": quick.get("intervals", {})}
+    return Screen(screened.leader, {**screened.quick, other: record})
 
 
 def choose_noise(name: str, runs: list[NoiseRun],
@@ -223,6 +311,8 @@ def choose_noise(name: str, runs: list[NoiseRun],
             if noise != screened.leader:
                 entries.append(_Entry(noise, q["log_z"], None, q["method"], q["intervals"],
                                       None))
+    # Against an upper bound, the lead and the probability are lower bounds.
+    least = "at least " if any(e.method == BOUND_METHOD for e in entries) else ""
     log_z = np.array([e.log_z for e in entries])
     sampled = [i for i, e in enumerate(entries) if e.run is not None]
     best = max(sampled, key=lambda i: log_z[i])
@@ -258,7 +348,8 @@ def choose_noise(name: str, runs: list[NoiseRun],
     other = next(i for i in range(len(entries)) if i != best)
     delta = log_z[best] - log_z[other]
     reason = (f"chosen by evidence over {' and '.join(e.noise for e in entries)} noise "
-              + (f"(ln Z higher by {delta:.1f}; probability {prob[best]:.3f})"
+              + (f"(ln Z higher by {least}{delta:.1f}; probability {least}"
+                 f"{prob[best]:.3f})"
                  if np.isfinite(delta) else "(the other has no evidence)"))
     chosen.post = replace(chosen.post, noise_reason=reason)
     if apart:
@@ -309,7 +400,12 @@ def fit_and_screen(s: Structure, data: FrequencyResponse, options: RunOptions):
     screen's record (None when it did not decide) and the noise models to sample."""
     candidates, fit = _fit(s, data, options)
     screened = screen(s, data, candidates, fit, options)
-    return fit, screened, [n for n in candidates if screened is None or n == screened.leader]
+    return fit, screened, _to_sample(candidates, screened)
+
+
+def _to_sample(candidates, screened: Screen | None) -> list[str]:
+    """The noise models to sample now: the leader where the screen has one, else all."""
+    return list(candidates) if screened is None else [screened.leader]
 
 
 def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions, fitted=None):
@@ -332,20 +428,21 @@ def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions, fi
     quick = (_quick_estimates(s, data, candidates, fit, options)
              if len(candidates) > 1 and fit.optima.size else {})
     screened = screen(s, data, candidates, fit, options, quick=quick)
-    noises = [n for n in candidates if screened is None or n == screened.leader]
+    noises = _to_sample(candidates, screened)
     if (options.sampler != "auto" or options.evidence != "auto"
             or options.evidence_check or not fit.optima.size):
         return (fit, screened, noises), False
+    # The promise covers a deferred noise model too: it may be sampled where the leader is.
+    promised = noises + ([screened.deferred.noise] if screened and screened.deferred else [])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for noise in noises:
+        for noise in promised:
             if noise not in quick:
                 try:
                     quick.update(_quick_estimates(s, data, (noise,), fit, options))
                 except (InputError, np.linalg.LinAlgError, FloatingPointError):
                     quick[noise] = None
-    promise = all(quick.get(n) is not None and quick[n]["k_hat"] < K_HAT_MAX
-                  and not quick[n].get("undetermined") for n in noises)
+    promise = all(_quick_promise(quick.get(n)) for n in promised)
     return (fit, screened, noises), promise
 
 
@@ -359,13 +456,23 @@ def _fit(s: Structure, data: FrequencyResponse, options: RunOptions):
 
 
 def sample_held(s: Structure, data: FrequencyResponse, noise: str, fit,
-                options: RunOptions) -> NoiseRun:
+                options: RunOptions, deferred: Deferred | None = None) -> NoiseRun:
     """Step 2: :func:`sample` under one noise model, its warnings held back in
     ``run.caught`` (category, message, file, line): only the chosen model's reach the user
-    (:func:`conclude`; the other's are kept in its record)."""
+    (:func:`conclude`; the other's are kept in its record).
+
+    With ``deferred`` (the noise model waiting for this one's ln Z, :func:`_deferral`), where
+    the certified ln Z exceeds the deferred model's polished maximum log-likelihood by
+    :data:`SCREEN_MARGIN`, its maximum is sought again by a global optimisation, and
+    ``run.bound`` holds the higher of the two (for :func:`settle`)."""
     with warnings.catch_warnings(record=True) as held:
         warnings.simplefilter("always")
         run = sample(s, data, noise, fit, options)
+        evidence = run.criteria["evidence"]
+        if (deferred is not None and evidence is not None and run.post.converged
+                and evidence.log_z - deferred.best >= SCREEN_MARGIN):
+            run.bound = max(deferred.best, _best_log_likelihood(s, data, deferred.noise, fit,
+                                                                options, search=True))
     run.caught = [(w.category, str(w.message), w.filename, w.lineno) for w in held]
     return run
 

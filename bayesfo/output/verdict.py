@@ -296,7 +296,7 @@ def _join(items) -> str:
 
 def _noise_sentences(name, result) -> list[tuple[str, bool]]:
     """How the winner's noise model was chosen, and whether its exponents depend on it."""
-    from ..comparison.steps import NOISE_DECISIVE
+    from ..comparison.steps import BOUND_METHOD, NOISE_DECISIVE
 
     record = result.criteria.noise_models
     if not record:
@@ -305,8 +305,12 @@ def _noise_sentences(name, result) -> list[tuple[str, bool]]:
     models = record["models"]
     p = models[chosen]["probability"]
     others = [n for n in models if n != chosen]
+    # Against an upper bound of the other's ln Z, the probability is a lower bound.
+    least = "at least " if any(models[n].get("evidence_method") == BOUND_METHOD
+                               for n in others) else ""
     text = (f"Noise model of {name}: {chosen}, chosen by evidence over "
-            f"{_join(others)} noise" + (f" (probability {p:.3f})." if p is not None else "."))
+            f"{_join(others)} noise"
+            + (f" (probability {least}{p:.3f})." if p is not None else "."))
     if "marginal" in record:
         text += (" Its ln Z in the ranking is averaged over the noise models (equal prior "
                  "weights), as every structure's is.")

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import bayesfo as bf
+from bayesfo.comparison import steps
 from bayesfo.comparison.steps import NOISE_DECISIVE
 from bayesfo.data import FrequencyResponse
 from bayesfo.inference.evidence import Evidence
@@ -152,3 +153,46 @@ def test_the_nested_check_is_compared_with_the_chosen_noise_models_own_ln_z():
     combined = np.hypot(ev.conditional.log_z_err, nested.log_z_err)
     assert result.criteria.evidence_agree == (
         abs(ev.conditional.log_z - nested.log_z) <= 2 * combined)
+
+
+def springpot_data() -> FrequencyResponse:
+    """A springpot, G = 1000 (iω)^0.3 Pa, at 30 frequencies over four decades (|G| spans 1.2),
+    with 5 % constant noise (σ of the median |G|). The fractional Kelvin-Voigt model (two
+    springpots in parallel) has no curvature at its optimum there (its two orders coincide),
+    so importance sampling gives no estimate under constant noise and the tempered ladder gives
+    the posterior."""
+    omega = np.logspace(-2, 2, 30)
+    g = 1000.0 * (1j * omega) ** 0.3
+    rng = np.random.default_rng(1)
+    sd = 0.05 * np.median(np.abs(g))
+    noisy = g + sd / np.sqrt(2) * (rng.normal(size=g.size) + 1j * rng.normal(size=g.size))
+    return FrequencyResponse(omega, noisy, kind="modulus", name="springpot")
+
+
+def test_a_noise_model_below_the_leaders_evidence_at_its_best_fit_is_not_sampled():
+    """Where the screen cannot decide and a posterior promises to be slow, the noise model
+    that reaches the higher likelihood is sampled first; the other is set aside where even its
+    maximum log-likelihood (an upper bound of its ln Z) trails the leader's certified ln Z by
+    5 nats. Checked against that model's own certified posterior: its ln Z lies below the
+    bound, and so does the log-likelihood of every one of its draws (which an optimiser that
+    missed the maximum would not bound); the marginal ln Z of the ranking is that of both
+    posteriors within e^-5 of their sum."""
+    data = springpot_data()
+    name = "fractional_kelvin_voigt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        auto = bf.compare(data, name, seed=3, progress=False)[name]
+        forced = bf.compare(data, name, seed=3, progress=False, noise="proportional")[name]
+    record = auto.criteria.noise_models
+    assert record["chosen"] == "constant" and auto.posterior.sampler == "ladder"
+    bound = record["models"]["proportional"]
+    assert bound["evidence_method"] == steps.BOUND_METHOD
+    given = auto.criteria.evidence.given_noise
+    assert given.log_z - bound["log_evidence"] >= steps.SCREEN_MARGIN
+    assert forced.posterior.converged
+    assert forced.log_z < bound["log_evidence"]
+    assert forced.posterior.max_log_likelihood <= bound["log_evidence"] + 1e-6
+    both = np.logaddexp(given.log_z, forced.log_z) - np.log(2)
+    assert abs(auto.log_z - both) <= np.log1p(np.exp(-steps.SCREEN_MARGIN))
+    assert record["models"]["constant"]["probability"] >= 1 / (1 + np.exp(-steps.SCREEN_MARGIN))
+    assert "higher by at least" in auto.posterior.noise_reason

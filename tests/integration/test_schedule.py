@@ -596,3 +596,36 @@ def test_workers_that_overtake_the_early_optimisations_end_them():
     assert taken == [("zener-int", True, True), ("maxwell-int", False, False)]
     assert here == ["maxwell-int"]  # by the (here: in-process) worker
     assert same and ("<lambda>", "maxwell-int", None) in ran
+
+
+@pytest.mark.parametrize("set_aside, recorder", [(True, _LazyRecorder), (False, _Recorder)])
+def test_a_deferred_noise_model_waits_for_the_leaders_ln_z(monkeypatch, set_aside, recorder):
+    """Where the screen defers a noise model (:func:`~bayesfo.comparison.steps.settle`), the
+    leader's posterior runs first, and the other's only where its bound does not set it aside
+    (forced here by a margin no bound meets), on the automatic schedule and a plain pool with
+    the numbers of the serial path."""
+    from test_noise_choice import springpot_data
+
+    if not set_aside:
+        monkeypatch.setattr(steps, "SCREEN_MARGIN", np.inf)
+    data, name = springpot_data(), "fractional_kelvin_voigt"
+
+    def run(**kw):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return bf.compare(data, name, seed=3, progress=False, **kw)
+
+    serial = run(workers=1)
+    pool = recorder()
+    result = run(pool=pool)
+    if isinstance(pool, _Recorder):
+        pool.pool.shutdown()
+    expected = [("sample_held", name, "constant")]
+    if not set_aside:
+        expected.append(("sample_held", name, "proportional"))
+    assert [step for step in pool.steps if step[0] == "sample_held"] == expected
+    assert _numbers(serial.results) == _numbers(result.results)
+    assert json.dumps(serial.to_summary(), sort_keys=True, default=str) == \
+        json.dumps(result.to_summary(), sort_keys=True, default=str)
+    method = serial[name].criteria.noise_models["models"]["proportional"]["evidence_method"]
+    assert (method == steps.BOUND_METHOD) == set_aside

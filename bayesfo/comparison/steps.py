@@ -346,11 +346,14 @@ def choose_noise(name: str, runs: list[NoiseRun],
     record["sensitive"] = bool(apart)
     record["sensitive_parameters"] = apart
     other = next(i for i in range(len(entries)) if i != best)
-    delta = log_z[best] - log_z[other]
+    with np.errstate(invalid="ignore"):  # neither has an evidence: -inf - -inf
+        delta = log_z[best] - log_z[other]
     reason = (f"chosen by evidence over {' and '.join(e.noise for e in entries)} noise "
               + (f"(ln Z higher by {least}{delta:.1f}; probability {least}"
-                 f"{prob[best]:.3f})"
-                 if np.isfinite(delta) else "(the other has no evidence)"))
+                 f"{prob[best]:.3f})" if np.isfinite(delta) else "(the other has no evidence)")
+              if np.isfinite(log_z[best]) else
+              f"neither {' nor '.join(e.noise for e in entries)} noise has an evidence to "
+              "choose by; the first is kept")
     chosen.post = replace(chosen.post, noise_reason=reason)
     if apart:
         ours, theirs = intervals[best], intervals[other]
@@ -360,8 +363,9 @@ def choose_noise(name: str, runs: list[NoiseRun],
             for p in apart)
         decided = np.isfinite(prob[best]) and prob[best] >= NOISE_DECISIVE
         msg = (f"{name}: the exponents depend on the noise model: 94 % intervals do not overlap "
-               f"({shown}); the evidence favours {entries[best].noise} noise with probability "
-               f"{prob[best]:.3f}")
+               f"({shown}); " + (f"the evidence favours {entries[best].noise} noise with "
+                                 f"probability {least}{prob[best]:.3f}" if np.isfinite(prob[best])
+                                 else "neither noise model has an evidence to choose by"))
         if not decided:
             msg += (". Give sigma per point, or force a model with --noise, if you know how "
                     "the instrument's error scales")

@@ -125,6 +125,20 @@ def test_noise_sensitive_when_the_intervals_part():
         p = 1 / (1 + np.exp(-0.5))
         assert ev.log_z_err == pytest.approx(0.01 * np.hypot(p, 1 - p))
         assert ev.given_noise.log_z == -10.0 and ev.conditional is ev.given_noise
+    # Neither model has an evidence (no admissible prior mass): no probability to state.
+    runs = [run("constant", 0.50, 0.52, -10.0), run("proportional", 0.55, 0.60, -10.5)]
+    for r in runs:
+        r.post, r.criteria["evidence"] = Post(r.post.summary), None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        chosen, record = choose_noise("zener", runs, None)
+    assert record["models"]["constant"]["probability"] is None
+    assert chosen.post.noise_reason == ("neither constant nor proportional noise has an "
+                                        "evidence to choose by; the first is kept")
+    assert [str(w.message).endswith("neither noise model has an evidence to choose by. Give "
+                                    "sigma per point, or force a model with --noise, if you "
+                                    "know how the instrument's error scales") for w in caught] \
+        == [True]
 
 
 def test_q_coverage_with_half_a_decade_and_relative_noise():

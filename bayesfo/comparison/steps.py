@@ -28,6 +28,7 @@ from ..identify.optimize import fit_structure
 from ..inference import Likelihood, starting_points
 from ..inference.adequacy import check_adequacy
 from ..inference.certified import certified_posterior, evidence_check
+from ..inference.evidence import other_noise_evidence
 from ..inference.importance import K_HAT_MAX, screen_noise
 from ..inference.likelihood import NOISE_PRIORS
 from ..structures import Structure
@@ -87,13 +88,14 @@ class NoiseRun:
     post: Any
     criteria: dict
     caught: list = field(default_factory=list)
-    bound: float | None = None
+    aside: dict | None = None
 
 
 class Deferred(NamedTuple):
     """A noise model whose posterior waits for the leader's certified ln Z (:func:`settle`):
     ``best``, the highest log-likelihood under it (with the maximum-likelihood noise scale)
-    found by polishing the structure's optima under its weighting."""
+    found by polishing the structure's optima under its weighting, at an admissible point
+    (−inf where none is)."""
 
     noise: str
     best: float
@@ -233,12 +235,13 @@ NOISE_WEIGHTING = {"constant": "none", "proportional": "relative"}
 
 
 def _best_log_likelihood(s, data, noise, fit, options: RunOptions, *,
-                         search: bool = False) -> float:
+                         search: bool = False) -> tuple[float, float]:
     """The highest log-likelihood of ``s`` under ``noise`` (with the maximum-likelihood noise
-    scale) at the admissible optima of a least-squares fit under its weighting
-    (:data:`NOISE_WEIGHTING`) started from the structure's optima: polished from them alone, or,
-    with ``search``, by the global optimisation of :func:`_fit` (random and linear-method
-    starts besides). −inf where no optimum is admissible."""
+    scale) that a least-squares fit under its weighting (:data:`NOISE_WEIGHTING`) started from
+    the structure's optima finds: polished from them alone, or, with ``search``, by the global
+    optimisation of :func:`_fit` (random and linear-method starts besides). Returns (the value
+    at its best optimum, admissible or not; the value at its best admissible optimum, −inf where
+    none is)."""
     lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
     known = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
     starts = lik.structure.to_physical(known, fit.scaling)
@@ -246,47 +249,66 @@ def _best_log_likelihood(s, data, noise, fit, options: RunOptions, *,
                            weighting=NOISE_WEIGHTING[noise], seed_methods=True) if search else
              fit_structure(lik.structure, data, rng=options.seed, starts=starts, n_starts=1,
                            weighting=NOISE_WEIGHTING[noise], stop_after=None))
-    if not found.optima.size:
-        return -np.inf
-    theta = lik.structure.to_scaled(lik.structure.to_physical(found.optima, found.scaling),
-                                    lik.scaling)
-    return float(np.max(lik(np.column_stack([theta, lik.noise_estimate(theta)]))))
+    best = found.optima if found.optima.size else np.atleast_2d(found.theta_scaled)
+    theta = lik.structure.to_scaled(lik.structure.to_physical(best, found.scaling), lik.scaling)
+    value = float(np.max(lik(np.column_stack([theta, lik.noise_estimate(theta)]))))
+    return value, (value if found.optima.size else -np.inf)
 
 
-def _deferral(s, data, candidates, fit, options: RunOptions, quick) -> Screen | None:
+def _deferral(s, data, candidates, fit, options: RunOptions, quick) -> Screen:
     """Where the screen does not decide and a posterior promises to be slow (a tempered ladder
     or emcee), the noise model whose likelihood reaches higher (polished optima,
     :func:`_best_log_likelihood`) is sampled first, and the other waits for its ln Z
-    (:func:`settle`): ln Z = ln ∫ L π ≤ ln max L, so a model whose maximum log-likelihood
-    trails the leader's certified ln Z by :data:`SCREEN_MARGIN` cannot hold more than e^-5 of
-    their sum. None (both sampled at once) where no optimum is admissible under the other."""
+    (:func:`settle`, :func:`_set_aside`)."""
     best = {n: _best_log_likelihood(s, data, n, fit, options) for n in candidates}
-    leader, other = sorted(candidates, key=lambda n: -best[n])
-    if not np.isfinite(best[other]):
-        return None
+    leader, other = sorted(candidates, key=lambda n: -best[n][0])
     return Screen(leader, {n: q for n, q in quick.items() if q is not None},
-                  Deferred(other, best[other]))
+                  Deferred(other, best[other][1]))
 
 
-#: How the record of a noise model set aside by :func:`settle` names its ln Z.
+#: How the record of a noise model set aside by its maximum likelihood names its ln Z.
 BOUND_METHOD = "upper bound (maximum likelihood)"
+
+
+def _set_aside(s, data, deferred: Deferred | None, fit, options: RunOptions,
+               run: NoiseRun) -> dict | None:
+    """The record (``{"log_z", "method", "intervals"}``) with which the deferred noise model
+    is set aside after the leader's certified posterior ``run``, or None where it must be
+    sampled. Set aside where it trails the leader's ln Z by :data:`SCREEN_MARGIN`, by
+
+    1. its ln Z estimated from the leader's posterior
+       (:func:`~bayesfo.inference.evidence.other_noise_evidence`), where the Pareto k̂ of that
+       estimate is below :data:`~bayesfo.inference.importance.K_HAT_MAX` (the rule of the
+       quick screen), else
+    2. its maximum log-likelihood, an upper bound of its ln Z (ln ∫ L π ≤ ln max L): the
+       polished one of :func:`_deferral`, and where that trails (or none was admissible), the
+       higher of it and a global fit's (:func:`_best_log_likelihood`). The lead and the
+       probability of the leader are then lower bounds."""
+    evidence = run.criteria["evidence"]
+    if deferred is None or evidence is None or not run.post.converged:
+        return None
+    other = Likelihood(s, data, noise=deferred.noise,
+                       priors=options.priors_of(s, deferred.noise))
+    estimate = other_noise_evidence(other, run.lik, run.post, evidence.log_z)
+    if estimate is not None and estimate["k_hat"] < K_HAT_MAX:
+        return estimate if evidence.log_z - estimate["log_z"] >= SCREEN_MARGIN else None
+    if evidence.log_z - deferred.best < SCREEN_MARGIN:
+        return None
+    bound = max(deferred.best, _best_log_likelihood(s, data, deferred.noise, fit, options,
+                                                    search=True)[1])
+    if not (np.isfinite(bound) and evidence.log_z - bound >= SCREEN_MARGIN):
+        return None  # (−inf: no admissible point found, no bound)
+    return {"log_z": bound, "method": BOUND_METHOD, "intervals": {}}
 
 
 def settle(screened: Screen, run: NoiseRun) -> Screen | None:
     """After the leader's posterior (``run``), the deferred noise model of ``screened``: set
-    aside (a :class:`Screen` without ``deferred``, whose record for it holds its upper bound,
-    :data:`BOUND_METHOD`) where the leader's certified ln Z exceeds that bound
-    (``run.bound``, :func:`sample_held`) by :data:`SCREEN_MARGIN`; else None: it is sampled
+    aside with the record that :func:`sample_held` found for it (``run.aside``; see
+    :func:`_set_aside`), as a :class:`Screen` without ``deferred``; None where it is sampled
     too."""
-    other = screened.deferred.noise
-    evidence = run.criteria["evidence"]
-    if (run.bound is None or evidence is None or not run.post.converged
-            or not evidence.log_z - run.bound >= SCREEN_MARGIN):
+    if run.aside is None:
         return None
-    quick = screened.quick.get(other) or {}
-    record = {"log_z": run.bound, "method": BOUND_METHOD,
-              "intervals": quick.get("intervals", {})}
-    return Screen(screened.leader, {**screened.quick, other: record})
+    return Screen(screened.leader, {**screened.quick, screened.deferred.noise: run.aside})
 
 
 def choose_noise(name: str, runs: list[NoiseRun],
@@ -465,18 +487,13 @@ def sample_held(s: Structure, data: FrequencyResponse, noise: str, fit,
     ``run.caught`` (category, message, file, line): only the chosen model's reach the user
     (:func:`conclude`; the other's are kept in its record).
 
-    With ``deferred`` (the noise model waiting for this one's ln Z, :func:`_deferral`), where
-    the certified ln Z exceeds the deferred model's polished maximum log-likelihood by
-    :data:`SCREEN_MARGIN`, its maximum is sought again by a global optimisation, and
-    ``run.bound`` holds the higher of the two (for :func:`settle`)."""
+    With ``deferred`` (the noise model waiting for this one's ln Z, :func:`_deferral`),
+    ``run.aside`` is the record that sets it aside, where this posterior allows
+    (:func:`_set_aside`; for :func:`settle`)."""
     with warnings.catch_warnings(record=True) as held:
         warnings.simplefilter("always")
         run = sample(s, data, noise, fit, options)
-        evidence = run.criteria["evidence"]
-        if (deferred is not None and evidence is not None and run.post.converged
-                and evidence.log_z - deferred.best >= SCREEN_MARGIN):
-            run.bound = max(deferred.best, _best_log_likelihood(s, data, deferred.noise, fit,
-                                                                options, search=True))
+        run.aside = _set_aside(s, data, deferred, fit, options, run)
     run.caught = [(w.category, str(w.message), w.filename, w.lineno) for w in held]
     return run
 

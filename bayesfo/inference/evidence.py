@@ -306,6 +306,46 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
     ), runs
 
 
+def other_noise_evidence(other: Likelihood, lik: Likelihood, posterior: PosteriorResult,
+                         log_z: float) -> dict | None:
+    """ln Z of the same structure under another noise model (``other``), from the posterior
+    under ``lik``, whose ln Z is ``log_z``: both share the structure's prior and support, so
+
+        Z_other = Z · E_p[m_other(θ) / m(θ)],
+
+    m the likelihood with the noise scale integrated out
+    (:meth:`~bayesfo.inference.likelihood.Likelihood.log_noise_marginal`) and p the posterior
+    of the structure parameters θ (its draws). An importance-sampling estimate whose proposal
+    is the posterior under ``lik``: uncertified, and reliable only where the Pareto k̂ of the
+    ratios is small (their tail is heavy where the other noise model's posterior lies away from
+    this one's). Returns ``{"log_z", "k_hat", "intervals", "method"}`` (the exponents' 94 %
+    intervals under ``other`` from the smoothed ratios), as
+    :func:`~bayesfo.inference.importance.screen_noise`; None where m is not available or no
+    ratio is finite."""
+    from ._arviz import psis
+    from .importance import exponent_intervals
+
+    k = lik.structure.n_params
+    theta = np.asarray(posterior.samples_scaled, dtype=float)[:, :k]
+    mine, theirs = lik.log_noise_marginal(theta), other.log_noise_marginal(theta)
+    if mine is None or theirs is None:
+        return None
+    with np.errstate(invalid="ignore"):
+        log_r = theirs - mine
+    finite = np.isfinite(log_r)
+    if finite.sum() < 2:
+        return None
+    smoothed, k_hat = psis(log_r[finite])
+    w = np.exp(smoothed - logsumexp(smoothed))
+    return {"log_z": float(log_z + logsumexp(log_r[finite]) - math.log(log_r.size)),
+            "k_hat": float(k_hat), "intervals": exponent_intervals(other, theta[finite], w),
+            "method": OTHER_NOISE_METHOD}
+
+
+#: How :func:`other_noise_evidence` names its estimate.
+OTHER_NOISE_METHOD = "importance (from the other noise model's posterior)"
+
+
 def nested_evidence(lik: Likelihood, *, seed: int = 0, nlive: int = 500, dlogz: float = 0.1,
                     sample: str = "unif", slices: int | None = None) -> Evidence:
     """ln Z by static nested sampling with dynesty on the same prior and likelihood.

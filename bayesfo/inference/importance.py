@@ -604,7 +604,17 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
         return None
     log_z = float(logsumexp(np.where(finite, log_w, -np.inf)) - math.log(n_proposals)) - log_s
     w = np.exp(smoothed - logsumexp(smoothed))
-    theta = tr.to_theta(x[finite])
+    intervals = exponent_intervals(lik, tr.to_theta(x[finite]), w, interval)
+    name, share = _widest(lik, tr, x[finite], w)
+    return {"log_z": log_z, "k_hat": float(k_hat), "intervals": intervals,
+            "undetermined": name if share > UNDETERMINED else "",
+            "method": "importance (uncertified)"}
+
+
+def exponent_intervals(lik: Likelihood, theta: np.ndarray, w: np.ndarray,
+                       interval: float = 0.94) -> dict:
+    """Central ``interval`` of each exponent (q, α, β, ...) of draws ``theta`` (rows) with
+    normalised weights ``w``: ``{name: (low, high)}``."""
     tail = (1.0 - interval) / 2.0
     intervals = {}
     for i, p in enumerate(lik.structure.parameters):
@@ -615,7 +625,4 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
         lo = theta[order[min(np.searchsorted(cdf, tail), cdf.size - 1)], i]
         hi = theta[order[min(np.searchsorted(cdf, 1.0 - tail), cdf.size - 1)], i]
         intervals[p.name] = (float(lo), float(hi))
-    name, share = _widest(lik, tr, x[finite], w)
-    return {"log_z": log_z, "k_hat": float(k_hat), "intervals": intervals,
-            "undetermined": name if share > UNDETERMINED else "",
-            "method": "importance (uncertified)"}
+    return intervals

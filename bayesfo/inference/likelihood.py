@@ -288,6 +288,38 @@ class Likelihood:
             out[:, k] = theta[:, k] * (g if to_physical else 1.0 / g)
         return out
 
+    def log_noise_marginal(self, theta_structure) -> np.ndarray | None:
+        """The log-likelihood with the noise scale integrated out, ln ∫ L(θ, σ) p(σ) dσ.
+
+        For structure parameters θ (scaled, rows), under the log-uniform prior p(σ) on [a, b],
+        in closed form. With S = Σ_k |r_k|²/w_k (w_k = 1, or |g_k|² under ``proportional``)
+        over n points,
+
+            ∫_a^b σ^(-2n) e^(-S/σ²) dσ/(σ ln(b/a)) = Γ(n) [P(n, S/a²) − P(n, S/b²)] / (2 S^n ln(b/a)),
+
+        P the regularised lower incomplete gamma function. None where it does not apply (known
+        or ``relative_parts`` noise, or a noise prior that is not log-uniform)."""
+        from scipy.special import gammainc, gammaln
+
+        prior = self.noise_param[1] if self.noise_param else None
+        if self.noise not in ("constant", "proportional") or not isinstance(prior, LogUniform):
+            return None
+        theta_structure = np.atleast_2d(theta_structure)
+        model = self.structure.response(theta_structure, self.omega_scaled, self.data.kind)
+        r2 = np.abs(self.g_scaled - model) ** 2
+        n = r2.shape[1]
+        if self.noise == "constant":
+            s, log_w = r2.sum(axis=1), 0.0
+        else:
+            s, log_w = (r2 / self._abs_g2).sum(axis=1), float(np.log(self._abs_g2).sum())
+        a, b = prior.low, prior.high
+        with np.errstate(divide="ignore", invalid="ignore"):
+            mass = gammainc(n, s / a**2) - gammainc(n, s / b**2)
+            out = (n * (self._unit_shift - math.log(math.pi)) - log_w
+                   - math.log(2.0 * math.log(b / a)) + gammaln(n) - n * np.log(s)
+                   + np.log(mass))
+        return np.where(np.isfinite(out), out, -np.inf)
+
     def noise_estimate(self, theta_structure) -> np.ndarray:
         """The noise parameter that maximises the likelihood for given structure parameters
         (scaled): sqrt(mean |r|²) (``constant``), sqrt(mean |r|²/|G|²) (``proportional``) or the

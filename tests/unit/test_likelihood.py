@@ -83,3 +83,28 @@ def test_prior_overrides():
     assert lik.prior_list[-1] == LogUniform(1e-3, 1.0)
     with pytest.raises(InputError, match="unknown parameter 'c'"):
         Likelihood(ZENER, _data(), priors={"c": LogUniform(1, 2)})
+
+
+@pytest.mark.parametrize("noise", ["constant", "proportional"])
+def test_the_noise_scale_integrated_out_matches_quadrature(noise):
+    """Likelihood.log_noise_marginal (closed form, incomplete gamma) against scipy's quadrature
+    of exp(ln L(θ, σ)) over the log-uniform prior of σ, at the truth and away from it."""
+    from scipy import integrate
+
+    lik = Likelihood(ZENER, _data(), noise=noise)
+    truth = lik.to_scaled(np.append(TRUTH, 1.0))[0, :4]
+    theta = np.vstack([truth, truth * [1.02, 0.97, 1.05, 1.01]])
+    got = lik.log_noise_marginal(theta)
+    prior = lik.noise_param[1]
+    for row, value in zip(theta, got, strict=True):
+        peak = np.log(lik.noise_estimate(row[None, :])[0])
+
+        def density(log_s, row=row, value=value):
+            full = np.append(row, np.exp(log_s))[None, :]
+            return np.exp(lik(full)[0] - value) / np.log(prior.high / prior.low)
+
+        total, _ = integrate.quad(density, np.log(prior.low), np.log(prior.high),
+                                  points=[peak], limit=200)
+        assert total == pytest.approx(1.0, rel=1e-8)
+    assert Likelihood(ZENER, _data(sigma=np.full(25, 2e-5)), noise="known") \
+        .log_noise_marginal(theta) is None

@@ -365,7 +365,9 @@ def choose_noise(name: str, runs: list[NoiseRun],
         spans = [iv[param] for iv in intervals if param in iv]
         if max(lo for lo, _ in spans) > min(hi for _, hi in spans):
             apart.append(param)
-    record["sensitive"] = bool(apart)
+    # Unknown (None) where a model set aside by its maximum likelihood has no intervals.
+    unknown = any(param not in iv for iv in intervals for param in intervals[best])
+    record["sensitive"] = True if apart else (None if unknown else False)
     record["sensitive_parameters"] = apart
     other = next(i for i in range(len(entries)) if i != best)
     with np.errstate(invalid="ignore"):  # neither has an evidence: -inf - -inf

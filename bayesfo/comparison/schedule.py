@@ -207,8 +207,8 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 future.cancel()
 
     def sample(i):
-        # Step (2) of every noise model to sample now; the leader's run also bounds the
-        # deferred one's evidence.
+        # Step (2) of every noise model to sample now; the leader's run also finds whether the
+        # deferred one can be set aside (steps.settle).
         fit, screened, noises = prepared[i]
         for noise in noises:
             submit(i, noise, sample_held, structures[i], data, noise, fit, options,

@@ -35,9 +35,10 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
+from ._arviz import psis
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
-from .results import PosteriorResult
+from .results import PosteriorResult, exponent_intervals
 from .smc import ladder_runs_together
 from .transform import _log_prob_fn, _Transform
 
@@ -322,9 +323,6 @@ def other_noise_evidence(other: Likelihood, lik: Likelihood, posterior: Posterio
     intervals under ``other`` from the smoothed ratios), as
     :func:`~bayesfo.inference.importance.screen_noise`; None where m is not available or no
     ratio is finite."""
-    from ._arviz import psis
-    from .importance import exponent_intervals
-
     k = lik.structure.n_params
     theta = np.asarray(posterior.samples_scaled, dtype=float)[:, :k]
     mine, theirs = lik.log_noise_marginal(theta), other.log_noise_marginal(theta)

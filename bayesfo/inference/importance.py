@@ -72,6 +72,7 @@ from ._arviz import psis
 from ._peaks import DF, _hessian, _mixture_log_pdf, _polish
 from ._ridge import PROBE_MAX_DIM, PROBE_MISSED, _ridge_probe
 from .likelihood import Likelihood
+from .results import exponent_intervals
 from .transform import _Unbounded
 
 #: Certificate of the importance weights: Pareto k̂ below this (Vehtari et al.'s threshold of
@@ -610,19 +611,3 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
             "undetermined": name if share > UNDETERMINED else "",
             "method": "importance (uncertified)"}
 
-
-def exponent_intervals(lik: Likelihood, theta: np.ndarray, w: np.ndarray,
-                       interval: float = 0.94) -> dict:
-    """Central ``interval`` of each exponent (q, α, β, ...) of draws ``theta`` (rows) with
-    normalised weights ``w``: ``{name: (low, high)}``."""
-    tail = (1.0 - interval) / 2.0
-    intervals = {}
-    for i, p in enumerate(lik.structure.parameters):
-        if p.role != "exponent":
-            continue
-        order = np.argsort(theta[:, i])
-        cdf = np.cumsum(w[order])
-        lo = theta[order[min(np.searchsorted(cdf, tail), cdf.size - 1)], i]
-        hi = theta[order[min(np.searchsorted(cdf, 1.0 - tail), cdf.size - 1)], i]
-        intervals[p.name] = (float(lo), float(hi))
-    return intervals

@@ -406,3 +406,19 @@ def save_netcdf(idata, path) -> Path:
         raise
     return path
 
+
+def exponent_intervals(lik: Likelihood, theta: np.ndarray, w: np.ndarray,
+                       interval: float = 0.94) -> dict:
+    """Central ``interval`` of each exponent (q, α, β, ...) of draws ``theta`` (rows) with
+    normalised weights ``w``: ``{name: (low, high)}``."""
+    tail = (1.0 - interval) / 2.0
+    intervals = {}
+    for i, p in enumerate(lik.structure.parameters):
+        if p.role != "exponent":
+            continue
+        order = np.argsort(theta[:, i])
+        cdf = np.cumsum(w[order])
+        lo = theta[order[min(np.searchsorted(cdf, tail), cdf.size - 1)], i]
+        hi = theta[order[min(np.searchsorted(cdf, 1.0 - tail), cdf.size - 1)], i]
+        intervals[p.name] = (float(lo), float(hi))
+    return intervals

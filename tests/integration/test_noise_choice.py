@@ -174,9 +174,10 @@ def test_the_nested_check_is_compared_with_the_chosen_noise_models_own_ln_z():
 def springpot_data() -> FrequencyResponse:
     """A springpot, G = 1000 (iω)^0.3 Pa, at 30 frequencies over four decades (|G| spans 1.2),
     with 5 % constant noise (σ of the median |G|). The fractional Kelvin-Voigt model (two
-    springpots in parallel) has no curvature at its optimum there (its two orders coincide),
-    so importance sampling gives no estimate under constant noise and the tempered ladder gives
-    the posterior."""
+    springpots in parallel) fits it with one springpot's coefficient small, which leaves its
+    order α undetermined: the quick estimates do not promise a quick posterior (and the
+    proportional model's is heavy-tailed, so the screen does not decide), and the tempered
+    ladder gives the posterior."""
     omega = np.logspace(-2, 2, 30)
     g = 1000.0 * (1j * omega) ** 0.3
     rng = np.random.default_rng(1)

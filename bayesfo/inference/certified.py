@@ -29,7 +29,8 @@ The routes, in order, with ``sampler="auto"``:
    (and proposing in the configurations where an element vanishes that the search found, as
    every ladder of this module does): their final particles are the posterior when the runs
    agree (R-hat < 1.01, ESS ≥ 400), and their ln Z the evidence; where they do not, two more
-   runs, and the four where the new pair agrees and all four agree;
+   runs (unless one of the first ended more than :data:`LADDER_SHORTFALL` below the best fit,
+   which more runs cannot mend), and the four where the new pair agrees and all four agree;
 3. else emcee from the optima (and any other starts given); ln Z by bridge sampling from its
    draws where the walkers converged, else by a tempered ladder guided by them, whose
    particles replace the walkers' draws when its runs agree. A posterior that no route
@@ -161,9 +162,14 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
             guide = (info or {}).get("proposal_draws")
             if slabs is None:
                 slabs = configurations(lik, modes, guide)
-            post, ev, tried, more = _ladder_first(lik, seed, guide, slabs)
+            # The log-likelihood the runs must reach (within LADDER_SHORTFALL): the best start
+            # moved into the support where no optimum is admissible; else the best fit's.
+            reach = (_seeds_log_likelihood(lik, starts, seed) if not modes.size
+                     else fit_log_likelihood)
+            post, ev, tried, more = _ladder_first(lik, seed, guide, slabs, reach)
             if post is not None and not modes.size \
-                    and (tried := _short_of_seeds(lik, starts, ev, seed)) is not None:
+                    and (tried := _shortfall(reach, ev, "the best fit moved into the "
+                                             "posterior's support")) is not None:
                 post = ev = more = None
             if post is not None and not modes.size:
                 notes.append(f"{name}: no optimum found lies in the posterior's support "
@@ -261,7 +267,7 @@ def _configurations_checked(lik, modes, post, ev, info: dict, seed: int):
     return None, None, slabs
 
 
-def _ladder_first(lik, seed: int, guide=None, slabs=()):
+def _ladder_first(lik, seed: int, guide=None, slabs=(), reach: float = -math.inf):
     """Where importance sampling does not certify the posterior (ridges, several regions) or
     has no proposal (no admissible optimum), the tempered ladder's two independent runs: their
     final particles are the posterior when the runs agree (R-hat < 1.01, ESS ≥ 400; see
@@ -283,7 +289,11 @@ def _ladder_first(lik, seed: int, guide=None, slabs=()):
     found; the ladder's independence moves propose from them too, so that a narrow mode with
     little prior mass that the optimiser found is not lost (see
     :func:`~bayesfo.inference.smc.ladder_run`); ``slabs``: the configurations where an element
-    vanishes (:mod:`~bayesfo.inference._configurations`), where the ladder proposes too."""
+    vanishes (:mod:`~bayesfo.inference._configurations`), where the ladder proposes too;
+    ``reach``: the log-likelihood that the runs must reach within :data:`LADDER_SHORTFALL`
+    (the best fit's, or the best start's moved into the support): where the first two runs
+    disagree and one ended further below, they missed the region around it, which more runs
+    cannot mend (a run that falls short keeps the four short), so none are made."""
     def why(post):
         return "; ".join(m.split(": ", 1)[-1] for m in post.messages)
 
@@ -292,6 +302,8 @@ def _ladder_first(lik, seed: int, guide=None, slabs=()):
         first = ladder_agreement(lik, runs, seed=seed)
         if first.converged:
             return posterior_from_particles(lik, runs, seed=seed, agreement=first), ev, None, None
+        if (short := _shortfall(reach, ev, "the best fit")) is not None:
+            return None, None, f"{why(first)}; {short}", None
         ev, runs = ladder_runs(lik, seed=seed, guide=guide, earlier=runs, slabs=slabs)
         second = ladder_agreement(lik, runs[len(runs) // 2:], seed=seed)
         if not second.converged:
@@ -309,23 +321,28 @@ def _ladder_first(lik, seed: int, guide=None, slabs=()):
     return post, ev, None, note
 
 
-def _short_of_seeds(lik, starts, ev: Evidence, seed: int) -> str | None:
-    """Where no optimum is admissible, the ladder runs that started from the prior unguided
-    must reach, within :data:`LADDER_SHORTFALL`, the log-likelihood of the best of ``starts``
-    (the optimiser's best fit among them) moved into the support: a run that ends further below
-    missed the region around it, which emcee, started there, explores. Returns why the runs
-    are set aside, or None."""
+def _seeds_log_likelihood(lik, starts, seed: int) -> float:
+    """The log-likelihood of the best of ``starts`` (the optimiser's best fit among them)
+    moved into the support; −inf where there are none, or none could be moved there."""
     if starts is None or not np.size(starts):
-        return None
+        return -math.inf
     try:
         _, ll = support_seeds(lik, starts, np.random.default_rng(seed))
     except InputError:  # no start in the support, nor any prior draw: nothing to compare
-        return None
-    gap = float(ll[0]) - ev.reached_log_likelihood
+        return -math.inf
+    return float(ll[0])
+
+
+def _shortfall(reach: float, ev: Evidence, what: str) -> str | None:
+    """Why the tempered-ladder runs of ``ev`` are set aside: the run that reached least high
+    ended more than :data:`LADDER_SHORTFALL` below ``reach`` (the log-likelihood of ``what``),
+    missing the region around it; None where they reached it (or ``reach`` is −inf). Where
+    no optimum is admissible, emcee, started from the best fit moved into the support,
+    explores that region instead."""
+    gap = reach - ev.reached_log_likelihood
     if not gap > LADDER_SHORTFALL:
         return None
-    return (f"a run ended {gap:.1f} nats below the best fit moved into the posterior's support, "
-            "missing the region around it")
+    return f"a run ended {gap:.1f} nats below {what}, missing the region around it"
 
 
 #: Share of the particles of the tempered ladder run for ln Z beside an importance posterior

@@ -142,15 +142,19 @@ def _prior_particles(target: _Target, n: int, rng: np.random.Generator,
     """``n`` prior draws in the support (by rejection), in the sampling coordinates.
 
     Each batch is sized by the admissible fraction seen so far (the support check costs several
-    times a likelihood evaluation per draw, so drawing far more than needed is not free)."""
+    times a likelihood evaluation per draw, so drawing far more than needed is not free). The
+    search gives up once even a generous upper bound of that fraction (:func:`_upper_count`)
+    leaves fewer than ``n`` admissible draws within ``max_draws``: drawing on would end with
+    the same error, later."""
     lik = target.lik
     batch = 2 * n
     kept, drawn, found = [], 0, 0
     while found < n:
-        if drawn >= max_draws:
+        if drawn >= max_draws or found + _upper_count(found, drawn, max_draws - drawn) < n:
             raise InputError(
-                f"structure '{lik.structure.name}': fewer than {n} of {drawn} prior draws are "
-                "stable and dissipative, too few to start the tempered ladder")
+                f"structure '{lik.structure.name}': only {found} of {drawn} prior draws are "
+                f"stable and dissipative, too few to start the tempered ladder (it needs {n} "
+                f"within {max_draws} draws)")
         theta = np.column_stack([p.sample(rng, batch) for p in lik.prior_list])
         drawn += batch
         theta = theta[lik.in_support(theta)]
@@ -159,6 +163,22 @@ def _prior_particles(target: _Target, n: int, rng: np.random.Generator,
         fraction = max(found, 1) / drawn
         batch = int(min(max(1.5 * (n - found) / fraction, n), 20 * n, 200_000))
     return np.concatenate(kept)[:n]
+
+
+#: Standard deviations by which :func:`_upper_count` overstates the admissible fraction seen
+#: (the search gives up only where the fraction is far below what ``n`` draws would need).
+UPPER_SD = 5.0
+
+
+def _upper_count(found: int, drawn: int, more: int) -> float:
+    """A generous upper bound of the admissible draws among ``more`` further prior draws,
+    after ``found`` of ``drawn``: the rate's bound (found + z²/2 + z √(found + z²/4)) / drawn
+    (Wilson's interval for a count, z = :data:`UPPER_SD`), times ``more``; infinite before
+    the first draw."""
+    if drawn <= 0:
+        return math.inf
+    z = UPPER_SD
+    return (found + z * z / 2 + z * math.sqrt(found + z * z / 4)) / drawn * more
 
 
 def unique_rows(x: np.ndarray) -> np.ndarray:

@@ -270,6 +270,43 @@ def test_ladder_runs_short_of_the_best_fit_moved_into_the_support_hand_over_to_e
     assert not any("no optimum found lies" in w for w in r.criteria.warnings)
 
 
+def test_no_more_ladder_runs_where_the_first_two_disagree_short_of_the_best_fit(monkeypatch):
+    # As above, but the first two runs disagree: two more runs could not reach the region
+    # they missed (the four's shortfall is that of the run that reached least high), so none
+    # are made, and emcee gives the posterior as before.
+    import dataclasses
+
+    import bayesfo.inference.certified as route
+
+    real_seeds, real_agreement, real_runs = (route.support_seeds, route.ladder_agreement,
+                                             route.ladder_runs)
+    calls = []
+
+    def far_better(lik, seeds, rng, **kwargs):
+        seeds, _ = real_seeds(lik, seeds, rng, **kwargs)
+        return seeds[:1], np.array([-400.0])
+
+    def disagree(lik, runs, **kwargs):
+        found = real_agreement(lik, runs, **kwargs)
+        return dataclasses.replace(found, messages=found.messages + ("made to disagree",))
+
+    def counted(lik, **kwargs):
+        calls.append("earlier" in kwargs)
+        return real_runs(lik, **kwargs)
+
+    monkeypatch.setattr(route, "support_seeds", far_better)
+    monkeypatch.setattr(route, "ladder_agreement", disagree)
+    monkeypatch.setattr(route, "ladder_runs", counted)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = bf.compare(bf.read(DATA.with_name("Tm020C.csv")), "maxwell", seed=0, workers=1,
+                       progress=False, noise="constant")["maxwell"]
+    assert calls[0] is False and True not in calls  # the first pair, and no runs added to it
+    assert r.posterior.sampler == "emcee" and r.posterior.converged
+    note = next(w for w in r.criteria.warnings if "tried first did not certify" in w)
+    assert "made to disagree; a run ended " in note and "nats below the best fit" in note
+
+
 @pytest.mark.slow
 def test_runs_from_the_prior_that_miss_the_best_fit_region_are_set_aside_on_silk():
     # The generalised Maxwell max-n1m2-inv on the silk feedstock (GPL, read in place): no

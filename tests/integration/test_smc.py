@@ -14,7 +14,14 @@ from scipy.special import logsumexp
 
 from bayesfo.errors import InputError
 from bayesfo.inference.evidence import ladder_evidence
-from bayesfo.inference.smc import _next_beta, _systematic, ladder_run, ladder_runs_together
+from bayesfo.inference.smc import (
+    _next_beta,
+    _prior_particles,
+    _systematic,
+    _Target,
+    ladder_run,
+    ladder_runs_together,
+)
 from bayesfo.priors import Uniform
 
 MEANS = np.array([[-6.0, -4.0], [5.0, 3.0]])
@@ -303,3 +310,34 @@ def test_runs_of_a_helper_that_fails_go_on_where_they_were():
     same, helpers, pid, helped, sent = in_fresh_process(_runs_with_a_helper, True)
     assert helpers == 1 and sent == [None]
     assert all(same) and helped == [None, None, None]
+
+
+class _SmallSupport(_TwoModes):
+    """The two-mode likelihood whose support is a disc of radius ``r`` about the origin: an
+    admissible fraction π r² / 400 of the uniform prior. Counts the prior draws checked."""
+
+    def __init__(self, fraction):
+        super().__init__()
+        self.radius = math.sqrt(fraction * 400.0 / math.pi)
+        self.checked = 0
+
+    def in_support(self, theta):
+        theta = np.atleast_2d(theta)
+        self.checked += len(theta)
+        return np.sum(theta**2, axis=1) <= self.radius**2
+
+
+def test_the_ladder_gives_up_early_where_too_few_prior_draws_are_admissible():
+    # 100 admissible draws within 500 000 need a fraction of 2e-4: at 1e-4 (about 50 expected)
+    # the search ends as soon as a bound 5 standard deviations above the fraction seen falls
+    # short, with the error the full search would have given.
+    lik = _SmallSupport(1e-4)
+    with pytest.raises(InputError, match=r"only \d+ of \d+ prior draws .* too few to start the "
+                                         r"tempered ladder \(it needs 100 within 500000"):
+        _prior_particles(_Target(lik), 100, np.random.default_rng(0), max_draws=500_000)
+    assert lik.checked < 300_000
+    # At 2.6e-4 (about 130 expected within the limit) it goes on, to the end where needed.
+    for seed in range(5):
+        lik = _SmallSupport(2.6e-4)
+        u = _prior_particles(_Target(lik), 100, np.random.default_rng(seed), max_draws=500_000)
+        assert u.shape == (100, 2) and np.all(lik.in_support(u))

@@ -108,6 +108,7 @@ The argument checks and the sentences of the verdict are in
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -359,6 +360,40 @@ def _noise_sd(lik: Likelihood, theta: np.ndarray) -> np.ndarray:
     return s * np.abs(lik.g_scaled)[None, :]
 
 
+#: The reference distributions kept (:func:`_reference`), by the generator's state.
+REFERENCES_KEPT = 4
+_references: dict = {}
+_references_lock = threading.Lock()
+
+
+def _reference(rng: np.random.Generator, n_reference: int, n: int) -> dict:
+    """The sorted reference distribution of each statistic: its value on ``n_reference`` data
+    sets of ``n`` unit normal residual pairs drawn from ``rng``, which is left as the draws
+    leave it.
+
+    The residuals depend on nothing but the generator's state, which the structures of one
+    comparison share (the same seed, and as many posterior draws): the last
+    :data:`REFERENCES_KEPT` are kept by that state, with the state the draws leave, and given
+    again without drawing (the same numbers)."""
+    key = (repr(rng.bit_generator.state), n_reference, n)
+    with _references_lock:
+        kept = _references.get(key)
+    if kept is None:
+        a_rep, b_rep = rng.normal(size=(2, n_reference, n))
+        values = {}
+        for name in STATISTICS:
+            values[name] = np.sort(_STAT_FUNCS[name](a_rep, b_rep))
+            values[name].flags.writeable = False
+        kept = (values, rng.bit_generator.state)
+        with _references_lock:
+            while _references and len(_references) >= REFERENCES_KEPT:
+                del _references[next(iter(_references))]
+            _references[key] = kept
+    else:
+        rng.bit_generator.state = kept[1]
+    return dict(kept[0])
+
+
 # ---------------------------------------------------------------------- the check
 def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, level: float = LEVEL,
                    n_draws: int = N_DRAWS, n_reference: int = N_REFERENCE,
@@ -434,17 +469,16 @@ def check_adequacy(lik: Likelihood, post: PosteriorResult, *, seed: int = 0, lev
     # unit normal draws themselves, rotated by a phase factor that leaves them unit normal: the
     # reference of every statistic is simulated from those draws directly (n_reference data
     # sets), and y_rep itself is formed only for the predictive band (REPLICATES_PER_DRAW each).
-    a_rep, b_rep = rng.normal(size=(2, n_reference, n))
+    reference = _reference(rng, n_reference, n)
     a_obs, b_obs = (_normalised_parts if parts else _normalised)(g[None, :], model, sd)
 
-    p_values, statistics, reference = {}, {}, {}
+    p_values, statistics = {}, {}
     for name in STATISTICS:
-        t_rep = np.sort(_STAT_FUNCS[name](a_rep, b_rep))
+        t_rep = reference[name]
         t_obs = _STAT_FUNCS[name](a_obs, b_obs)
         exceed = t_rep.size - np.searchsorted(t_rep, t_obs, side="left")
         p_values[name] = float(np.mean((1.0 + exceed) / (1.0 + t_rep.size)))
         statistics[name] = float(np.median(t_obs))
-        reference[name] = t_rep
     per_stat = level / len(STATISTICS)
     failed = [name for name in STATISTICS if p_values[name] < per_stat]
 

@@ -252,6 +252,33 @@ def test_same_seed_same_numbers(zener_on_zener):
         assert other.p_values[name] == pytest.approx(first.p_values[name], abs=0.1)
 
 
+def test_a_reference_kept_from_an_earlier_check_gives_the_numbers_of_a_fresh_one(
+        zener_on_zener, monkeypatch):
+    # The reference distributions depend only on the generator's state: a second check from
+    # the same state takes them from the first, without drawing, and gives the same numbers
+    # (the predictive band, drawn after them, included).
+    import bayesfo.inference.adequacy as adequacy
+
+    lik, post, first = zener_on_zener
+    rows = []
+    real_scan = adequacy._STAT_FUNCS["scan"]
+
+    def scan(a, b):
+        rows.append(a.shape[0])
+        return real_scan(a, b)
+
+    monkeypatch.setattr(adequacy, "_references", {})  # nothing kept yet
+    monkeypatch.setitem(adequacy._STAT_FUNCS, "scan", scan)
+    fresh = check_adequacy(lik, post, seed=0)
+    kept = check_adequacy(lik, post, seed=0)
+    assert fresh == first and kept == first
+    assert rows.count(adequacy.N_REFERENCE) == 1  # the reference's scan, once
+    assert len(adequacy._references) == 1
+    other = check_adequacy(lik, post, seed=1)  # another state: drawn afresh, and kept too
+    assert rows.count(adequacy.N_REFERENCE) == 2 and len(adequacy._references) == 2
+    assert other.p_values != first.p_values
+
+
 def test_to_dict_is_json_with_finite_numbers(springpot_fits):
     lik, post = springpot_fits["zener"]
     result = check_adequacy(lik, post, seed=0)

@@ -144,8 +144,8 @@ def _prior_particles(target: _Target, n: int, rng: np.random.Generator,
     Each batch is sized by the admissible fraction seen so far (the support check costs several
     times a likelihood evaluation per draw, so drawing far more than needed is not free). The
     search gives up once even a generous upper bound of that fraction (:func:`_upper_count`)
-    leaves fewer than ``n`` admissible draws within ``max_draws``: drawing on would end with
-    the same error, later."""
+    leaves fewer than ``n`` admissible draws within ``max_draws``: drawing on would, all but
+    surely, end with the same error, later."""
     lik = target.lik
     batch = 2 * n
     kept, drawn, found = [], 0, 0
@@ -172,9 +172,9 @@ UPPER_SD = 5.0
 
 def _upper_count(found: int, drawn: int, more: int) -> float:
     """A generous upper bound of the admissible draws among ``more`` further prior draws,
-    after ``found`` of ``drawn``: the rate's bound (found + z²/2 + z √(found + z²/4)) / drawn
-    (Wilson's interval for a count, z = :data:`UPPER_SD`), times ``more``; infinite before
-    the first draw."""
+    after ``found`` of ``drawn``: the rate's bound (found + z²/2 + z √(found + z²/4)) / drawn,
+    the upper end of Wilson's score interval (z = :data:`UPPER_SD`) made larger still by
+    leaving out its factors below one, times ``more``; infinite before the first draw."""
     if drawn <= 0:
         return math.inf
     z = UPPER_SD

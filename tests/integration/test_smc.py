@@ -330,7 +330,7 @@ class _SmallSupport(_TwoModes):
 def test_the_ladder_gives_up_early_where_too_few_prior_draws_are_admissible():
     # 100 admissible draws within 500 000 need a fraction of 2e-4: at 1e-4 (about 50 expected)
     # the search ends as soon as a bound 5 standard deviations above the fraction seen falls
-    # short, with the error the full search would have given.
+    # short, with the error that the full search ends with.
     lik = _SmallSupport(1e-4)
     with pytest.raises(InputError, match=r"only \d+ of \d+ prior draws .* too few to start the "
                                          r"tempered ladder \(it needs 100 within 500000"):

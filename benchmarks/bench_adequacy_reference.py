@@ -1,5 +1,5 @@
 """CPU time of the adequacy checks of one comparison, with the reference distributions drawn
-afresh for every check and kept from the first (:func:`bayesfo.inference.adequacy._reference`).
+afresh for every check and kept from the first (:func:`bayesfo.inference.adequacy._drawn`).
 
 The default structures on the bundled 17-point adhesive isotherm at 20 °C, ``compare`` in one
 process (``workers=1``), rounds alternating the two ways; prints the checks' summed time per
@@ -42,7 +42,7 @@ def main() -> None:
 
     def timed(*a, fresh=False, **k):
         if fresh:
-            adequacy._references.clear()
+            adequacy._drawn.cache_clear()
         t = time.process_time()
         out = real(*a, **k)
         timed.seconds += time.process_time() - t
@@ -52,7 +52,7 @@ def main() -> None:
           f"{platform.python_version()}; load {os.getloadavg()[0]:.2f}")
     for _ in range(args.rounds):
         for way in ("fresh", "kept"):
-            adequacy._references.clear()
+            adequacy._drawn.cache_clear()
             timed.seconds = 0.0
             steps.check_adequacy = lambda *a, _f=(way == "fresh"), **k: timed(*a, fresh=_f, **k)
             try:

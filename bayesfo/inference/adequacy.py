@@ -107,8 +107,9 @@ The argument checks and the sentences of the verdict are in
 
 from __future__ import annotations
 
+import functools
+import json
 import math
-import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -360,10 +361,8 @@ def _noise_sd(lik: Likelihood, theta: np.ndarray) -> np.ndarray:
     return s * np.abs(lik.g_scaled)[None, :]
 
 
-#: The reference distributions kept (:func:`_reference`), by the generator's state.
+#: The reference distributions kept (:func:`_drawn`), by the generator's state.
 REFERENCES_KEPT = 4
-_references: dict = {}
-_references_lock = threading.Lock()
 
 
 def _reference(rng: np.random.Generator, n_reference: int, n: int) -> dict:
@@ -375,23 +374,20 @@ def _reference(rng: np.random.Generator, n_reference: int, n: int) -> dict:
     comparison share (the same seed, and as many posterior draws): the last
     :data:`REFERENCES_KEPT` are kept by that state, with the state the draws leave, and given
     again without drawing (the same numbers)."""
-    key = (repr(rng.bit_generator.state), n_reference, n)
-    with _references_lock:
-        kept = _references.get(key)
-    if kept is None:
-        a_rep, b_rep = rng.normal(size=(2, n_reference, n))
-        values = {}
-        for name in STATISTICS:
-            values[name] = np.sort(_STAT_FUNCS[name](a_rep, b_rep))
-            values[name].flags.writeable = False
-        kept = (values, rng.bit_generator.state)
-        with _references_lock:
-            while _references and len(_references) >= REFERENCES_KEPT:
-                del _references[next(iter(_references))]
-            _references[key] = kept
-    else:
-        rng.bit_generator.state = kept[1]
-    return dict(kept[0])
+    values, after = _drawn(json.dumps(rng.bit_generator.state), n_reference, n)
+    rng.bit_generator.state = after
+    return dict(values)
+
+
+@functools.lru_cache(maxsize=REFERENCES_KEPT)
+def _drawn(state: str, n_reference: int, n: int) -> tuple[dict, dict]:
+    rng = np.random.default_rng()
+    rng.bit_generator.state = json.loads(state)
+    a_rep, b_rep = rng.normal(size=(2, n_reference, n))
+    values = {name: np.sort(_STAT_FUNCS[name](a_rep, b_rep)) for name in STATISTICS}
+    for v in values.values():
+        v.flags.writeable = False
+    return values, rng.bit_generator.state
 
 
 # ---------------------------------------------------------------------- the check

@@ -267,15 +267,16 @@ def test_a_reference_kept_from_an_earlier_check_gives_the_numbers_of_a_fresh_one
         rows.append(a.shape[0])
         return real_scan(a, b)
 
-    monkeypatch.setattr(adequacy, "_references", {})  # nothing kept yet
+    adequacy._drawn.cache_clear()  # nothing kept yet
     monkeypatch.setitem(adequacy._STAT_FUNCS, "scan", scan)
     fresh = check_adequacy(lik, post, seed=0)
     kept = check_adequacy(lik, post, seed=0)
     assert fresh == first and kept == first
     assert rows.count(adequacy.N_REFERENCE) == 1  # the reference's scan, once
-    assert len(adequacy._references) == 1
+    assert adequacy._drawn.cache_info().currsize == 1
     other = check_adequacy(lik, post, seed=1)  # another state: drawn afresh, and kept too
-    assert rows.count(adequacy.N_REFERENCE) == 2 and len(adequacy._references) == 2
+    assert rows.count(adequacy.N_REFERENCE) == 2
+    assert adequacy._drawn.cache_info().currsize == 2
     assert other.p_values != first.p_values
 
 

@@ -564,7 +564,7 @@ def _adapted(first, n_proposals: int, rng: np.random.Generator):
 def _log_support(lik, rng):
     from .evidence import log_support_fraction
 
-    return log_support_fraction(lik, rng, n=5000)
+    return log_support_fraction(lik, rng, n=5000, max_draws=5000)
 
 
 def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: int = 5000,

@@ -15,8 +15,12 @@ leaves the box; the weights are then the posterior density in z (the density in 
 Jacobian |du/dz|) over the proposal's, so that their mean is still the evidence. The proposal
 stays in u wherever it keeps its draws: a coordinate that leans on a bound along a ridge is
 covered better there, by a component cut at the bound, than in z, where the curvature at the
-mode does not reach along the ridge (BENCHMARKS.md, twelfth session). One vectorised call of
-the likelihood on 20 000 proposal draws gives the importance weights, and from them
+mode does not reach along the ridge (BENCHMARKS.md, twelfth session). An optimum on the edge
+of the support inside the box (a coefficient at 0 where its element vanishes, two orders that
+meet) has no difference stencil around it: the curvature is taken a few (smaller) steps inside
+(:func:`~._peaks._inward`), and the component spills part of its draws over the edge, where their weight
+is zero. One vectorised call of the likelihood on 20 000 proposal draws gives the importance
+weights, and from them
 
 * the evidence, ln Z' = ln mean(w), with the standard error of that mean (the prior normalised
   on its support as elsewhere: ln Z = ln Z' − ln P(S)), where k̂ < 0.5;
@@ -69,7 +73,7 @@ from scipy.special import logsumexp
 
 from ..errors import InputError
 from ._arviz import psis
-from ._peaks import DF, _hessian, _mixture_log_pdf, _polish
+from ._peaks import DF, _laplace, _mixture_log_pdf, _polished
 from ._ridge import PROBE_MAX_DIM, PROBE_MISSED, _ridge_probe
 from .likelihood import Likelihood
 from .results import exponent_intervals
@@ -105,56 +109,6 @@ NEWTON = 4
 FIT_DRAWS = 4000
 FIT_SCALE = 1.6
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
-
-
-def _polished(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """:func:`_polish` within the box: an optimum on a bound of the prior box (a coefficient at
-    its smallest value) is moved just inside, so that the difference stencil of
-    :func:`_laplace` stays in the box."""
-    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u0))
-    h = 1e-4 * span
-    return _polish(f, np.clip(u0, lo + 3 * h, hi - 3 * h), lo + 3 * h, hi - 3 * h)
-
-
-def _laplace(f, u0: np.ndarray, lo: np.ndarray, hi: np.ndarray, newton_steps: int = 4,
-             broad: float | None = None, polish: bool = True):
-    """The mode near ``u0`` (a few Newton steps on the log posterior) and the Laplace
-    approximation there, as the eigenvalues and eigenvectors ``(w, v)`` of its precision
-    (directions without curvature floored at the variance ``broad``, by default one that
-    spreads over the box, see below); None where the difference stencil leaves the support or
-    the Hessian is singular or not finite."""
-    span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u0))
-    h = 1e-4 * span
-    u = _polished(f, u0, lo, hi) if polish else np.clip(u0, lo + 3 * h, hi - 3 * h)
-    best = None
-    for _ in range(newton_steps + 1):
-        out = _hessian(f, u, h)
-        if out is None:
-            return None
-        f0, grad, hess = out
-        try:
-            step = np.linalg.solve(hess, -grad)
-        except np.linalg.LinAlgError:
-            return None
-        best = (f0, u, hess)
-        cand = u + step
-        if not np.all(np.isfinite(cand)) or not np.all((cand > lo + 3 * h) & (cand < hi - 3 * h)):
-            break
-        value = f(cand[None, :])[0]
-        if not value > f0:
-            break
-        u = cand
-    f0, u, hess = best
-    w, v = np.linalg.eigh(-hess)
-    if not np.all(np.isfinite(w)):
-        return None
-    # Directions without curvature (a parameter the data leave to its prior, a peak cut by a
-    # bound) get a variance that spreads the proposal over the prior box; the certificate of
-    # the weights decides whether that describes the posterior.
-    if broad is None:
-        broad = (np.max(span[np.isfinite(span)]) / 4.0) ** 2
-    w = np.where(w > 1.0 / broad, w, 1.0 / broad)
-    return f0, u, (w, v)
 
 
 def _with_ridge(out, probe: dict, n_proposals: int, rng: np.random.Generator):

@@ -103,7 +103,7 @@ class _Unbounded:
 
     def broad(self, z0: np.ndarray) -> float:
         """The variance floor of the Laplace approximation in z
-        (:func:`~bayesfo.inference.importance._laplace`): :attr:`BROAD`, or where a coordinate
+        (:func:`~bayesfo.inference._peaks._laplace`): :attr:`BROAD`, or where a coordinate
         is left as it is, the rule in u over those coordinates, if wider."""
         free = ~self.bounded
         if not free.any():
@@ -112,7 +112,7 @@ class _Unbounded:
 
     def start(self, log_target, u: np.ndarray) -> np.ndarray:
         """Where the Newton steps towards the mode in z begin, from an optimum ``u`` polished
-        in u within the box (:func:`~bayesfo.inference.importance._polished`, where the bounds
+        in u within the box (:func:`~bayesfo.inference._peaks._polished`, where the bounds
         hold a coordinate that leans on one).
 
         Such a coordinate maps to the far tail in z, where the target's slope is that of the

@@ -438,7 +438,7 @@ def _plain_temperature(text: str | None) -> float | None:
 def _read_lines(path, where, lines: list[Line], delimiter, encoding, decimal, mapping, kind,
                 duplicates, units, name, fmt=None) -> list[Isotherm]:
     meta = comment_meta(lines)
-    tables = [t for t in find_tables(lines, " " if delimiter == "spaces" else delimiter)]
+    tables = [t for t in find_tables(lines, " " if delimiter == "spaces" else delimiter, where)]
     if not tables:
         raise no_table(where, lines)
     n_rows = sum(len(t.rows) for t in tables)

@@ -243,7 +243,7 @@ def _fit_header(cells: list[str], n: int) -> list[str] | None:
     return cells if len(cells) >= n else None
 
 
-def find_tables(lines: list[Line], delimiter: str) -> list[Table]:
+def find_tables(lines: list[Line], delimiter: str, where: str = "the file") -> list[Table]:
     """The tables of a classified file, in order.
 
     A table is a run of data lines with the same number of cells (blank and comment lines
@@ -251,6 +251,14 @@ def find_tables(lines: list[Line], delimiter: str) -> list[Table]:
     line whose cells align with the data, optionally with a units row in between. A run without
     a header right after a table of as many columns, separated by blank and comment lines only,
     takes that table's header (blocks such as gnuplot's).
+
+    Raises
+    ------
+    InputError
+        Naming ``where`` and the line, where up to :data:`ODD_ROWS` data lines with another
+        number of cells sit directly between the rows of a table (a stray delimiter, such as a
+        thousands separator, or a missing cell): read as they are, they would end the table
+        there and leave the rows after them without a header, unread.
     """
     tables: list[Table] = []
     k, n_lines = 0, len(lines)
@@ -266,6 +274,11 @@ def find_tables(lines: list[Line], delimiter: str) -> list[Table]:
             if ln.kind == "data" and len(ln.cells) == ncell:
                 rows.append(ln)
                 j += 1
+            elif ln.kind == "data" and rows and not broke and _resumes(lines, j, ncell):
+                raise InputError(
+                    f"{where}, line {ln.number}: {len(ln.cells)} cells where the rows above "
+                    f"and below it have {ncell}: a stray delimiter (a thousands separator?) "
+                    "or a missing cell; correct or remove the line")
             elif ln.kind == "comment" and not broke:
                 j += 1
             elif ln.kind == "blank":
@@ -307,6 +320,26 @@ def find_tables(lines: list[Line], delimiter: str) -> list[Table]:
         last_end = end - 1
         k = end if end > k else j
     return tables
+
+
+#: Consecutive data lines with another number of cells that :func:`find_tables` takes for
+#: damaged rows of the table around them (more are a table of their own).
+ODD_ROWS = 3
+
+
+def _resumes(lines: list[Line], j: int, ncell: int) -> bool:
+    """Whether the data lines from ``j`` on with another number of cells than ``ncell`` (at most
+    :data:`ODD_ROWS` of them) are followed directly by a data line with ``ncell`` cells."""
+    for k in range(j, min(j + ODD_ROWS, len(lines))):
+        if lines[k].kind != "data":
+            return False
+        if k + 1 < len(lines) and lines[k + 1].kind == "data" and \
+                len(lines[k + 1].cells) == ncell:
+            return True
+        if k + 1 < len(lines) and lines[k + 1].kind == "data":
+            continue
+        return False
+    return False
 
 
 def _realign(line: Line, delimiter: str, n: int) -> list[str]:

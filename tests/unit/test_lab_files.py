@@ -205,6 +205,32 @@ def test_headerless_numbers_need_columns_by_number():
                  "modulus")
 
 
+LAB_ROWS = ["Angular Frequency,Storage Modulus,Loss Modulus"] + [
+    f"{w:g},{100 + 10 * k},{50 + 5 * k}" for k, w in enumerate([100, 30, 10, 3, 1, 0.3, 0.1])]
+
+
+@pytest.mark.parametrize("damaged, cells", [("1,000,130,65", 4), ("1,130", 2),
+                                            ("1,130,65,1\n0.3,140,70,2", 4)])
+def test_a_damaged_row_inside_a_table_is_an_error_naming_its_line(tmp_path, damaged, cells):
+    # A stray delimiter (a thousands separator) or a missing cell used to end the table at that
+    # line: the rows after it, without a header, were skipped with a note, and the data set
+    # came out shorter, silently. Up to three such lines between rows of the table are named.
+    rows = list(LAB_ROWS)
+    rows[5:7] = damaged.split("\n")
+    path = tmp_path / "sweep.csv"
+    path.write_text("\n".join(rows) + "\n")
+    with pytest.raises(InputError, match=rf"sweep.csv', line 6: {cells} cells where the rows "
+                                         r"above and below it have 3: a stray delimiter"):
+        read(path)
+    # The same rows after a blank line are a table of their own, as before (no error).
+    rows = LAB_ROWS[:5] + [""] + [damaged.split("\n")[0]] * 2
+    path.write_text("\n".join(rows) + "\n")
+    assert read(path).omega.size == 4
+    # Intact, all seven rows are read.
+    path.write_text("\n".join(LAB_ROWS) + "\n")
+    assert read(path).omega.size == 7
+
+
 def test_two_moduli_need_columns_to_choose():
     with pytest.raises(InputError, match=r"ambiguous.csv', line 1: columns 'G'', 'E'' could each "
                                          r"be the storage column"):

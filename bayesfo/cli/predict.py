@@ -143,9 +143,10 @@ def _write_csv(p, path) -> None:
 
 def _print(p) -> None:
     from ..predictions.functions import QUANTITIES
+    from ..structures.physical import in_brackets
 
     who = f"structure {p.structure}" if p.weights is None else f"{p.average} average ({_weights(p)})"
-    unit = f" [{p.unit}]" if p.unit else ""
+    unit = in_brackets(p.unit)
     print(f"{p.symbol or QUANTITIES[p.quantity][1]}{unit} of {who}: posterior median and 94 % "
           "HDI")
     print(f"{'x [' + p.x_unit + ']':>14} {'median':>12} {'HDI low':>12} {'HDI high':>12}")

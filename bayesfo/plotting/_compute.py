@@ -337,7 +337,9 @@ def unit_mathtext(unit: str) -> str:
 
 def unit_suffix(unit: str) -> str:
     """`` [unit]`` in mathtext, or nothing for a parameter without a unit."""
-    return f" [{unit_mathtext(unit)}]" if unit else ""
+    from ..structures.physical import in_brackets
+
+    return in_brackets(unit_mathtext(unit) if unit else "")
 
 
 def to_coordinates(theta, is_log) -> np.ndarray:

@@ -35,6 +35,8 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     symbols = parts_of(mc.data.symbol, mc.data.kind)
     letter = response_symbol(mc.data.symbol, mc.data.kind)
     unit = mc.data.units or f"[{letter}]"
+    from ..structures.physical import in_brackets
+
     temps = np.asarray(mc.temperatures)
     cmap = mpl.colormaps["coolwarm"]
     norm = mpl.colors.Normalize(temps.min(), temps.max())
@@ -67,7 +69,7 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
         ax.loglog(grid, med, "k-", lw=1.2, label=f"{mc.structure} (median, 94 %)")
         ax.set_xlabel(f"a_T ω [rad/s] (T_ref = {mc.reference_temperature:g} °C)")
         ax.set_ylabel(f"{'b_T ' if vertical.any() and modulus else ''}{sym}"
-                      f"{' / b_T' if vertical.any() and not modulus else ''} [{unit}]")
+                      f"{' / b_T' if vertical.any() and not modulus else ''}{in_brackets(unit)}")
         values[f"{q.split('_')[0]}_median"] = med
     axes[0].legend(loc="best", fontsize=8)
     fig.colorbar(mpl.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes[1], label="T [°C]")

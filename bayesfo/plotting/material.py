@@ -134,10 +134,11 @@ def plot_prediction(prediction, *, ax=None) -> Drawn:
         for i in np.flatnonzero(out):
             ax.axvspan(bounds[i], bounds[i + 1], color="0.88", lw=0, zorder=0)
     from ..predictions.functions import QUANTITIES
+    from ..structures.physical import in_brackets
 
     domain = QUANTITIES[p.quantity][0]
     ax.set_xlabel({"omega": "ω [rad/s]", "time": "t [s]", "tau": "τ [s]"}[domain])
-    ax.set_ylabel(f"{p.symbol}" + (f" [{p.unit}]" if p.unit else ""))
+    ax.set_ylabel(f"{p.symbol}" + in_brackets(p.unit))
     ax.legend(loc="best", fontsize=8)
     values = {"x": p.x, "median": p.median, "hdi_low": p.hdi_low, "hdi_high": p.hdi_high}
     return Drawn.build(fig, (ax,), values, {"median": line, "band": band},

@@ -44,7 +44,9 @@ def plot_prony(result, prony, *, structure=None, average=None, seed: int = 0,
     error = series / model.median - 1
     half = (model.hdi_high - model.hdi_low) / 2 / np.abs(model.median)
     letter = modulus_symbol(prony.symbol)
-    unit = f" [{prony.unit}]" if prony.unit else ""
+    from ..structures.physical import in_brackets
+
+    unit = in_brackets(prony.unit)
 
     fig = new_figure(fig, (6.4, 5.2))
     top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))

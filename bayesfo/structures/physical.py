@@ -227,6 +227,22 @@ def display_name(name: str, symbol: str = "G") -> str:
 
 
 # ---------------------------------------------------------------------------- units
+def in_brackets(unit: str) -> str:
+    """`` [unit]`` after a quantity's name, nothing without a unit, and the placeholder of data
+    without a unit (``[G]``, :func:`stress_unit`) as it is, not bracketed twice.
+
+    Examples
+    --------
+    >>> in_brackets("Pa"), in_brackets("[G]"), in_brackets("")
+    (' [Pa]', ' [G]', '')
+    """
+    if not unit:
+        return ""
+    if unit.startswith("[") and unit.endswith("]") and unit.count("[") == 1:
+        return f" {unit}"
+    return f" [{unit}]"
+
+
 def stress_unit(kind: str, unit: str = "") -> str:
     """The stress unit of the physical parameters for data of ``kind`` in ``unit``."""
     u = (unit or "").strip()

@@ -136,7 +136,7 @@ def _combined_caption(name: str, comparison) -> str | None:
     if name == "time_functions":
         return ("Relaxation modulus G(t) and creep compliance J(t) of each structure's posterior "
                 "(median, 50 % and 90 % credible bands), from the inverse Laplace transform of "
-                "the model; the data inform about t between 1/ω_max and 1/ω_min, and the shaded "
+                "the model; the data inform about t between 1/ω_max and 1/ω_min, and the hatched "
                 "stretches beyond are extrapolation. 'bayesfo predict' gives the numbers.")
     if name == "nyquist":
         if nyquist_form(comparison) == "log":

@@ -4,7 +4,7 @@ compliance J(t) of each structure's posterior, with credible bands.
 G(t) and J(t) are those of :func:`bayesfo.predict` (fixed-Talbot inversion of G*(s)/s and
 J*(s)/s for every draw; :mod:`bayesfo.predictions`), for thinned posterior draws. The times run
 from a tenth of 1/ω_max to ten times 1/ω_min; the data inform about 1/ω_max … 1/ω_min, and the
-stretches beyond are shaded as extrapolation. Tensile data (``symbol`` E) are labelled E(t) and
+stretches beyond are hatched as extrapolation. Tensile data (``symbol`` E) are labelled E(t) and
 D(t), the tensile relaxation modulus and creep compliance.
 """
 
@@ -17,7 +17,7 @@ from ._base import Drawn, new_figure
 from ._compute import N_DRAWS, legend_name, select_results, structure_draws
 from ._legend import _legend
 from .response import _band_handle, positive_band
-from .style import COLUMN_WIDTH, comparison_styles
+from .style import COLUMN_WIDTH, EXTRAPOLATED, comparison_styles
 
 #: Points of the time grid.
 N_TIMES = 120
@@ -31,7 +31,7 @@ def time_grid(data, n: int = N_TIMES) -> np.ndarray:
 def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS,
                         seed: int = 0) -> Drawn:
     """The relaxation modulus G(t) and the creep compliance J(t) of each structure: posterior
-    median and 50 %/90 % bands, on logarithmic axes, the extrapolated times shaded.
+    median and 50 %/90 % bands, on logarithmic axes, the extrapolated times hatched.
 
     Parameters
     ----------
@@ -92,10 +92,10 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
             u = _unit(q, data) if data.units else ""
             ax.set_ylabel(symbols[q] + (f" [{u}]" if u else ""))
             lo, hi = t[0], t[-1]
-            ax.axvspan(lo, window[0], color="0.93", lw=0, zorder=0)
-            ax.axvspan(window[1], hi, color="0.93", lw=0, zorder=0)
+            ax.axvspan(lo, window[0], **EXTRAPOLATED)
+            ax.axvspan(window[1], hi, **EXTRAPOLATED)
             ax.set_xlim(lo, hi)
-        axes[-1].set_xlabel("t [s] (shaded: beyond the measured window)")
+        axes[-1].set_xlabel("t [s] (hatched: beyond the measured window)")
         _legend(fig, handles, labels)
     return Drawn.build(fig, axes, values, artists)
 
@@ -103,7 +103,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
 def plot_prediction(prediction, *, ax=None) -> Drawn:
     """A material function of :func:`bayesfo.predict` (any quantity, one structure, an average
     or a master curve): its posterior median and 94 % band, the arguments outside the data
-    window shaded as extrapolation; logarithmic axes where the values are positive.
+    window hatched as extrapolation; logarithmic axes where the values are positive.
 
     Returns
     -------
@@ -127,12 +127,21 @@ def plot_prediction(prediction, *, ax=None) -> Drawn:
     (line,) = ax.plot(p.x, p.median, "k-", lw=1.2, label="posterior median")
     ax.set_title(who, fontsize=8, wrap=True)
     out = np.asarray(p.extrapolated, bool)
-    if out.any():
+    if out.any() and p.window is not None:
+        # Shade what lies beyond the measured window, to its ends.
+        lo, hi = p.window
+        if p.x.min() < lo:
+            ax.axvspan(p.x.min(), lo, **EXTRAPOLATED, label="extrapolated")
+        if p.x.max() > hi:
+            ax.axvspan(hi, p.x.max(), **EXTRAPOLATED,
+                       label=None if p.x.min() < lo else "extrapolated")
+    elif out.any():
         # Shade each run of extrapolated arguments, to the midpoint with the next one inside.
         edges = np.sqrt(p.x[1:] * p.x[:-1])
         bounds = np.r_[p.x[0], edges, p.x[-1]]
-        for i in np.flatnonzero(out):
-            ax.axvspan(bounds[i], bounds[i + 1], color="0.88", lw=0, zorder=0)
+        for k, i in enumerate(np.flatnonzero(out)):
+            ax.axvspan(bounds[i], bounds[i + 1], **EXTRAPOLATED,
+                       label=None if k else "extrapolated")
     from ..predictions.functions import QUANTITIES
     from ..structures.physical import in_brackets
 
@@ -143,4 +152,4 @@ def plot_prediction(prediction, *, ax=None) -> Drawn:
     values = {"x": p.x, "median": p.median, "hdi_low": p.hdi_low, "hdi_high": p.hdi_high}
     return Drawn.build(fig, (ax,), values, {"median": line, "band": band},
                        caption=f"{p.symbol}: posterior median and 94 % band; extrapolated "
-                               "arguments shaded")
+                               "arguments hatched")

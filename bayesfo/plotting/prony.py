@@ -1,13 +1,14 @@
 """The Prony series of ``bayesfo export`` against the model it stands for: the relaxation
 modulus G(t) of the series beside the model's posterior median and 94 % band, and the series'
 relative error against the median with the band's half-width, over the data window and the
-decade beyond each side (shaded as extrapolation)."""
+decade beyond each side (hatched as extrapolation)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ._base import Drawn, new_figure
+from .style import EXTRAPOLATED
 
 #: Points of the time grid.
 N_TIMES = 150
@@ -56,20 +57,19 @@ def plot_prony(result, prony, *, structure=None, average=None, seed: int = 0,
     (line,) = top.loglog(t, series, "--", color="#D55E00", lw=1.4,
                          label=f"Prony series, {prony.tau.size} terms")
     top.set_ylabel(f"{letter}(t){unit}")
-    top.legend(loc="best", fontsize=8)
     bottom.fill_between(t, -half, half, color="0.3", alpha=0.25, lw=0,
                         label="94 % band half-width")
     bottom.semilogx(t, error, "-", color="#D55E00", lw=1.2, label="series / median − 1")
     bottom.axhline(0.0, color="k", lw=0.6)
     bottom.set_xlabel("t [s]")
     bottom.set_ylabel("relative error")
-    bottom.legend(loc="best", fontsize=8)
     for ax in (top, bottom):
-        ax.axvspan(t[0], lo, color="0.85", lw=0, zorder=0)
-        ax.axvspan(hi, t[-1], color="0.85", lw=0, zorder=0)
+        ax.axvspan(t[0], lo, **EXTRAPOLATED, label="extrapolated")
+        ax.axvspan(hi, t[-1], **EXTRAPOLATED)
         ax.set_xlim(t[0], t[-1])
+        ax.legend(loc="best", fontsize=8)
     values = {"t": t, "model_median": model.median, "model_low": model.hdi_low,
               "model_high": model.hdi_high, "series": series, "relative_error": error}
     return Drawn.build(fig, (top, bottom), values, {"series": line},
                        caption=f"{letter}(t) of the Prony series against the model; the data "
-                               "window is unshaded")
+                               "window is not hatched")

@@ -73,7 +73,7 @@ class Prediction:
         The median over the draws and the ends of their 94 % highest-density interval, per x.
     extrapolated : ndarray of bool
         Where x lies outside the window the data cover (ω outside [ω_min, ω_max]; t and τ
-        outside [1/ω_max, 1/ω_min]).
+        outside [1/ω_max, 1/ω_min]); an x equal to an end of the window to rounding is inside.
     structure : str or None
         The structure predicted from; None for an average.
     weights : dict or None
@@ -87,6 +87,8 @@ class Prediction:
     symbol : str
         The quantity's symbol in the letters of the data (E′, E(t), D(t) for tensile data;
         :mod:`bayesfo.data.symbols`).
+    window : tuple of float or None
+        The ends of that window, in the unit of x.
     """
 
     quantity: str
@@ -103,6 +105,7 @@ class Prediction:
     notes: tuple[str, ...] = ()
     values: np.ndarray = field(default=None, repr=False)
     symbol: str = ""
+    window: tuple[float, float] | None = None
 
     def to_dict(self) -> dict:
         """The JSON form (``bayesfo predict --json``): plain lists, NaN as None."""
@@ -114,6 +117,8 @@ class Prediction:
                "x_unit": self.x_unit, "median": plain(self.median),
                "hdi_low": plain(self.hdi_low), "hdi_high": plain(self.hdi_high),
                "extrapolated": [bool(v) for v in self.extrapolated]}
+        if self.window is not None:
+            out["window"] = [float(v) for v in self.window]
         if self.weights is None:
             out["structure"] = self.structure
         else:
@@ -221,7 +226,8 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, data.omega),
         structure=next(iter(weights)) if average is None else None,
         weights=dict(weights) if average is not None else None, average=average,
-        notes=tuple(notes), values=values, symbol=_symbol(quantity, data))
+        notes=tuple(notes), values=values, symbol=_symbol(quantity, data),
+        window=_window(domain, data.omega))
 
 
 #: How each kind of quantity scales with the vertical shift b_T and the horizontal a_T
@@ -268,7 +274,7 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
         quantity=quantity, unit=_unit(quantity, mc.data), x=x, x_unit=X_UNITS[domain],
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, window),
         structure=mc.structure, notes=tuple(notes), values=values,
-        symbol=_symbol(quantity, mc.data))
+        symbol=_symbol(quantity, mc.data), window=_window(domain, window))
 
 
 # ---------------------------------------------------------------------------- checks
@@ -481,11 +487,20 @@ def _band(values) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return median, lo, hi
 
 
-def _outside(x, domain: str, omega) -> np.ndarray:
+#: Relative rounding within which an argument at an end of the measured window is inside it
+#: (a grid such as ``--omega 0.001:1000:7`` gives 0.01 as 0.009999999999999998).
+WINDOW_ROUNDING = 1e-9
+
+
+def _window(domain: str, omega) -> tuple[float, float]:
+    """The window the data cover, in the unit of the domain's argument."""
     w_lo, w_hi = float(np.min(omega)), float(np.max(omega))
-    if domain == "omega":
-        return (x < w_lo) | (x > w_hi)
-    return (x < 1.0 / w_hi) | (x > 1.0 / w_lo)
+    return (w_lo, w_hi) if domain == "omega" else (1.0 / w_hi, 1.0 / w_lo)
+
+
+def _outside(x, domain: str, omega) -> np.ndarray:
+    lo, hi = _window(domain, omega)
+    return (x < lo * (1 - WINDOW_ROUNDING)) | (x > hi * (1 + WINDOW_ROUNDING))
 
 
 def _symbol(quantity: str, data) -> str:

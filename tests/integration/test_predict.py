@@ -78,6 +78,14 @@ def test_extrapolation_is_flagged_outside_the_window(result):
     assert p.extrapolated.tolist() == [True, False, True]
     p = result.predict("relaxation_modulus", [1e-3, 1.0, 100.0])
     assert p.extrapolated.tolist() == [True, False, True]
+    # An end of the window to rounding (a grid's 0.009999999999999998 for 0.01) is inside it;
+    # a millionth beyond, outside. The window's ends go with the prediction.
+    w = result.data.omega
+    lo, hi = float(w.min()), float(w.max())
+    p = result.predict("storage", [lo * (1 - 1e-12), hi * (1 + 1e-12), lo * (1 - 1e-6)])
+    assert p.extrapolated.tolist() == [False, False, True]
+    assert p.window == (lo, hi) and p.to_dict()["window"] == [lo, hi]
+    assert result.predict("relaxation_modulus", [1.0]).window == (1 / hi, 1 / lo)
 
 
 def test_averages_weigh_the_structures(result):
@@ -152,7 +160,7 @@ def test_the_command_prints_writes_and_refuses(result, tmp_path, run_cli):
     status, text, err = run_cli("predict", tmp_path / "none", "--quantity", "storage",
                                 "--omega", "1")
     assert status == 2 and err.count("\n") == 1
-    # A figure of the prediction: the same numbers, the extrapolated arguments shaded.
+    # A figure of the prediction: the same numbers, the extrapolated arguments hatched.
     status, text, err = run_cli("predict", out, "--quantity", "relaxation_spectrum", "--tau",
                                 "0.001:1000:30", "--figure", tmp_path / "h.png")
     assert status == 0, err
@@ -175,8 +183,11 @@ def test_a_prediction_is_drawn_with_its_band(result):
         ax = drawn.axes[0]
         assert ax.get_xlabel() == "t [s]" and ax.get_ylabel() == "G(t) [Pa]"
         assert ax.get_yscale() == "log" and ax.get_title() == "zener"
-        # One shaded span per extrapolated time.
-        assert len(ax.patches) == int(p.extrapolated.sum()) > 0
+        # What lies beyond the measured window is hatched, to the ends of the window.
+        spans = sorted((s.get_x(), s.get_x() + s.get_width()) for s in ax.patches)
+        assert p.extrapolated[0] and p.extrapolated[-1]
+        assert spans == [(p.x[0], p.window[0]), (p.window[1], p.x[-1])]
+        assert "extrapolated" in [t.get_text() for t in ax.get_legend().get_texts()]
     finally:
         plt.close(drawn.figure)
 

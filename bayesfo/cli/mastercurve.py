@@ -198,7 +198,9 @@ def _print(mc, out) -> None:
     for name, law in mc.laws.items():
         text = ", ".join(f"{k} = {v['mean']:.4g} ± {v['sd']:.2g} {v['unit']}".rstrip()
                          for k, v in law["parameters"].items())
-        print(f"{name:>10}: {text}; probability {law['probability']:.3f}")
+        untested = ("; as many constants as free shifts: not tested by them"
+                    if law.get("dof", 1) <= 0 else "")
+        print(f"{name:>10}: {text}; probability {law['probability']:.3f}{untested}")
     from ..tts.validity import describe, describe_parts
 
     vgp = mc.tts_checks.get("van_gurp_palmen")

@@ -92,9 +92,13 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     else:
         law = mc.shift_law()
         chi2 = mc.laws[law["name"]]["chi2_per_dof"]
-        out.append((f"Of the two laws fitted to the shifts, {_LAW_NAMES[law['name']]} is "
-                    f"preferred (probability {law['probabilities'][law['name']]:.3f}); it misses "
-                    f"them by χ²/dof {chi2:.3g}.", chi2 > 4.0))
+        preferred = (f"Of the two laws fitted to the shifts, {_LAW_NAMES[law['name']]} is "
+                     f"preferred (probability {law['probabilities'][law['name']]:.3f})")
+        if mc.laws[law["name"]].get("dof", 1) <= 0:
+            out.append((f"{preferred}, but with as many constants as free shifts it passes "
+                        "through them: the shifts cannot test it (more isotherms would).", True))
+        else:
+            out.append((f"{preferred}; it misses them by χ²/dof {chi2:.3g}.", chi2 > 4.0))
     if not mc.posterior.converged:
         out.append((f"The joint posterior of {mc.structure} is not certified: "
                     f"{'; '.join(mc.posterior.messages)}.", True))
@@ -144,6 +148,13 @@ def _law_log_z(evidence: dict) -> str:
     return _num(evidence.get("log_evidence"))
 
 
+def _chi2(law: dict) -> str:
+    """χ²/dof of a law, or why there is none (no free shift to spare)."""
+    if law.get("dof", 1) <= 0:
+        return "– (as many constants as shifts)"
+    return f"{law['chi2_per_dof']:.3g}"
+
+
 def _laws_table(mc) -> str:
     rows = []
     for name, law in mc.laws.items():
@@ -151,7 +162,7 @@ def _laws_table(mc) -> str:
                            f" {v['unit']}".rstrip() for k, v in law["parameters"].items())
         evidence = mc.law_evidence.get(name, {})
         rows.append(f"<tr><td class='text'>{_e(_LAW_NAMES[name])}</td>"
-                    f"<td class='text'>{_e(params)}</td><td>{law['chi2_per_dof']:.3g}</td>"
+                    f"<td class='text'>{_e(params)}</td><td>{_chi2(law)}</td>"
                     f"<td>{_num(law['probability'], '.3f')}</td>"
                     f"<td>{_law_log_z(evidence)}</td></tr>")
     if "free" in mc.law_evidence:

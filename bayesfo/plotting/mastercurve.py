@@ -8,6 +8,7 @@ import numpy as np
 from ..data.symbols import parts as parts_of
 from ..data.symbols import response_symbol
 from ._base import Drawn, new_figure
+from .style import temperature_colormap
 
 
 def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
@@ -38,7 +39,7 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     from ..structures.physical import in_brackets
 
     temps = np.asarray(mc.temperatures)
-    cmap = mpl.colormaps["coolwarm"]
+    cmap = temperature_colormap()
     norm = mpl.colors.Normalize(temps.min(), temps.max())
     shifts = mc.log_shift_mean
     vertical = (np.zeros(len(temps)) if getattr(mc, "vertical_draws", None) is None
@@ -126,7 +127,7 @@ def plot_van_gurp_palmen(mc, *, ax=None) -> Drawn:
     with style():
         fig, ax = axes_or_new(ax, (COLUMN_WIDTH + 0.6, 3.2))
         temps = np.asarray(mc.temperatures)
-        cmap = mpl.colormaps["coolwarm"]
+        cmap = temperature_colormap()
         norm = mpl.colors.Normalize(temps.min(), temps.max())
         values, artists = {}, {}
         for d, t in zip(mc.isotherms, temps, strict=True):
@@ -180,7 +181,7 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
     modulus = mc.data.kind == "modulus"
     symbols = parts_of(mc.data.symbol, mc.data.kind)
     temps = np.asarray(mc.temperatures)
-    cmap = mpl.colormaps["coolwarm"]
+    cmap = temperature_colormap()
     norm = mpl.colors.Normalize(temps.min(), temps.max())
     structure = mc.master if mc.master is not None else get_structure(mc.structure)
     rng = np.random.default_rng(seed)

@@ -180,3 +180,13 @@ def unit_suffix(units: str) -> str:
 #: How arguments beyond the measured window are shaded (prediction and Prony figures): hatched,
 #: so that they do not read as a credible band.
 EXTRAPOLATED = {"facecolor": "0.96", "edgecolor": "0.78", "hatch": "///", "lw": 0, "zorder": 0}
+
+
+def temperature_colormap():
+    """The colours of isotherms by temperature: plasma from dark blue to orange, without the
+    pale end (or the pale middle of a diverging map), so that every isotherm shows on white."""
+    import matplotlib as mpl
+    import numpy as np
+
+    return mpl.colors.ListedColormap(mpl.colormaps["plasma"](np.linspace(0.0, 0.82, 256)),
+                                     name="bayesfo_temperature")

@@ -32,9 +32,25 @@ class _Isotherms:
         first = self.data[0]
         return FrequencyResponse(
             omega, response, sigma, kind=first.kind, units=first.units,
-            name=f"{first.label.split(',')[0]}: {len(self.data)} isotherms, "
+            name=f"{self.title}: {len(self.data)} isotherms, "
                  f"{min(self.temperatures):g} to {max(self.temperatures):g} °C",
             source=first.source, distinct_frequencies=False, symbol=first.symbol)
+
+    @property
+    def title(self) -> str:
+        """What the isotherms are called together: the label they share (one file's, before
+        the temperature), else the directory their files share, else the first label."""
+        from pathlib import Path
+
+        bases = {d.label.split(",")[0] for d in self.data}
+        if len(bases) == 1:
+            return bases.pop()
+        folders = {Path(d.source).parent for d in self.data if d.source}
+        if len(folders) == 1 and len(self.data) == sum(bool(d.source) for d in self.data):
+            name = folders.pop().resolve().name
+            if name:
+                return name
+        return self.data[0].label.split(",")[0]
 
     @cached_property
     def point_isotherm(self) -> np.ndarray:

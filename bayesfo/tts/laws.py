@@ -6,7 +6,8 @@ seeded subset of the posterior draws of log10 a_T (weighted by the shifts' poste
 that their parameters carry the shifts' uncertainty. Their relative support is judged by BIC on
 the posterior mean and covariance of the shifts (an approximation of their evidence: the
 shifts' posterior taken as a Gaussian measurement); χ²/dof says how far each misses the shifts
-in their posterior sds.
+in their posterior sds, and ``dof`` (free shifts less the law's constants) whether the shifts
+can test the law at all: with none to spare (WLF on three isotherms) it passes through them.
 """
 
 from __future__ import annotations
@@ -95,6 +96,6 @@ def _fit_laws(shift_draws, temperatures, reference: int, seed: int) -> dict:
         worst = int(np.argmax(np.abs(z)))
         out[name].update(
             bic=bics[name], probability=weights[name] / total,
-            chi2_per_dof=float(np.sum(z**2) / max(n - k, 1)),
+            chi2_per_dof=float(np.sum(z**2) / max(n - k, 1)), dof=n - k,
             worst_temperature=float(t[worst]), worst_deviation=float(mean[worst] - predicted[name][worst]))
     return out

@@ -236,7 +236,8 @@ def describe_parts(check: dict) -> str:
     shown = ", ".join(f"{name.replace('_', ' ')} {worst[name]['log_shift']:+.2f}"
                       for name in PARTS if worst[name] is not None)
     where = "; ".join(f"{a:g}/{b:g} °C" for a, b in check["disagreeing"])
-    return (f"the horizontal shifts that G′, G″ and tan δ give disagree for {where} (at "
-            f"{worst['temperatures'][0]:g}/{worst['temperatures'][1]:g} °C: {shown} decades): "
-            "a vertical shift (tan δ is free of it) or a material that is not "
-            "thermorheologically simple")
+    low, high = worst["temperatures"]
+    return (f"the horizontal shifts that G′, G″ and tan δ give disagree for {where} (the "
+            f"{high:g} °C isotherm laid onto the {low:g} °C one by {shown} decades of ω, "
+            f"log10 a_T({high:g} °C) − log10 a_T({low:g} °C)): a vertical shift (tan δ is free "
+            "of it) or a material that is not thermorheologically simple")

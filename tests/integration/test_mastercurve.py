@@ -125,6 +125,22 @@ def test_law_fits_per_draw_carry_the_shift_uncertainty():
     assert laws["wlf"]["chi2_per_dof"] < 4 < 10 < laws["arrhenius"]["chi2_per_dof"]
 
 
+def test_a_law_with_as_many_constants_as_free_shifts_is_not_called_tested():
+    # Three isotherms leave two free shifts: WLF's two constants pass through them (χ² ~ 0),
+    # which says nothing about the law. Its dof is 0 and the report says so instead of "misses
+    # them by χ²/dof 0"; Arrhenius keeps one degree of freedom.
+    from bayesfo.output.mastercurve_report import _chi2
+
+    rng = np.random.default_rng(1)
+    t = np.array([0.0, 20.0, 40.0])
+    draws = wlf(t, 20.0, 8.0, 80.0) + 0.05 * rng.normal(size=(2000, t.size))
+    draws[:, 1] = 0.0
+    laws = _fit_laws(draws, list(t), 1, seed=0)
+    assert laws["wlf"]["dof"] == 0 and laws["arrhenius"]["dof"] == 1
+    assert _chi2(laws["wlf"]) == "– (as many constants as shifts)"
+    assert _chi2(laws["arrhenius"]) == f"{laws['arrhenius']['chi2_per_dof']:.3g}"
+
+
 def test_master_data_lie_on_one_curve(wlf_case):
     _, mc = wlf_case
     m = mc.master_data()

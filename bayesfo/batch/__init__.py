@@ -9,11 +9,11 @@ patterns, manifests) into data sets, runs the comparison of each in a worker, an
   warnings and timings) and, for a data set that failed, ``error.txt``;
 * ``DIR/batch_summary.csv``: one row per data set and structure (ln Z, posterior probability,
   criteria, posterior of q), and one row with the error for a data set that failed;
-* ``DIR/batch_summary.png`` and ``.pdf``: the posterior model probabilities and the posterior of
-  q per data set;
+* ``DIR/batch_summary.png`` (and the other ``--figure-formats``): the posterior model
+  probabilities and the posterior of q per data set;
 * when the data sets have temperatures (isotherms), ``DIR/temperature_summary.csv`` and
-  ``DIR/temperature_q.png``/``.pdf``: the posterior of q (mean, 94 % HDI) against temperature
-  per structure, and the best structure at each temperature.
+  ``DIR/temperature_q.png`` (and the other formats): the posterior of q (mean, 94 % HDI)
+  against temperature per structure, and the best structure at each temperature.
 
 Design
 ------

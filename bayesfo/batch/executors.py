@@ -214,7 +214,8 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
         if write_combined and done:
             order = list(dict.fromkeys(n for ds in datasets for n in ds.options["structures"]))
             try:
-                write_batch_outputs([r for o in done for r in o.rows], out_dir, order)
+                write_batch_outputs([r for o in done for r in o.rows], out_dir, order,
+                                    _combined_formats(datasets))
                 listed = ", listed in batch_summary.csv"
             except OSError:
                 pass
@@ -228,9 +229,15 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
     written = {}
     if write_combined:
         order = list(dict.fromkeys(n for ds in datasets for n in ds.options["structures"]))
-        written = write_batch_outputs([r for o in ordered for r in o.rows], out_dir, order)
+        written = write_batch_outputs([r for o in ordered for r in o.rows], out_dir, order,
+                                      _combined_formats(datasets))
     return BatchResult(out_dir, ordered, executor, time.perf_counter() - t0, written)
 
 
-
-
+def _combined_formats(datasets) -> tuple[str, ...]:
+    """The file formats of the combined figures: those the data sets' figures are asked in
+    (``--figure-formats``, PNG by default)."""
+    out: dict[str, None] = {}
+    for ds in datasets:
+        out.update(dict.fromkeys(ds.options.get("figure_formats") or ("png",)))
+    return tuple(out) or ("png",)

@@ -282,12 +282,14 @@ def _lost(ds: DataSet, exc: BaseException, why: str = "the worker failed") -> di
             "error": f"{why}: {type(exc).__name__}: {exc}", "traceback": None}
 
 
-def write_batch_outputs(result_rows, out_dir, structures=None) -> dict[str, Path]:
+def write_batch_outputs(result_rows, out_dir, structures=None,
+                        formats=("png", "pdf")) -> dict[str, Path]:
     """Write the combined outputs: ``batch_summary.csv`` and its figure, and, when data sets have
     temperatures, ``temperature_summary.csv`` and the figure of q against temperature.
 
     Each file is written through a temporary file and a rename; ``structures`` orders the
-    structures in the figures. Returns the written files by name.
+    structures in the figures, ``formats`` are the figures' file formats (none: no figures).
+    Returns the written files by name.
     """
     out_dir = Path(out_dir)
     rows = list(result_rows)
@@ -297,18 +299,18 @@ def write_batch_outputs(result_rows, out_dir, structures=None) -> dict[str, Path
     if trows:
         written["temperature_summary.csv"] = atomic_write_text(
             out_dir / "temperature_summary.csv", _csv_text(trows, TEMPERATURE_FIELDS))
-    if not any(r.get("status") == OK for r in rows):
+    if not formats or not any(r.get("status") == OK for r in rows):
         return written
     from ..plotting import save_figure
     from ..plotting.batch import plot_batch_summary, plot_q_temperature
 
     fig = plot_batch_summary(rows, structures)
-    for suffix in ("png", "pdf"):
+    for suffix in formats:
         save_figure(fig, out_dir / f"batch_summary.{suffix}")
         written[f"batch_summary.{suffix}"] = out_dir / f"batch_summary.{suffix}"
     if trows:
         fig = plot_q_temperature(trows, structures)
-        for suffix in ("png", "pdf"):
+        for suffix in formats:
             save_figure(fig, out_dir / f"temperature_q.{suffix}")
             written[f"temperature_q.{suffix}"] = out_dir / f"temperature_q.{suffix}"
     return written

@@ -267,8 +267,10 @@ def test_bad_file_is_recorded_and_the_others_finish(reference):
         record = json.loads((out / name / "batch.json").read_text())
         assert record["status"] == "ok" and record["task"]["seed"] == 3
         assert record["compare_seconds"] > 0
-    for name in ("batch_summary.png", "batch_summary.pdf", "temperature_q.png"):
-        assert (out / name).read_bytes()[:4] in (b"\x89PNG", b"%PDF")
+    for name in ("batch_summary.png", "temperature_q.png"):
+        assert (out / name).read_bytes()[:4] == b"\x89PNG"
+    # The combined figures in the formats asked for (PNG by default), as the data sets' own.
+    assert not list(out.glob("*.pdf"))
 
 
 def test_temperature_table_and_figure(reference):
@@ -625,3 +627,15 @@ def test_compare_into_a_data_set_of_a_batch_says_the_batch_summary_is_stale(tmp_
                              "--noise", "proportional", "--no-figures", "--quiet",
                              "--out", tmp_path / "alone")
     assert status == 0 and "batch" not in err
+
+
+def test_the_combined_figures_take_the_formats_asked_for():
+    from types import SimpleNamespace
+
+    from bayesfo.batch.executors import _combined_formats
+
+    sets = [SimpleNamespace(options={"figure_formats": ("png",)}),
+            SimpleNamespace(options={"figure_formats": ("png", "pdf")}),
+            SimpleNamespace(options={})]
+    assert _combined_formats(sets) == ("png", "pdf")
+    assert _combined_formats(sets[:1]) == ("png",) and _combined_formats(sets[2:]) == ("png",)

@@ -142,7 +142,14 @@ def run(args) -> int:
     known = {p for s in structures for p in s.param_names} | {"sigma", "sigma_rel"}
     unknown = [k for k in priors if k not in known]
     if unknown:
-        raise InputError(f"--prior names '{unknown[0]}', which no selected structure has")
+        import difflib
+
+        names = sorted(known)
+        close = difflib.get_close_matches(unknown[0], names, n=1)
+        hint = f"did you mean '{close[0]}'? " if close else ""
+        raise InputError(f"--prior names '{unknown[0]}', which no selected structure has; "
+                         f"{hint}the selected structures' parameters (as sampled, on the "
+                         f"scaled problem) are: {', '.join(names)}")
     settings = {"max_steps": args.max_steps, "walkers": args.walkers}
     check_sampler_settings(settings, "compare")
     formats, detail = figure_options(args)

@@ -147,6 +147,8 @@ def test_cli_compare_on_real_adhesive_data(run_cli, tmp_path):
         (["--prior", "q=uniform:0.2"], "NAME=TYPE:A:B"),
         (["--prior", "q=beta:0:1"], "unknown prior 'beta'"),
         (["--prior", "zeta=uniform:0:1"], "no selected structure has"),
+        (["--prior", "qq=uniform:0:1"], "did you mean 'q'? the selected structures' parameters "
+                                        "(as sampled, on the scaled problem) are: "),
         (["--structures", "voigt,nope"], "unknown structure 'nope'"),
     ],
 )

@@ -39,7 +39,7 @@ from ._arviz import psis
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .results import PosteriorResult, exponent_intervals
-from .smc import ladder_runs_together
+from .smc import _upper_count, ladder_runs_together
 from .transform import _log_prob_fn, _Transform
 
 
@@ -101,6 +101,10 @@ SUPPORT_COUNT = 100
 #: search for its starting particles, ``smc._prior_particles``).
 MAX_SUPPORT_DRAWS = 5_000_000
 
+#: Prior draws without an admissible one after which :func:`log_support_fraction` gives up: the
+#: support then holds less than 1.5·10⁻⁵ of the prior (at 95 %).
+EMPTY_SUPPORT_DRAWS = 200_000
+
 
 def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_000,
                          max_draws: int = MAX_SUPPORT_DRAWS) -> tuple[float, float]:
@@ -108,10 +112,14 @@ def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_
 
     Where fewer than :data:`SUPPORT_COUNT` of the first ``n`` draws lie in the support, the
     estimate draws on in batches, sized by the share seen so far, until that many are admissible
-    or ``max_draws`` are drawn: a structure whose support holds 1 in 10 000 prior draws gets
-    an estimate with an error of about 0.1 nats instead of none (or one of a single draw). The
-    same generator state gives the same numbers; where the first draws hold enough, they are
-    the numbers of ``n`` draws alone.
+    or ``max_draws`` are drawn, or once an upper bound of the admissible count
+    (``smc._upper_count``, 5 standard deviations above the share seen) could not reach
+    :data:`SUPPORT_COUNT` within ``max_draws`` (the estimate then rests on fewer, with the
+    larger error that says so), or, with none admissible, after :data:`EMPTY_SUPPORT_DRAWS`.
+    A structure whose support holds 1 in 10 000 prior draws gets an estimate with an error of
+    about 0.1 nats instead of none (or one of a single draw). The same generator state gives
+    the same numbers; where the first draws hold enough, they are the numbers of ``n`` draws
+    alone.
 
     Raises
     ------
@@ -124,7 +132,9 @@ def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_
         draws = np.column_stack([p.sample(rng, batch) for p in lik.prior_list])
         k += int(lik.in_support(draws).sum())
         drawn += batch
-        if k >= SUPPORT_COUNT or drawn >= max_draws:
+        if (k >= SUPPORT_COUNT or drawn >= max_draws
+                or (k == 0 and drawn >= EMPTY_SUPPORT_DRAWS)
+                or k + _upper_count(k, drawn, max_draws - drawn) < SUPPORT_COUNT):
             break
         # Enough for the count at the share seen (one draw where none was admissible), with a
         # margin; at least n, at most 200 000 at once (the support check's temporaries).

@@ -17,10 +17,10 @@ stays in u wherever it keeps its draws: a coordinate that leans on a bound along
 covered better there, by a component cut at the bound, than in z, where the curvature at the
 mode does not reach along the ridge (BENCHMARKS.md, twelfth session). An optimum on the edge
 of the support inside the box (a coefficient at 0 where its element vanishes, two orders that
-meet) has no difference stencil around it: the curvature is taken a few (smaller) steps inside
-(:func:`~._peaks._inward`), and the component spills part of its draws over the edge, where their weight
-is zero. One vectorised call of the likelihood on 20 000 proposal draws gives the importance
-weights, and from them
+meet) has no difference stencil around it: the curvature is taken a few (smaller) steps
+inside (:func:`~._peaks._inward`), and the component spills part of its draws over the edge,
+where their weight is zero. One vectorised call of the likelihood on 20 000 proposal draws
+gives the importance weights, and from them
 
 * the evidence, ln Z' = ln mean(w), with the standard error of that mean (the prior normalised
   on its support as elsewhere: ln Z = ln Z' − ln P(S)), where k̂ < 0.5;

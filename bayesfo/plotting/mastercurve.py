@@ -7,6 +7,7 @@ import numpy as np
 
 from ..data.symbols import parts as parts_of
 from ..data.symbols import response_symbol
+from ..structures.physical import in_brackets
 from ._base import Drawn, new_figure
 from .style import temperature_colormap
 
@@ -36,8 +37,6 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     symbols = parts_of(mc.data.symbol, mc.data.kind)
     letter = response_symbol(mc.data.symbol, mc.data.kind)
     unit = mc.data.units or f"[{letter}]"
-    from ..structures.physical import in_brackets
-
     temps = np.asarray(mc.temperatures)
     cmap = temperature_colormap()
     norm = mpl.colors.Normalize(temps.min(), temps.max())

@@ -177,6 +177,7 @@ def unit_suffix(units: str) -> str:
         return ""
     return " [" + units.replace("$", r"\$") + "]"
 
+
 #: How arguments beyond the measured window are shaded (prediction and Prony figures): hatched,
 #: so that they do not read as a credible band.
 EXTRAPOLATED = {"facecolor": "0.96", "edgecolor": "0.78", "hatch": "///", "lw": 0, "zorder": 0}

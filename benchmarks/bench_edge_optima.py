@@ -19,18 +19,14 @@ Usage: python benchmarks/bench_edge_optima.py [--rounds 1] [--other DIR]
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import platform
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
+from _versions import ROOT, child_run, interleaved, versions
 
-ROOT = Path(__file__).resolve().parents[1]
 METAL = (ROOT.parent / "shared" / "data" / "reference-gpl" / "pyrheo_metal_network_epstein"
          / "original" / "epstein.csv")
 CASES = [("g_spec", "max-n1m1"), ("g_spec", "max-n2m0"), ("g_spec", "max-n3m0"),
@@ -49,15 +45,7 @@ print(json.dumps({"sampler": r.posterior.sampler, "log_z": r.log_z, "err": r.log
 
 
 def run(source: Path, data: str, name: str) -> tuple[float, dict]:
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(source))
-    where = "g_spec" if data == "g_spec" else str(METAL)
-    t = time.perf_counter()
-    done = subprocess.run([sys.executable, "-c", CHILD, where, name], env=env,
-                          capture_output=True, text=True, cwd=source)
-    wall = time.perf_counter() - t
-    if done.returncode != 0:
-        raise RuntimeError(f"{name} on {data} failed: {done.stderr[-2000:]}")
-    return wall, json.loads(done.stdout.strip().splitlines()[-1])
+    return child_run(source, CHILD, "g_spec" if data == "g_spec" else str(METAL), name)
 
 
 def main() -> None:
@@ -66,18 +54,10 @@ def main() -> None:
     ap.add_argument("--other", type=Path, help="a checkout of another version to time beside")
     args = ap.parse_args()
     cases = [c for c in CASES if c[0] == "g_spec" or METAL.is_file()]
-    versions = {"this": ROOT} if args.other is None else {"other": args.other.resolve(),
-                                                          "this": ROOT}
+    which = versions(args.other)
     print(f"machine: {platform.machine()}, {os.cpu_count()} CPUs, python "
           f"{platform.python_version()}; load {os.getloadavg()[0]:.2f}", flush=True)
-    times, found = {}, {}
-    for r in range(args.rounds):
-        for case in cases:
-            order = list(versions) if r % 2 == 0 else list(reversed(versions))
-            for version in order:
-                wall, out = run(versions[version], *case)
-                times.setdefault((*case, version), []).append(wall)
-                found[(*case, version)] = out
+    times, found = interleaved(args.rounds, cases, which, run)
     print(f"{'data':<14} {'structure':<24} {'version':<7} {'median s':>9} {'posterior':<11} "
           f"{'ln Z by':<11} ln Z")
     for (data, name, version), v in times.items():
@@ -85,7 +65,7 @@ def main() -> None:
         lz = "none" if out["log_z"] is None else f"{out['log_z']:.3f} ± {out['err']:.3f}"
         print(f"{data:<14} {name:<24} {version:<7} {np.median(v):>9.2f} {out['sampler']:<11} "
               f"{out['method'] or '-':<11} {lz}")
-    if len(versions) == 2:
+    if len(which) == 2:
         for data, name in cases:
             a, b = found[(data, name, "this")], found[(data, name, "other")]
             if None not in (a["log_z"], b["log_z"]):

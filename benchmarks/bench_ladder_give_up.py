@@ -17,17 +17,13 @@ Usage: python benchmarks/bench_ladder_give_up.py [--rounds 1] [--other DIR]
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
+from _versions import ROOT, child_run, interleaved, versions
 
-ROOT = Path(__file__).resolve().parents[1]
 SILK = (ROOT.parent / "shared" / "data" / "reference-gpl" / "reptate_silk_feedstock" / "original"
         / "silk_feedstock.tts")
 CASES = [("max-n2m3-inv", "constant"), ("max-n2m3-inv-int", "proportional"),
@@ -44,14 +40,7 @@ print(json.dumps({"log_z": r.log_z, "sampler": r.posterior.sampler}))
 
 
 def run(source: Path, name: str, noise: str) -> tuple[float, dict]:
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(source))
-    t = time.perf_counter()
-    done = subprocess.run([sys.executable, "-c", CHILD, str(SILK), name, noise], env=env,
-                          capture_output=True, text=True, cwd=source)
-    wall = time.perf_counter() - t
-    if done.returncode != 0:
-        raise RuntimeError(f"{name} ({noise}) failed: {done.stderr[-2000:]}")
-    return wall, json.loads(done.stdout.strip().splitlines()[-1])
+    return child_run(source, CHILD, str(SILK), name, noise)
 
 
 def main() -> None:
@@ -62,24 +51,16 @@ def main() -> None:
     if not SILK.is_file():
         print(f"skipped: {SILK} not found (GPL reference data)")
         return
-    versions = {"this": ROOT} if args.other is None else {"other": args.other.resolve(),
-                                                          "this": ROOT}
+    which = versions(args.other)
     print(f"machine: {platform.machine()}, {os.cpu_count()} CPUs, python "
           f"{platform.python_version()}; load {os.getloadavg()[0]:.2f}", flush=True)
-    times, found = {}, {}
-    for r in range(args.rounds):
-        for name, noise in CASES:
-            order = list(versions) if r % 2 == 0 else list(reversed(versions))
-            for version in order:
-                wall, out = run(versions[version], name, noise)
-                times.setdefault((name, noise, version), []).append(wall)
-                found[(name, noise, version)] = out
+    times, found = interleaved(args.rounds, CASES, which, run)
     print(f"{'structure':<18} {'noise':<13} {'version':<7} {'median s':>9} {'route':<11} ln Z")
     for (name, noise, version), v in times.items():
         out = found[(name, noise, version)]
         lz = "none" if out["log_z"] is None else f"{out['log_z']:.3f}"
         print(f"{name:<18} {noise:<13} {version:<7} {np.median(v):>9.2f} {out['sampler']:<11} {lz}")
-    if len(versions) == 2:
+    if len(which) == 2:
         same = all(found[(n, z, "this")] == found[(n, z, "other")] for n, z in CASES)
         print("the same ln Z and route in both versions:", same)
     print(f"load at the end {os.getloadavg()[0]:.2f}")

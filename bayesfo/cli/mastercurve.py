@@ -35,6 +35,10 @@ def add_parser(subparsers):
                         f"{DEFAULT_STRUCTURES}; 'bayesfo structures' lists them), and "
                         "'spectrum': a discrete relaxation spectrum with a smoothness prior, "
                         "which needs no structure (slower: minutes on many isotherms)")
+    p.add_argument("--temperatures", default=None, metavar="T1,T2,...",
+                   help="the temperature [°C] of each file, in the order given (a directory's "
+                        "files in name order), where the files do not say it; one file per "
+                        "temperature")
     p.add_argument("--reference-temperature", type=float, default=None, metavar="T",
                    help="reference temperature [°C], an isotherm's (default: the middle one)")
     p.add_argument("--noise", default="proportional", choices=("proportional", "constant",
@@ -60,9 +64,10 @@ def add_parser(subparsers):
     return p
 
 
-def read_isotherm_files(paths) -> list[tuple]:
-    """(FrequencyResponse, temperature or None) of every isotherm in ``paths`` (files, or
-    directories of ``*.csv``)."""
+def read_isotherm_files(paths, temperatures=None) -> list[tuple]:
+    """(FrequencyResponse, temperature) of every isotherm in ``paths`` (files, or directories
+    of ``*.csv``); ``temperatures`` (°C, one per file in that order) where the files do not
+    say them."""
     from ..data import read_isotherms
     from ..data.temperature import temperature_of_file
 
@@ -77,14 +82,30 @@ def read_isotherm_files(paths) -> list[tuple]:
             files.append(p)
         else:
             raise InputError(f"'{p}': no such file or directory")
+    if temperatures is not None and len(temperatures) != len(files):
+        raise InputError(f"--temperatures gives {len(temperatures)} temperature(s) for "
+                         f"{len(files)} file(s) ({', '.join(f.name for f in files)}): give one "
+                         "per file, in that order")
     out = []
-    for f in files:
+    for k, f in enumerate(files):
         sets = read_isotherms(f)
-        if len(sets) == 1 and sets[0].temperature is None:
+        if temperatures is not None:
+            if len(sets) != 1:
+                raise InputError(f"'{f}' holds {len(sets)} data sets: --temperatures gives "
+                                 "one temperature per file (leave it out for a file that "
+                                 "names its temperatures)")
+            own = (sets[0].temperature if sets[0].temperature is not None
+                   else temperature_of_file(f))
+            if own is not None and not math.isclose(own, temperatures[k], abs_tol=1e-9):
+                raise InputError(f"'{f}' says {own:g} °C, --temperatures gives "
+                                 f"{temperatures[k]:g} °C for it: correct one of them")
+            out.append((sets[0].data, temperatures[k]))
+        elif len(sets) == 1 and sets[0].temperature is None:
             t = temperature_of_file(f)
             if t is None:
-                raise InputError(f"'{f}': no temperature (give a '# temperature: 20 C' line or "
-                                 "name the file by it, e.g. Tp020C.csv)")
+                raise InputError(f"'{f}': no temperature (give a '# temperature: 20 C' line, "
+                                 "name the file by it, e.g. Tp020C.csv, or give "
+                                 "--temperatures T1,T2,... for the files in order)")
             out.append((sets[0].data, t))
         else:
             for s in sets:
@@ -95,6 +116,7 @@ def read_isotherm_files(paths) -> list[tuple]:
 
 
 def run(args) -> int:
+    from ..options import parse_floats
     from ..outdir import check_output_directory, staged_run
     from ..tts import mastercurve
     from ..tts.joint import _master_names
@@ -104,7 +126,9 @@ def run(args) -> int:
         raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got "
                          f"{args.workers}")
     structures = _master_names(args.structures)  # an unknown name fails before reading
-    isotherms = read_isotherm_files(args.data)
+    temperatures = (parse_floats(args.temperatures, "--temperatures")
+                    if args.temperatures is not None else None)
+    isotherms = read_isotherm_files(args.data, temperatures)
     target = Path(args.out or "bayesfo-mastercurve")
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))

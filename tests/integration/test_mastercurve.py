@@ -577,3 +577,28 @@ def test_two_workers_give_the_numbers_of_one():
     np.testing.assert_array_equal(one.shift_draws, two.shift_draws)
     np.testing.assert_array_equal(one.master_draws, two.master_draws)
     assert one.log_evidence == two.log_evidence
+
+
+def test_temperatures_given_for_files_that_do_not_say_them(tmp_path, run_cli):
+    # Lab files named otherwise (pyRheo's oscillation_ps130_data.csv) were refused; with
+    # --temperatures each file, in the order given (a directory's by name), takes its own.
+    from bayesfo.cli.mastercurve import read_isotherm_files
+
+    for name, source in (("a.csv", "Tp000C.csv"), ("b.csv", "Tp020C.csv")):
+        (tmp_path / name).write_text("\n".join(
+            line for line in (ADHESIVE / source).read_text().splitlines()
+            if not line.startswith("# name:")) + "\n")
+    with pytest.raises(InputError, match=r"a.csv': no temperature .* or give --temperatures"):
+        read_isotherm_files([tmp_path])
+    pairs = read_isotherm_files([tmp_path], [0.0, 20.0])
+    assert [t for _, t in pairs] == [0.0, 20.0]
+    assert pairs[1][0].n_frequencies == bf.read(ADHESIVE / "Tp020C.csv").n_frequencies
+    with pytest.raises(InputError, match=r"--temperatures gives 1 temperature\(s\) for 2 "
+                                         r"file\(s\) \(a.csv, b.csv\): give one per file"):
+        read_isotherm_files([tmp_path], [0.0])
+    # A file that says its temperature must agree with the one given for it.
+    with pytest.raises(InputError, match=r"Tp020C.csv' says 20 °C, --temperatures gives 25 °C"):
+        read_isotherm_files([ADHESIVE / "Tp000C.csv", ADHESIVE / "Tp020C.csv"], [0.0, 25.0])
+    status, _, err = run_cli("mastercurve", tmp_path, "--temperatures", "0,x",
+                             "--out", tmp_path / "mc")
+    assert status == 2 and "--temperatures takes comma-separated numbers" in err

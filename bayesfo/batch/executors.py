@@ -237,7 +237,10 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
 def _combined_formats(datasets) -> tuple[str, ...]:
     """The file formats of the combined figures: those the data sets' figures are asked in
     (``--figure-formats``, PNG by default)."""
+    from ..options import DEFAULT_OPTIONS
+
+    default = DEFAULT_OPTIONS["figure_formats"]
     out: dict[str, None] = {}
     for ds in datasets:
-        out.update(dict.fromkeys(ds.options.get("figure_formats") or ("png",)))
-    return tuple(out) or ("png",)
+        out.update(dict.fromkeys(ds.options.get("figure_formats") or default))
+    return tuple(out) or default

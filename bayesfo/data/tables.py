@@ -328,17 +328,14 @@ ODD_ROWS = 3
 
 
 def _resumes(lines: list[Line], j: int, ncell: int) -> bool:
-    """Whether the data lines from ``j`` on with another number of cells than ``ncell`` (at most
-    :data:`ODD_ROWS` of them) are followed directly by a data line with ``ncell`` cells."""
-    for k in range(j, min(j + ODD_ROWS, len(lines))):
-        if lines[k].kind != "data":
+    """Whether the data line ``j`` with another number of cells than ``ncell``, and at most
+    :data:`ODD_ROWS` − 1 more such data lines after it, are followed directly by a data line
+    with ``ncell`` cells."""
+    for following in lines[j + 1:j + 1 + ODD_ROWS]:
+        if following.kind != "data":
             return False
-        if k + 1 < len(lines) and lines[k + 1].kind == "data" and \
-                len(lines[k + 1].cells) == ncell:
+        if len(following.cells) == ncell:
             return True
-        if k + 1 < len(lines) and lines[k + 1].kind == "data":
-            continue
-        return False
     return False
 
 

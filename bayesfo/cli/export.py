@@ -5,6 +5,8 @@ from __future__ import annotations
 
 def add_parser(subparsers):
     """Register ``bayesfo export``."""
+    import argparse
+
     from ..predictions.functions import AVERAGES
     from ..predictions.prony import FORMATS
 
@@ -29,7 +31,10 @@ def add_parser(subparsers):
     many.add_argument("--terms", type=int, default=None, metavar="N",
                       help="the number of relaxation times instead (2-100, log-spaced over the "
                            "same span; terms of zero weight are dropped)")
-    p.add_argument("--liquid", action="store_true", help="G_inf = 0: the material relaxes fully")
+    p.add_argument("--liquid", action=argparse.BooleanOptionalAction, default=None,
+                   help="G_inf = 0: the material relaxes fully (--no-liquid: G_inf fitted with "
+                        "the terms; default: 0 where the model's long-time modulus is 0, else "
+                        "fitted)")
     who = p.add_mutually_exclusive_group()
     who.add_argument("--structure", metavar="S", help="the structure (default: the best ranked)")
     who.add_argument("--average", choices=AVERAGES, help="an average over the structures")
@@ -90,6 +95,11 @@ def run(args) -> int:
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
           f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
+    for line in prony.long_time_text():
+        if prony.model_g_inf == 0.0:
+            line += (" (--liquid sets G_inf = 0)" if prony.g_inf > 0 else
+                     " (--no-liquid fits G_inf with the terms)" if args.liquid is None else "")
+        print(f"note: {line}")
     law = prony.shift_law
     if law is not None:
         from ..tts.joint import LAW_MISS

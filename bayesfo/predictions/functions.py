@@ -193,21 +193,8 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
     if temperature is not None:
         raise InputError("predict: a temperature applies to a master curve only (bayesfo "
                          "mastercurve); a comparison describes the data at their own")
-    notes = []
-    if average is None:
-        name = structure if structure is not None else _best(result)
-        weights = {_usable(result, name).name: 1.0}
-    else:
-        weights, notes = _weights(result, average)
-    counts = _draw_counts(weights, rng)
-    parts = []
-    for name, n in counts.items():
-        if n == 0:
-            continue
-        r = result[name]
-        theta = _draws(r, n, rng)
-        parts.append(_evaluate(r.structure, theta, quantity, x))
-    values = np.concatenate(parts, axis=0)
+    weights, notes, drawn = _mixture(result, structure, average, rng)
+    values = np.concatenate([_evaluate(s, theta, quantity, x) for s, theta in drawn], axis=0)
     if quantity in ("relaxation_spectrum", "retardation_spectrum"):
         discrete = [n for n in weights if result[n].structure.integer and weights[n] >= 1e-3]
         if discrete:
@@ -238,27 +225,11 @@ _SCALING = {"modulus": (0, -1), "compliance": (0, 1), "viscosity": (1, -1), "non
 def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) -> Prediction:
     """:func:`predict` of a master curve: its master structure's draws, each with its own
     shifts at ``temperature`` (the reference temperature by default)."""
-    if average is not None:
-        raise InputError("predict: a master curve holds the posterior of one master "
-                          f"structure ({mc.structure}), so there is nothing to average")
-    if structure is not None and structure != mc.structure:
-        raise InputError(f"predict: the master curve's structure is {mc.structure!r}, not "
-                          f"{structure!r}")
     domain = QUANTITIES[quantity][0]
-    n = mc.master_draws.shape[0]
-    rows = (np.sort(rng.choice(n, size=MAX_DRAWS, replace=False)) if n >= MAX_DRAWS
-            else rng.choice(n, size=MAX_DRAWS, replace=True))
-    theta = np.asarray(mc.master_draws, float)[rows]
     t = mc.reference_temperature if temperature is None else temperature
-    log_a, log_b = mc.shifts_at(t)
-    log_a, log_b = log_a[rows], log_b[rows]
+    master, theta, log_a, log_b = _master_draws(mc, structure, average, t, rng)
     a = 10.0 ** log_a[:, None]
     x_ref = x[None, :] * a if domain == "omega" else x[None, :] / a
-    master = mc.master
-    if master is None:  # a MasterCurve built by hand, with the structure's name only
-        from ..structures import get_structure
-
-        master = get_structure(mc.structure)
     values = _evaluate(master, theta, quantity, x_ref)
     pa, pb = _SCALING[QUANTITIES[quantity][2]]
     if pa or pb:
@@ -275,6 +246,86 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, window),
         structure=mc.structure, notes=tuple(notes), values=values,
         symbol=_symbol(quantity, mc.data), window=_window(domain, window))
+
+
+def _master_draws(mc, structure, average, temperature, rng) -> tuple:
+    """The master structure, :data:`MAX_DRAWS` of its draws and their log10 shifts (a_T, b_T)
+    at ``temperature``."""
+    if average is not None:
+        raise InputError("predict: a master curve holds the posterior of one master "
+                          f"structure ({mc.structure}), so there is nothing to average")
+    if structure is not None and structure != mc.structure:
+        raise InputError(f"predict: the master curve's structure is {mc.structure!r}, not "
+                          f"{structure!r}")
+    n = mc.master_draws.shape[0]
+    rows = (np.sort(rng.choice(n, size=MAX_DRAWS, replace=False)) if n >= MAX_DRAWS
+            else rng.choice(n, size=MAX_DRAWS, replace=True))
+    log_a, log_b = mc.shifts_at(temperature)
+    master = mc.master
+    if master is None:  # a MasterCurve built by hand, with the structure's name only
+        from ..structures import get_structure
+
+        master = get_structure(mc.structure)
+    return master, np.asarray(mc.master_draws, float)[rows], log_a[rows], log_b[rows]
+
+
+def long_time_modulus(result, *, structure: str | None = None, average: str | None = None,
+                      seed: int = 0) -> np.ndarray:
+    """The long-time modulus G_e = lim G(t) as t → ∞ of each draw that :func:`predict` takes
+    with the same arguments (a master curve's at its reference temperature): 0 for a draw
+    that relaxes fully (a liquid). Exact, from the lowest powers of s in the compliance
+    (:func:`equilibrium_modulus`), not from G(t) at a large t: a springpot of small order
+    relaxes too slowly for any finite t to tell.
+
+    Examples
+    --------
+    >>> import bayesfo as bf
+    >>> result = bf.compare(bf.read("examples/data/adhesive_468mp/Tp020C.csv"), "maxwell")  # doctest: +SKIP
+    >>> float(np.median(long_time_modulus(result)))  # doctest: +SKIP
+    0.0
+    """
+    if result.data.kind not in ("modulus", "compliance"):
+        raise InputError(f"long_time_modulus: the data are a {result.data.kind} transfer "
+                         "function; material functions follow from modulus or compliance "
+                         "data only")
+    if structure is not None and average is not None:
+        raise InputError("long_time_modulus: give a structure or an average, not both")
+    rng = np.random.default_rng(seed)
+    if hasattr(result, "shift_draws"):
+        master, theta, _, log_b = _master_draws(result, structure, average,
+                                                result.reference_temperature, rng)
+        return equilibrium_modulus(master, theta) / 10.0 ** log_b
+    _, _, drawn = _mixture(result, structure, average, rng)
+    return np.concatenate([equilibrium_modulus(s, theta) for s, theta in drawn])
+
+
+def equilibrium_modulus(structure, theta) -> np.ndarray:
+    """G_e = lim 1/C(s) as s → 0 for each parameter set of ``theta`` (physical units): the
+    ratio of the lowest-order terms of the compliance's denominator and numerator. 0 where
+    the denominator's lowest power of s is the higher (the model relaxes fully: a liquid);
+    inf where it is the lower (a compliance that vanishes at long times).
+
+    Examples
+    --------
+    A Zener solid, C(s) = (b0 + b1 s^q)/(1 + a1 s^q), relaxes to 1/b0; a fractional Maxwell
+    model, C(s) = (1 + b1 s^α)/(a1 s^β), relaxes fully:
+
+    >>> from bayesfo.structures import get_structure
+    >>> equilibrium_modulus(get_structure("zener"), [[2.0, 0.5, 0.1, 0.4]])
+    array([2.])
+    >>> equilibrium_modulus(get_structure("maxwell"), [[1e3, 2.0, 0.3, 0.8]])
+    array([0.])
+    """
+    nc, ne, dc, de = structure.power_arrays(np.atleast_2d(np.asarray(theta, float)))
+
+    def lowest(coef, expo):  # the lowest power of s with a coefficient, and its coefficient
+        expo = np.where(coef != 0, expo, np.inf)
+        low = np.min(expo, axis=1)
+        return low, np.sum(np.where(expo == low[:, None], coef, 0.0), axis=1)
+
+    (en, cn), (ed, cd) = lowest(nc, ne), lowest(dc, de)
+    with np.errstate(all="ignore"):
+        return np.where(ed > en, 0.0, np.where(ed < en, np.inf, cd / cn))
 
 
 # ---------------------------------------------------------------------------- checks
@@ -371,6 +422,21 @@ def _stacking(ranked) -> dict | None:
     w = {name: float(table.loc[name, "weight"]) for name in trees}
     total = sum(w.values())
     return {k: v / total for k, v in w.items()}
+
+
+def _mixture(result, structure, average, rng) -> tuple[dict, list, list]:
+    """The draws :func:`predict` evaluates: ``(weights, notes, [(structure, theta), ...])``,
+    each structure's share of :data:`MAX_DRAWS` in proportion to its weight (the best ranked
+    structure alone where neither ``structure`` nor ``average`` is given)."""
+    notes = []
+    if average is None:
+        name = structure if structure is not None else _best(result)
+        weights = {_usable(result, name).name: 1.0}
+    else:
+        weights, notes = _weights(result, average)
+    drawn = [(result[name].structure, _draws(result[name], n, rng))
+             for name, n in _draw_counts(weights, rng).items() if n > 0]
+    return weights, notes, drawn
 
 
 def _draw_counts(weights: dict, rng) -> dict:

@@ -3,7 +3,12 @@
 G(t) = G∞ + Σ g_i exp(−t/τ_i) with the τ_i fixed, ``per_decade`` of them per decade from two
 decades below 1/ω_max to two decades above 1/ω_min, and G∞, g_i ≥ 0 fitted by non-negative least
 squares to the posterior median of G′(ω) and G″(ω) (relative residuals, 20 frequencies per
-decade over the data window widened by a decade each side). ``liquid`` fixes G∞ = 0.
+decade over the data window widened by a decade each side). G∞ is 0 where the model relaxes
+fully (a liquid: its long-time modulus, the limit of G(t) as t → ∞, is 0 for the median draw),
+and the τ_i then reach a decade further; else G∞ is fitted with the terms; ``liquid`` forces
+either. A fitted G∞ is the series' modulus beyond its longest relaxation time: a fractional
+model still relaxing there (a springpot relaxes over every decade) has a long-time modulus
+below it, which the files state beside it.
 
 How well the series stands for the model is stated: the largest relative error of its G′, G″
 and G(t) against the posterior medians over the data window, beside the half-width of the
@@ -44,6 +49,8 @@ FORMATS = ("csv", "abaqus", "ansys", "lsdyna")
 LSDYNA_MAX_TERMS = 18
 #: Decades of relaxation times beyond the data window on each side.
 TAU_MARGIN = 2
+#: Decades of relaxation times added beyond 1/ω_min where G∞ = 0.
+LIQUID_MARGIN = 1
 #: A g_0 more than this many times the largest measured |G*| is named in the files as the
 #: model's extrapolation.
 EXTRAPOLATED = 1.5
@@ -58,7 +65,7 @@ class Prony:
     tau, g : ndarray
         Relaxation times [s] and moduli [``unit``] of the terms (terms fitted to 0 are dropped).
     g_inf : float
-        The long-time modulus (0 for a liquid).
+        The series' long-time modulus (0 for a liquid).
     unit : str
     source : str
         The structure, or the average, it was fitted to.
@@ -80,6 +87,9 @@ class Prony:
     measured_max : float
         The largest |G*| the data give (NaN where unknown): a g_0 far above it is the model
         extrapolated past the highest measured frequency, and the files say so.
+    model_g_inf : float
+        The model's own long-time modulus, lim G(t) as t → ∞ (the median over the draws; 0 for
+        a liquid; NaN where unknown), beside the series' ``g_inf``.
     """
 
     tau: np.ndarray
@@ -94,6 +104,7 @@ class Prony:
     shift_law: dict | None = None
     symbol: str = "G"
     measured_max: float = math.nan
+    model_g_inf: float = math.nan
 
     @property
     def g_0(self) -> float:
@@ -120,6 +131,7 @@ class Prony:
                 f"{self.unit or 'the data unit'}, as measured",
                 f"fitted over t = {self.window[0]:.4g} to {self.window[1]:.4g} s (the data window)",
                 f"g_inf = {self.g_inf:.10g}", f"g_0 = {self.g_0:.10g}",
+                *self.long_time_text(),
                 f"max_rel_error = {max(self.max_rel_error_modulus, self.max_rel_error_relaxation):.3g}"
                 f" ({e}', {e}'': {self.max_rel_error_modulus:.3g}; {e}(t): "
                 f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of {e}(t) is at "
@@ -209,6 +221,22 @@ class Prony:
         lines.append("*END")
         return lines
 
+    def long_time_text(self) -> list[str]:
+        """What g_inf stands for, beside the model's own long-time modulus."""
+        model, longest = self.model_g_inf, float(np.max(self.tau)) if self.tau.size else math.nan
+        if math.isnan(model):
+            return []
+        unit = f" {self.unit}" if self.unit else ""
+        if self.g_inf == 0.0:
+            return (["g_inf = 0: the model relaxes fully (a liquid)"] if model == 0.0 else
+                    [f"g_inf = 0 as asked, where the model's long-time modulus is {model:.6g}"
+                     f"{unit}"])
+        what = ("relaxes fully (a liquid)" if model == 0.0
+                else "does not settle (its G(t) grows without bound)" if math.isinf(model)
+                else f"has the long-time modulus {model:.6g}{unit}")
+        return [f"g_inf is the series' modulus beyond its longest relaxation time "
+                f"({longest:.4g} s); the model {what}"]
+
     def _law_text(self) -> str:
         law = self.shift_law
         p = law["parameters"]
@@ -224,7 +252,7 @@ class Prony:
                 f"(chi2/dof {law['chi2_per_dof']:.3g})")
 
 
-def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
+def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
                  structure: str | None = None, average: str | None = None,
                  seed: int = 0, terms: int | None = None) -> Prony:
     """A Prony series fitted to a comparison's structure (default the best ranked) or average.
@@ -235,8 +263,10 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
         A master curve gives the series at its reference temperature, with its shift law.
     per_decade : int
         Relaxation times per decade (1 to 10).
-    liquid : bool
-        G∞ = 0 (a liquid relaxes completely).
+    liquid : bool, optional
+        True: G∞ = 0 (a liquid relaxes completely); False: G∞ fitted with the terms; None
+        (default): 0 where the model's long-time modulus is 0 for the median draw
+        (:func:`~bayesfo.predictions.functions.long_time_modulus`), else fitted.
     structure : str, optional
         The structure (default: the best ranked), as in :func:`bayesfo.predict`.
     average : {"bma", "stacking"}, optional
@@ -254,7 +284,7 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     """
     from scipy.optimize import nnls
 
-    from .functions import predict
+    from .functions import long_time_modulus, predict
 
     if isinstance(per_decade, bool) or not isinstance(per_decade, int) or not 1 <= per_decade <= 10:
         raise InputError(f"export: terms per decade must be an integer from 1 to 10, got "
@@ -272,11 +302,17 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     storage = predict(result, "storage", omega, **kw)
     loss = predict(result, "loss", omega, **kw)
     g = storage.median + 1j * loss.median
+    model_g_inf = float(np.median(long_time_modulus(result, **kw)))
+    if liquid is None:
+        liquid = model_g_inf == 0.0
     if not np.all(np.isfinite(g)):
         raise InputError("export: the model's modulus is not finite over the window")
     # The terms reach TAU_MARGIN decades past the window: a power-law spectrum (a springpot)
     # relaxes over every decade, and terms only over the window leave its edges short.
-    lo_tau, hi_tau = 1 / (w_hi * 10**TAU_MARGIN), 10**TAU_MARGIN / w_lo
+    # Without G∞, a term further out takes the relaxation beyond the longest time that G∞
+    # would have stood for.
+    lo_tau = 1 / (w_hi * 10**TAU_MARGIN)
+    hi_tau = 10**(TAU_MARGIN + (LIQUID_MARGIN if liquid else 0)) / w_lo
     n = terms if terms is not None else int(round(math.log10(hi_tau / lo_tau) * per_decade)) + 1
     tau = np.logspace(math.log10(lo_tau), math.log10(hi_tau), n)
     s = 1j * omega[:, None] * tau
@@ -311,7 +347,8 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool = False,
     measured = np.abs(data.response if data.kind == "modulus" else 1.0 / data.response)
     return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
                    band_rel_halfwidth=half, shift_law=_shift_law(result) if master else None,
-                   symbol=data.symbol, measured_max=float(np.max(measured)))
+                   symbol=data.symbol, measured_max=float(np.max(measured)),
+                   model_g_inf=model_g_inf)
 
 
 def _shift_law(mc) -> dict:

@@ -312,12 +312,17 @@ class Structure(Parametrised):
         theta = np.asarray(theta, dtype=float)
         if theta.ndim != 1:
             raise StructureError(f"power_terms takes one parameter set, got shape {theta.shape}")
+        nc, ne, dc, de = self.power_arrays(theta)
+        return ([(float(c), float(e)) for c, e in zip(nc[0], ne[0])],
+                [(float(c), float(e)) for c, e in zip(dc[0], de[0])])
+
+    def power_arrays(self, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Coefficients and exponents of the numerator's and the denominator's terms for each
+        parameter set: (num_coef, num_exp, den_coef, den_exp), each (n_sets, terms of its side)."""
         vals, _ = self.values(theta)
-        sides = []
-        for terms in (self.numerator, self.denominator):
-            coef, expo = self._side_arrays(terms, vals, 1)
-            sides.append([(float(c), float(e)) for c, e in zip(coef[0], expo[0])])
-        return sides[0], sides[1]
+        n_sets = np.atleast_2d(np.asarray(theta, float)).shape[0]
+        return (*self._side_arrays(self.numerator, vals, n_sets),
+                *self._side_arrays(self.denominator, vals, n_sets))
 
     def response(self, theta, omega, kind: str = "compliance") -> np.ndarray:
         """The response compared with data of ``kind``: the transfer function, or its reciprocal

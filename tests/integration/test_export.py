@@ -22,7 +22,7 @@ def written(tmp_path_factory):
     out = tmp_path_factory.mktemp("run")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = bf.compare(bf.read(DATA), "voigt,zener,maxwell-int", workers=1,
+        result = bf.compare(bf.read(DATA), "voigt,zener,maxwell-int,springpot", workers=1,
                             progress=False, seed=0)
     bf.write_outputs(result, out, figures=False)
     return result, out
@@ -112,6 +112,42 @@ def test_a_liquid_relaxes_fully(written):
     result, _ = written
     prony = prony_series(result, structure="maxwell-int", liquid=True)
     assert prony.g_inf == 0.0 and prony.relaxation(1e6) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_long_time_modulus_follows_the_model(written, tmp_path, run_cli):
+    """By default G_inf is 0 where the model relaxes fully (the Maxwell liquid) and fitted
+    where it does not (the Voigt, whose long-time modulus is 1/b0); either can be forced, and
+    the files and the command say which and what the model's own long-time modulus is."""
+    result, out = written
+    liquid = prony_series(result, structure="maxwell-int")
+    assert liquid.g_inf == 0.0 and liquid.model_g_inf == 0.0
+    assert "g_inf = 0: the model relaxes fully (a liquid)" in liquid.text("csv")
+    # A springpot relaxes fully, but slowly: fitted, G_inf stands for its relaxation beyond
+    # the longest relaxation time.
+    fitted = prony_series(result, structure="springpot", liquid=False)
+    assert fitted.g_inf > 0 and fitted.model_g_inf == 0.0
+    assert (f"g_inf is the series' modulus beyond its longest relaxation time "
+            f"({fitted.tau.max():.4g} s); the model relaxes fully (a liquid)") in fitted.text("csv")
+
+    solid = prony_series(result, structure="voigt")
+    b0 = np.asarray(result["voigt"].posterior.samples)[:, 1]
+    # The median of 1/b0 over the prediction's draws (a subset of the posterior's): within
+    # the spread of medians of subsets of that size.
+    assert solid.model_g_inf == pytest.approx(np.median(1 / b0), rel=0.01)
+    assert solid.g_inf > 0
+    assert f"the model has the long-time modulus {solid.model_g_inf:.6g} Pa" \
+        in solid.text("abaqus")
+    assert prony_series(result, structure="voigt", liquid=True).g_inf == 0.0
+
+    status, text, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "l.csv",
+                                "--structure", "maxwell-int")
+    assert status == 0, err
+    assert "G_inf = 0 Pa" in text
+    assert "note: g_inf = 0: the model relaxes fully (a liquid) (--no-liquid fits G_inf" in text
+    status, text, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "f.csv",
+                                "--structure", "springpot", "--no-liquid")
+    assert status == 0, err
+    assert "the model relaxes fully (a liquid) (--liquid sets G_inf = 0)" in text
 
 
 def test_bad_requests(written, tmp_path, run_cli):

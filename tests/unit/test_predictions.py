@@ -144,3 +144,37 @@ def test_bad_arguments_name_what_is_wrong(x, message):
         evaluate(get_structure("zener"), [2.0, 3.0, 0.5, 0.6], "relaxation_modulus", x)
     with pytest.raises(InputError, match="unknown quantity 'G_t'"):
         evaluate(get_structure("zener"), [2.0, 3.0, 0.5, 0.6], "G_t", [1.0])
+
+
+@pytest.mark.parametrize("name, theta, expected", [
+    ("voigt", [2.0, 0.25, 0.4], 4.0),                      # 1/b0
+    ("zener", [2.0, 0.5, 0.1, 0.4], 2.0),                  # 1/b0
+    ("max-n2m1", [2.0, 1.0, 0.2, 0.1, 0.6], 5.0),          # 1/b0
+    ("fractional_zener_sl", [7.0, 3.0, 5.0, 0.3], 7.0),    # the parallel spring G_e
+    ("maxwell", [1e3, 2.0, 0.3, 0.8], 0.0),                # two springpots in series
+    ("fractional_kelvin_voigt", [3.0, 5.0, 0.2, 0.7], 0.0),
+    ("fractional_maxwell_gel", [7.0, 3.0, 0.4], 0.0),
+    ("fractional_maxwell_liquid", [3.0, 5.0, 0.4], 0.0),
+    ("fractional_jeffreys", [1.0, 3.0, 5.0, 0.4], 0.0),
+    ("fractional_burgers", [7.0, 5.0, 2.0, 3.0, 0.4], 0.0),
+    ("springpot", [3.0, 0.05], 0.0),                       # relaxes, if slowly
+    ("maxwell-inv", [1e3, 2.0, 0.3, 0.8], np.inf),         # C(s) -> 0: G(t) grows
+])
+def test_long_time_modulus_from_the_lowest_powers(name, theta, expected):
+    from bayesfo.predictions.functions import equilibrium_modulus
+
+    got = equilibrium_modulus(get_structure(name), [theta, theta])
+    np.testing.assert_array_equal(got, [expected, expected])
+
+
+def test_long_time_modulus_is_where_integer_orders_relax_to():
+    """An independent computation: G(t) by the Talbot inversion, long after the last
+    relaxation time, for structures of integer orders (exponential relaxation)."""
+    from bayesfo.predictions.functions import equilibrium_modulus
+
+    for name, theta in [("zener-int", [2.0, 3.0, 0.5]), ("maxwell-int", [2.0, 0.5]),
+                        ("max-n2m1-int", [2.0, 1.0, 0.2, 0.1])]:
+        s = get_structure(name)
+        late = evaluate(s, theta, "relaxation_modulus", [1e3])[0, 0]
+        g_e = equilibrium_modulus(s, theta)[0]
+        assert late == pytest.approx(g_e, rel=1e-8, abs=1e-10), name

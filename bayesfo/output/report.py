@@ -29,6 +29,7 @@ from ..comparison.table import number
 from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
 from ..options import LEADING_STRUCTURES, VERY_STRONG
+from ..structures.physical import meanings
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
     _bayes_factor,
@@ -282,7 +283,8 @@ def _parameters_section(comparison) -> str:
         if phys is None or phys["picture"] is None:
             parts.append(f"<h3>{_e(name)}</h3>{sampled}")
             continue
-        physical = _physical_table(phys["physical"], symbol)
+        physical = _physical_table(phys["physical"], symbol,
+                                   meanings(r.structure, phys["picture"]))
         picture = _picture_text(r.structure, phys["picture"], symbol)
         compliance = _e(in_symbol(r.structure.formula, symbol))
         if phys["natural_form"] == "physical":
@@ -324,7 +326,9 @@ def _flags(s: dict) -> list[str]:
             else []) + (["poorly determined"] if s.get("poorly_determined") else [])
 
 
-def _physical_table(block: dict, symbol: str = "G") -> str:
+def _physical_table(block: dict, symbol: str = "G", meaning: dict | None = None) -> str:
+    """The physical parameters' summaries, with what each is (``meaning``, from
+    :func:`~bayesfo.structures.physical.meanings`) in a last column where given."""
     rows = []
     for p, s in block.items():
         flags = _flags(s)
@@ -334,9 +338,12 @@ def _physical_table(block: dict, symbol: str = "G") -> str:
             f"{_cell(s['mean'], '.4g')}"
             f"{_cell(s['sd'], '.3g')}" + "".join(_cell(v, '.4g') for v in shown_hdi(s))
             + f"{_cell(s['median'], '.4g')}{_cell(s['map'], '.4g')}"
-            f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td></tr>")
-    return (f"<table>{_PARAMETER_HEAD}<th class='text'>flags</th></tr>{''.join(rows)}"
-            "</table>")
+            f"<td class='text{' flag' if flags else ''}'>{_e(', '.join(flags))}</td>"
+            + (_text_cell(in_symbol((meaning or {}).get(p, ''), symbol)) if meaning else "")
+            + "</tr>")
+    head = _PARAMETER_HEAD + "<th class='text'>flags</th>" + (
+        "<th class='text'>meaning</th>" if meaning else "")
+    return f"<table>{head}</tr>{''.join(rows)}</table>"
 
 
 def _picture_text(structure, picture: str, symbol: str = "G") -> str:

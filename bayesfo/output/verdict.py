@@ -204,11 +204,12 @@ def verdict(comparison) -> list[tuple[str, bool]]:
                     False))
     out.extend(_physical_sentence(name, result, skip={p for p, _ in orders}))
     out.extend(_noise_sentences(name, result))
-    poor = [r["structure"] for r in rows[1:]
-            if any(s.poorly_determined for _, s in _orders(comparison[r["structure"]]))]
+    poor = [f"{r['structure']} ({', '.join(symbols)})" for r in rows[1:]
+            if (symbols := [ORDER_SYMBOLS[p] for p, s in _orders(comparison[r["structure"]])
+                            if s.poorly_determined])]
     if poor:
-        out.append(("The fractional order is poorly determined (HDI wider than half the prior "
-                    f"range) for: {', '.join(poor)}.", True))
+        out.append(("Fractional orders poorly determined (HDI wider than half the prior "
+                    f"range): {'; '.join(poor)}.", True))
     # Every ranked structure, the winner first, named as the terminal names them (the form
     # natural to the data), whether or not a sentence above gave its values.
     vague = [f"{r['structure']} ({', '.join(names)})" for r in rows

@@ -375,7 +375,45 @@ def physical_units(structure, kind: str = "modulus", unit: str = "", *,
     out.update({n: "" for n in expo})
     if derived:
         out.update({p.name: format_unit(p.stress, p.time.substitute(fixed), symbol)
-                    for p in pic.derived})
+                    for p in _varying(structure, pic.derived)})
+    return out
+
+
+def _varying(structure, derived) -> list:
+    """The derived quantities that depend on a free parameter: one of fixed parameters alone
+    is a constant of the structure (the Maxwell's second springpot order β − α = 0 when both
+    are fixed at 1), not something the data tell."""
+    return [p for p in derived if not p.value.names <= set(structure.fixed)]
+
+
+def _element_text(element) -> str:
+    """What an element's coefficient is: "quasi-property of the springpot of order alpha"."""
+    if element.kind == "springpot":
+        return f"quasi-property of the springpot of order {element.order}"
+    return {"spring": "modulus of the spring", "dashpot": "viscosity of the dashpot"}.get(
+        element.kind, "")
+
+
+def meanings(structure, picture: str | None = None) -> dict[str, str]:
+    """What each physical parameter of a picture is, in words, in the order of
+    :func:`physical_units`: the card's description of a modulus, quasi-property or derived
+    quantity; for an order, the elements of the network whose order it is or enters
+    ("order of the springpot c_beta; in the order beta - alpha of the springpot c_delta").
+    Empty text where a parameter has neither."""
+    pic = picture_of(structure, picture)
+    elements = pic.network.elements() if pic.network is not None else []
+    out = {}
+    for name in physical_units(structure, "modulus", picture=picture):
+        given = next((p.description for p in pic.parameters + pic.derived if p.name == name),
+                     "")
+        if given or name not in structure.exponent_params:
+            element = next((e for e in elements if e.coefficient.text == name), None)
+            out[name] = given or ("" if element is None else _element_text(element))
+            continue
+        parts = [f"order of the {e.kind} {e.coefficient}" if e.order.text == name
+                 else f"in the order {e.order} of the {e.kind} {e.coefficient}"
+                 for e in elements if e.order is not None and name in e.order.names]
+        out[name] = "; ".join(parts)
     return out
 
 
@@ -399,7 +437,8 @@ def physical_dimensions(structure, coefficients, *, picture: str | None = None,
         out = {p.name: (p.stress, np.broadcast_to(p.time(vals), shape)) for p in pic.parameters}
     out.update({n: (0.0, np.zeros(shape)) for n in structure.param_names if n in expo})
     if derived:
-        out.update({p.name: (p.stress, np.broadcast_to(p.time(vals), shape)) for p in pic.derived})
+        out.update({p.name: (p.stress, np.broadcast_to(p.time(vals), shape))
+                    for p in _varying(structure, pic.derived)})
     return out
 
 

@@ -175,6 +175,10 @@ def test_parameter_summaries_and_priors_are_listed(comparison):
             "s^q).") in text
     assert "G*(s) = G_e + c_q s, sampled as the card&#x27;s compliance J(s) = b0 / (1 + a1 s)." \
         in text
+    # The physical parameters say what each is, in a last column.
+    assert "<th class='text'>meaning</th>" in text
+    assert '<td class="text">retardation time, tau^q = c_q/G_e</td>' in text
+    assert '<td class="text">order of the springpot c_q</td>' in text
 
 
 def test_figures_are_embedded_and_nothing_is_external(comparison, figures):
@@ -221,6 +225,15 @@ def test_flags_poor_order_non_convergence_and_failures(comparison):
     assert "maxwell (nothing admissible (test))" in flagged_text
     text = render_report(replace(comparison, results=results))
     assert "failed: nothing admissible (test)" in text
+    # A runner-up's poorly determined order is named with its structure.
+    second = comparison[runner_up]
+    q2 = replace(second.posterior.summary["q"], poorly_determined=True)
+    post2 = replace(second.posterior, summary={**second.posterior.summary, "q": q2})
+    vague = StructureResult(second.structure, second.fit, post2, second.criteria)
+    sentences = verdict(replace(comparison, results=tuple(
+        vague if x.name == runner_up else x for x in comparison.results)))
+    assert (f"Fractional orders poorly determined (HDI wider than half the prior range): "
+            f"{runner_up} (q).") in " ".join(t for t, f in sentences if f)
 
 
 def test_write_report_is_atomic_and_complete(comparison, figures, tmp_path):

@@ -312,6 +312,30 @@ def test_unit_strings_come_from_the_data():
         "G_m": "kPa", "eta": "kPa s", "G_k": "kPa", "c_alpha": "kPa s^alpha", "alpha": "",
         "tau_m": "s", "tau_k": "s"}
     assert physical_units(LIB["zener"], "modulus", "Pa", picture="fpt")["G_g"] == "Pa"
+    # The integer baseline fixes both orders: its second springpot's order β − α is the
+    # constant 0, not a quantity the data tell; its other parameters stay.
+    assert physical_units(LIB["maxwell-int"], "modulus", "Pa") == {
+        "c_beta": "Pa s", "c_delta": "Pa", "tau": "s", "E": "Pa"}
+
+
+def test_each_physical_parameter_says_what_it_is():
+    from bayesfo.structures.physical import meanings
+
+    maxwell = meanings(LIB["maxwell"])
+    assert list(maxwell) == list(physical_units(LIB["maxwell"]))
+    # The card's descriptions, and for the orders the elements they are or enter: the
+    # thesis' alpha is no element's order, only part of the second springpot's.
+    assert maxwell["delta"] == "order of the second springpot"
+    assert maxwell["E"] == "the thesis' modulus E = c_beta/tau^beta"
+    assert maxwell["beta"] == ("order of the springpot c_beta; in the order beta - alpha of the "
+                               "springpot c_delta")
+    assert maxwell["alpha"] == "in the order beta - alpha of the springpot c_delta"
+    # Without a description in the card: from the element the coefficient belongs to.
+    burgers = meanings(LIB["fractional_burgers"])
+    assert burgers["eta"] == "viscosity of the dashpot"
+    assert burgers["c_alpha"] == "quasi-property of the springpot of order alpha"
+    assert burgers["alpha"] == "order of the springpot c_alpha"
+    assert all(all(meanings(LIB[n]).values()) for n in ("zener", "voigt", "fractional_zener_ll"))
 
 
 def test_physical_parameters_of_draws_and_the_natural_form():

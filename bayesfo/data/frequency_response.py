@@ -301,9 +301,14 @@ class FrequencyResponse:
         for w in holdout:
             match = np.flatnonzero(np.isclose(self.omega, w, rtol=1e-6, atol=0.0))
             if not match.size:
+                # The two nearest on a logarithmic scale, closest first, with enough digits
+                # to be given back as they are.
+                near = self.omega[np.argsort(np.abs(np.log(self.omega / w)))[:2]] if w > 0 \
+                    else np.sort(self.omega)[:1]
                 raise InputError(
                     f"hold-out frequency {w:g} rad/s is not among the frequencies of {self.where()} "
-                    f"({self.omega.min():g} … {self.omega.max():g} rad/s)"
+                    f"({self.omega.min():g} … {self.omega.max():g} rad/s); the nearest measured: "
+                    + ", ".join(f"{v:.6g}" for v in near) + " rad/s"
                 )
             mask[match] = True
         if mask.all():

@@ -29,7 +29,7 @@ from ..comparison.table import number
 from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
 from ..options import LEADING_STRUCTURES, VERY_STRONG
-from ..structures.physical import meanings
+from ..structures.physical import in_brackets, meanings
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
     _bayes_factor,
@@ -160,8 +160,12 @@ def _ranking_table(comparison) -> str:
     cols = list(RANKING_COLUMNS)
     if holdout:
         cols.insert(9, ("holdout_lpd", "held-out lpd", ".2f"))
+    data = comparison.data
+    unit = in_symbol(data.units or {"modulus": "[G]", "compliance": "[J]"}.get(data.kind, ""),
+                     _symbol(comparison))
     head = ('<tr><th>#</th><th class="text">structure</th><th>k</th>'
-            + "".join(f"<th>{_e(h)}</th>" for _, h, _ in cols)
+            + "".join(f"<th>{_e(h + (in_brackets(unit) if k == 'rmse' else ''))}</th>"
+                      for k, h, _ in cols)
             + '<th class="text">orders</th><th class="text">converged</th></tr>')
     body = []
     for row in comparison.table():
@@ -193,7 +197,8 @@ def _ranking_table(comparison) -> str:
             "better) with the standard error of each estimate, by PSIS-LOO, whose Pareto k "
             "says where it is unreliable (WAIC, which estimates the same without a diagnostic "
             "of its own, is in ranking.csv and summary.json); AIC and BIC: lower is better; "
-            "RMSE at the posterior mode (thesis eq. (3.23)); orders: each fractional order by "
+            "RMSE at the posterior mode (thesis eq. (3.23)), in the data's unit; orders: each "
+            "fractional order by "
             "its symbol, posterior mean and 94 % HDI.</p>")
     return f"<table>{head}{''.join(body)}</table>{note}"
 

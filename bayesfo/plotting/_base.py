@@ -37,6 +37,7 @@ class Drawn:
 
     @classmethod
     def build(cls, figure, axes, values: dict, artists: dict, caption: str = "") -> Drawn:
+        plain_log_labels(figure)
         frozen = {}
         for k, v in values.items():
             a = np.array(v)
@@ -61,3 +62,53 @@ def axes_or_new(ax, size):
         return ax.figure, ax
     fig = new_figure(None, size)
     return fig, fig.add_subplot()
+
+
+#: A logarithmic axis whose view lies within these bounds is labelled with plain numbers (40, 60,
+#: 100, 0.2) instead of powers of ten (4×10¹, 6×10¹, 10², 2×10⁻¹); one that reaches beyond
+#: keeps them all as powers.
+PLAIN_LOG_RANGE = (1e-2, 1e4)
+
+
+def plain_log_labels(figure) -> None:
+    """Label the logarithmic axes of ``figure`` that lie within :data:`PLAIN_LOG_RANGE` with
+    plain numbers: the same ticks labelled, as ``{:g}`` (decided at each draw, from the view
+    then). Axes with a formatter of their own are left as they are."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    plain = _plain_formatter()
+    for ax in figure.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            if axis.get_scale() != "log":
+                continue
+            for get, put in ((axis.get_major_formatter, axis.set_major_formatter),
+                             (axis.get_minor_formatter, axis.set_minor_formatter)):
+                old = get()
+                if type(old) is LogFormatterSciNotation:
+                    put(plain(base=old._base, labelOnlyBase=old.labelOnlyBase,
+                              minor_thresholds=old.minor_thresholds, linthresh=old._linthresh))
+
+
+_PLAIN = []
+
+
+def _plain_formatter():
+    """The formatter class of :func:`plain_log_labels` (defined once matplotlib is loaded)."""
+    if not _PLAIN:
+        from matplotlib.ticker import LogFormatterSciNotation
+
+        class PlainLogFormatter(LogFormatterSciNotation):
+            """Powers of ten as plain numbers where the whole view lies within
+            :data:`PLAIN_LOG_RANGE`; the labels of :class:`LogFormatterSciNotation` elsewhere."""
+
+            def __call__(self, x, pos=None):
+                label = super().__call__(x, pos)
+                if not label or self.axis is None:
+                    return label
+                lo, hi = sorted(self.axis.get_view_interval())
+                if PLAIN_LOG_RANGE[0] <= lo and hi < PLAIN_LOG_RANGE[1]:
+                    return f"{x:g}"
+                return label
+
+        _PLAIN.append(PlainLogFormatter)
+    return _PLAIN[0]

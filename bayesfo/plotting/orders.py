@@ -240,9 +240,11 @@ def _zoom_inset(ax, name, s, grid, dens, pd, base, color, span, ridge_height, va
     prior_at = float(np.max(pd[inside])) if np.any(inside) else 0.0
     ratio = peak / prior_at if prior_at > 0 else np.inf
     note = ("prior ≈ 0" if not np.isfinite(ratio) else
-            f"peak\n{ratio:.3g}×\nprior" if ratio < 1e4 else f"peak\n{ratio:.0e}×\nprior")
-    artists[f"{name}/inset_note"] = inset.text(0.03, 0.95, note, transform=inset.transAxes,
-                                               fontsize=5.0, ha="left", va="top", color="0.25")
+            f"peak {ratio:.3g}× prior" if ratio < 1e4 else f"peak {ratio:.0e}× prior")
+    # Above the inset, not inside it: the zoomed ridge fills its middle, and a note in a
+    # corner ran into its flank.
+    artists[f"{name}/inset_note"] = inset.set_title(note, fontsize=5.0, loc="left", pad=1.5,
+                                                    color="0.25")
     inset.set_xlim(z_lo, z_hi)
     inset.set_ylim(-0.12, 1.08)
     inset.set_yticks([])

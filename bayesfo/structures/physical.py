@@ -228,19 +228,20 @@ def display_name(name: str, symbol: str = "G") -> str:
 
 # ---------------------------------------------------------------------------- units
 def in_brackets(unit: str) -> str:
-    """`` [unit]`` after a quantity's name, nothing without a unit, and the placeholder of data
-    without a unit (``[G]``, :func:`stress_unit`) as it is, not bracketed twice.
+    """`` [unit]`` after a quantity's name, nothing without a unit; the placeholder of data
+    without a unit (``[G]``, ``[J]``: :func:`stress_unit`) is not bracketed twice, alone or in
+    a compound unit (``[G s^q]``, read as the unit of G times s^q).
 
     Examples
     --------
-    >>> in_brackets("Pa"), in_brackets("[G]"), in_brackets("")
-    (' [Pa]', ' [G]', '')
+    >>> in_brackets("Pa"), in_brackets("[G]"), in_brackets("[G] s^q"), in_brackets("")
+    (' [Pa]', ' [G]', ' [G s^q]', '')
+    >>> in_brackets("1/[J]")
+    ' [1/J]'
     """
     if not unit:
         return ""
-    if unit.startswith("[") and unit.endswith("]") and unit.count("[") == 1:
-        return f" {unit}"
-    return f" [{unit}]"
+    return f" [{unit.replace('[', '').replace(']', '')}]"
 
 
 def stress_unit(kind: str, unit: str = "") -> str:

@@ -132,6 +132,12 @@ def test_split_by_frequency():
     np.testing.assert_array_equal(test.response, G[[1, 3]])
     with pytest.raises(InputError, match="hold-out frequency 3 rad/s is not among"):
         fr.split([3.0])
+    # The nearest measured frequencies, on a log scale, closest first (3 is nearer to 4 than
+    # to 2 by ratio), to give back as they are.
+    with pytest.raises(InputError, match=r"the nearest measured: 4, 2 rad/s$"):
+        fr.split([3.0])
+    with pytest.raises(InputError, match=r"the nearest measured: 0.5 rad/s$"):
+        fr.split([0.0])
     with pytest.raises(InputError, match="nothing is left to fit"):
         fr.split(W)
 

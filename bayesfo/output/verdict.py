@@ -210,6 +210,12 @@ def verdict(comparison) -> list[tuple[str, bool]]:
     if poor:
         out.append(("Fractional orders poorly determined (HDI wider than half the prior "
                     f"range): {'; '.join(poor)}.", True))
+    undecided = [text for r in rows[1:]
+                 if (text := _undecided_noise(r["structure"], comparison[r["structure"]]))]
+    if undecided:
+        out.append(("Exponents that depend on a noise model the evidence does not decide "
+                     f"({HDI_PERCENT} % intervals under each; state σ per point or choose the "
+                     f"noise model with --noise): {'; '.join(undecided)}.", True))
     # Every ranked structure, the winner first, named as the terminal names them (the form
     # natural to the data), whether or not a sentence above gave its values.
     vague = [f"{r['structure']} ({', '.join(names)})" for r in rows
@@ -293,6 +299,27 @@ def _physical_sentence(name, result, skip=None) -> list[tuple[str, bool]]:
 def _join(items) -> str:
     items = list(items)
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _undecided_noise(name, result) -> str:
+    """``"zener (q 0.236–0.259 under constant noise, 0.463–0.549 under proportional;
+    probability 0.891 for constant)"`` where the structure's exponents depend on the noise
+    model and the evidence does not decide it; empty otherwise."""
+    from ..comparison.steps import NOISE_DECISIVE
+
+    record = result.criteria.noise_models
+    if not record or not record.get("sensitive"):
+        return ""
+    chosen, models = record["chosen"], record["models"]
+    p = models[chosen]["probability"]
+    if p is None or p >= NOISE_DECISIVE:
+        return ""
+    names = [chosen, *(n for n in models if n != chosen)]
+    parts = [f"{ORDER_SYMBOLS.get(param, param)} " + ", ".join(
+        f"{models[n]['hdi'][param][0]:.3g}–{models[n]['hdi'][param][1]:.3g} under {n}"
+        + (" noise" if i == 0 else "") for i, n in enumerate(names) if param in models[n]["hdi"])
+        for param in record["sensitive_parameters"]]
+    return f"{name} ({'; '.join(parts)}; probability {p:.3f} for {chosen})"
 
 
 def _noise_sentences(name, result) -> list[tuple[str, bool]]:

@@ -294,3 +294,27 @@ def test_the_verdict_says_when_the_data_fail_the_kramers_kronig_test():
     text, flagged = sentences[0]
     assert flagged and text.startswith("Data: the real and imaginary parts are not consistent")
     assert f"{100 * kk.misfit_rms:.2g} % rms" in text
+
+
+def test_a_runner_up_whose_exponents_hang_on_an_undecided_noise_model_is_named():
+    """Non-overlapping intervals under the two noise models, and evidence that gives the
+    chosen one less than NOISE_DECISIVE: named with both intervals; decided, or not sensitive:
+    nothing (the polystyrene's zener at 160 °C: q 0.236–0.259 against 0.463–0.549, 0.891)."""
+    from types import SimpleNamespace
+
+    from bayesfo.output.verdict import _undecided_noise
+
+    def result(p, sensitive=True):
+        models = {"constant": {"probability": p, "hdi": {"q": [0.236, 0.259]}},
+                  "proportional": {"probability": 1 - p, "hdi": {"q": [0.463, 0.549]}}}
+        record = {"chosen": "constant", "models": models, "sensitive": sensitive,
+                  "sensitive_parameters": ["q"] if sensitive else []}
+        return SimpleNamespace(criteria=SimpleNamespace(noise_models=record))
+
+    assert _undecided_noise("zener", result(0.891)) == (
+        "zener (q 0.236–0.259 under constant noise, 0.463–0.549 under proportional; "
+        "probability 0.891 for constant)")
+    assert _undecided_noise("zener", result(0.995)) == ""
+    assert _undecided_noise("zener", result(0.891, sensitive=False)) == ""
+    assert _undecided_noise("zener", SimpleNamespace(
+        criteria=SimpleNamespace(noise_models=None))) == ""

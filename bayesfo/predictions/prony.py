@@ -130,6 +130,7 @@ class Prony:
         head = [f"Prony series of {self.source} (bayesfo), {mode} modulus {e} in "
                 f"{self.unit or 'the data unit'}, as measured",
                 f"fitted over t = {self.window[0]:.4g} to {self.window[1]:.4g} s (the data window)",
+                *self._reach_text(),
                 f"g_inf = {self.g_inf:.10g}", f"g_0 = {self.g_0:.10g}",
                 *self.long_time_text(),
                 f"max_rel_error = {max(self.max_rel_error_modulus, self.max_rel_error_relaxation):.3g}"
@@ -220,6 +221,18 @@ class Prony:
         lines += [field(g) + field(b) + field(0.0) * 2 for g, b in rows]
         lines.append("*END")
         return lines
+
+    def _reach_text(self) -> list[str]:
+        """Where the relaxation times lie against the data window: terms beyond it stand for
+        the model's extrapolation, which lets the series follow it to the window's ends."""
+        if not self.tau.size:
+            return []
+        lo, hi = float(np.min(self.tau)), float(np.max(self.tau))
+        if lo >= self.window[0] and hi <= self.window[1]:
+            return []
+        return [f"relaxation times {lo:.4g} to {hi:.4g} s: those beyond the data window stand "
+                "for the model's extrapolation there, so that the series follows the model to "
+                "the window's ends"]
 
     def long_time_text(self) -> list[str]:
         """What g_inf stands for, beside the model's own long-time modulus."""

@@ -122,6 +122,10 @@ def test_the_long_time_modulus_follows_the_model(written, tmp_path, run_cli):
     liquid = prony_series(result, structure="maxwell-int")
     assert liquid.g_inf == 0.0 and liquid.model_g_inf == 0.0
     assert "g_inf = 0: the model relaxes fully (a liquid)" in liquid.text("csv")
+    # Terms beyond the data window are named as the model's extrapolation.
+    assert (f"relaxation times {liquid.tau.min():.4g} to {liquid.tau.max():.4g} s: those beyond "
+            "the data window stand for the model's extrapolation") in liquid.text("abaqus")
+    assert liquid.tau.max() > liquid.window[1]
     # A springpot relaxes fully, but slowly: fitted, G_inf stands for its relaxation beyond
     # the longest relaxation time.
     fitted = prony_series(result, structure="springpot", liquid=False)

@@ -122,14 +122,16 @@ def test_the_long_time_modulus_follows_the_model(written, tmp_path, run_cli):
     liquid = prony_series(result, structure="maxwell-int")
     assert liquid.g_inf == 0.0 and liquid.model_g_inf == 0.0
     assert "g_inf = 0: the model relaxes fully (a liquid)" in liquid.text("csv")
-    # Terms beyond the data window are named as the model's extrapolation.
-    assert (f"relaxation times {liquid.tau.min():.4g} to {liquid.tau.max():.4g} s: those beyond "
-            "the data window stand for the model's extrapolation") in liquid.text("abaqus")
-    assert liquid.tau.max() > liquid.window[1]
+    # Its two terms lie inside the data window: nothing is said of extrapolation.
+    assert liquid.tau.max() < liquid.window[1] and "extrapolation" not in liquid.text("csv")
     # A springpot relaxes fully, but slowly: fitted, G_inf stands for its relaxation beyond
     # the longest relaxation time.
     fitted = prony_series(result, structure="springpot", liquid=False)
     assert fitted.g_inf > 0 and fitted.model_g_inf == 0.0
+    # Its terms reach beyond the data window: named as the model's extrapolation.
+    assert fitted.tau.max() > fitted.window[1]
+    assert (f"relaxation times {fitted.tau.min():.4g} to {fitted.tau.max():.4g} s: those beyond "
+            "the data window stand for the model's extrapolation") in fitted.text("abaqus")
     assert (f"g_inf is the series' modulus beyond its longest relaxation time "
             f"({fitted.tau.max():.4g} s); the model relaxes fully (a liquid)") in fitted.text("csv")
 

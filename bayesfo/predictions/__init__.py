@@ -1,9 +1,17 @@
 """What follows from a compared model: material functions with credible bands, and averages
-over structures (:func:`predict`), and Prony series for finite-element codes
-(:func:`prony_series`)."""
+over structures (:func:`predict`), the long-time modulus (:func:`long_time_modulus`), and
+Prony series for finite-element codes (:func:`prony_series`)."""
 
-from .functions import AVERAGES, QUANTITIES, Prediction, evaluate, predict
+from .functions import (
+    AVERAGES,
+    QUANTITIES,
+    Prediction,
+    equilibrium_modulus,
+    evaluate,
+    long_time_modulus,
+    predict,
+)
 from .prony import FORMATS, Prony, prony_series
 
-__all__ = ["AVERAGES", "FORMATS", "QUANTITIES", "Prediction", "Prony", "evaluate", "predict",
-           "prony_series"]
+__all__ = ["AVERAGES", "FORMATS", "QUANTITIES", "Prediction", "Prony", "equilibrium_modulus",
+           "evaluate", "long_time_modulus", "predict", "prony_series"]

@@ -96,6 +96,7 @@ from .physical import (
                     Picture,
                     coefficient_units,
                     coefficients_from_physical,
+                    meanings,
                     parameter_forms,
                     physical_dimensions,
                     physical_parameters,
@@ -112,6 +113,6 @@ __all__ = ["CARD_KEYS", "MAX_DEGREE", "MODEL_PATH_ENV", "N_MAX_DEFAULT", "Expone
            "Library", "Parameter", "Picture", "Scaling", "Structure", "Term", "card_paths",
            "coefficient_units", "coefficients_from_physical", "default_library",
            "fix_parameters", "get_structure", "integer_variant", "inverted_variant", "list_structures",
-           "load_library", "parameter_forms", "physical_dimensions", "physical_parameters", "physical_units",
+           "load_library", "meanings", "parameter_forms", "physical_dimensions", "physical_parameters", "physical_units",
            "picture_for", "picture_of", "resolve_structures", "stress_unit",
            "structures_from_card"]

@@ -35,6 +35,18 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
     return path
 
 
+def write_error(path: str | os.PathLike, exc: OSError) -> str:
+    """Why ``path`` could not be written, in words: the nearest existing folder on its way
+    that is a file ("'out/run' is a file, not a folder"; the system says "File exists" or
+    "Not a directory"), else the system's reason."""
+    for parent in Path(path).parents:
+        if parent.exists():
+            if not parent.is_dir():
+                return f"'{parent}' is a file, not a folder"
+            break
+    return exc.strerror or str(exc)
+
+
 def publish(tmp: str | os.PathLike, path: str | os.PathLike) -> None:
     """Give a finished temporary file the usual permissions (mkstemp makes it private) and
     rename it over ``path`` atomically."""

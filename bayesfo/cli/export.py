@@ -48,7 +48,7 @@ def add_parser(subparsers):
 def run(args) -> int:
     from pathlib import Path
 
-    from .._io import atomic_write_text
+    from .._io import atomic_write_text, write_error
     from ..comparison import load
     from ..errors import InputError
     from ..predictions.prony import prony_series
@@ -74,7 +74,8 @@ def run(args) -> int:
     try:
         atomic_write_text(args.out, text)
     except OSError as exc:
-        raise InputError(f"--out '{args.out}': cannot be written ({exc.strerror or exc})") \
+        raise InputError(f"--out '{args.out}': cannot be written "
+                         f"({write_error(args.out, exc)})") \
             from None
     if args.figure is not None:
         from ._libraries import load_libraries
@@ -89,7 +90,7 @@ def run(args) -> int:
             save_figure(drawn.figure, args.figure, close=True)
         except OSError as exc:
             raise InputError(f"--figure '{args.figure}': cannot be written "
-                             f"({exc.strerror or exc})") from None
+                             f"({write_error(args.figure, exc)})") from None
         print(f"wrote {args.figure}")
     error = max(prony.max_rel_error_modulus, prony.max_rel_error_relaxation)
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import InputError
 
 #: Master structures ranked by default: a few seconds each on 20 isotherms.
-DEFAULT_STRUCTURES = "zener,fractional_zener_sl,max-n2m1"
+DEFAULT_STRUCTURES = "zener,max-n2m1,fractional_zener_ll"
 
 
 def add_parser(subparsers):
@@ -215,7 +215,9 @@ def _print(mc, out) -> None:
     for f in mc.shift_factors():
         line = f"{f['temperature']:8g}"
         for key in ("log10_aT", "log10_bT") if vertical else ("log10_aT",):
-            a = f[key]
+            # Rounded, then + 0.0: the reference's shift under a law, -1e-17 to rounding, is
+            # printed as 0.000, not -0.000.
+            a = {k: round(f[key][k], 3) + 0.0 for k in ("mean", "sd", "hdi_low", "hdi_high")}
             hdi = f"[{a['hdi_low']:.3f}, {a['hdi_high']:.3f}]"
             line += f" {a['mean']:10.3f} {a['sd']:7.3f} {hdi:>20}"
         print(line)
@@ -235,7 +237,22 @@ def _print(mc, out) -> None:
         print(describe_parts(parts))
     for n in mc.notes:
         print(f"note: {n}")
+    _print_cautions(mc)
     print(f"wrote {out}/summary.json, master.csv, {mc.structure}.nc" + (
         "" if not (out / "figures").exists()
         else ", report.html and figures/mastercurve.png, figures/residuals.png, "
              "figures/van_gurp_palmen.png"))
+
+
+def _print_cautions(mc) -> None:
+    """What the report's verdict cautions about beyond the lines above: whether the master
+    function describes the isotherms, and the overall answer on superposition where the tests
+    part (``summary.json``'s ``tts_valid``)."""
+    text = mc.misfit()
+    if text:
+        print(f"caution: {text}")
+    vgp = mc.tts_checks.get("van_gurp_palmen") or {}
+    if mc.tts_valid is False and vgp.get("valid"):
+        print("superposition not established (tts_valid false in summary.json): the van "
+              "Gurp–Palmen test passes, but the shifts of G′, G″ and tan δ disagree (the note "
+              "above); --vertical free lets the isotherms shift vertically too")

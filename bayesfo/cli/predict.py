@@ -106,6 +106,7 @@ def run(args) -> int:
 
 
 def _figure(p, path) -> None:
+    from .._io import write_error
     from ..plotting.material import plot_prediction
     from ..plotting.output import save_figure
     from ._libraries import load_libraries
@@ -114,7 +115,7 @@ def _figure(p, path) -> None:
     try:
         save_figure(plot_prediction(p).figure, path, close=True)
     except OSError as exc:
-        raise InputError(f"--figure '{path}': cannot be written ({exc.strerror or exc})") \
+        raise InputError(f"--figure '{path}': cannot be written ({write_error(path, exc)})") \
             from None
 
 
@@ -124,7 +125,8 @@ def _csv_text(p) -> str:
     lines = [f"# {p.symbol or QUANTITIES[p.quantity][1]} ({p.quantity}) in {p.unit or 'no unit'}; "
              f"94 % HDI of the posterior; "
              + (f"structure {p.structure}" if p.weights is None else
-                f"{p.average} average: {_weights(p)}")]
+                f"{p.average} average: {_weights(p)}")
+             + (f" at {p.temperature:g} °C" if p.temperature is not None else "")]
     lines += [f"# note: {n}" for n in p.notes]
     lines.append(f"x_{p.x_unit.replace('/', '_per_')},median,hdi_low,hdi_high,extrapolated")
     for row in zip(p.x, p.median, p.hdi_low, p.hdi_high, p.extrapolated, strict=True):
@@ -133,12 +135,13 @@ def _csv_text(p) -> str:
 
 
 def _write_csv(p, path) -> None:
-    from .._io import atomic_write_text
+    from .._io import atomic_write_text, write_error
 
     try:
         atomic_write_text(path, _csv_text(p))
     except OSError as exc:
-        raise InputError(f"--out '{path}': cannot be written ({exc.strerror or exc})") from None
+        raise InputError(f"--out '{path}': cannot be written ({write_error(path, exc)})") \
+            from None
 
 
 def _print(p) -> None:

@@ -7,8 +7,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
-
 from .._io import atomic_write_text
 from .report import CSS, _e, _figures_section, _num
 
@@ -26,9 +24,6 @@ CAPTIONS = {
                        "the isotherms of a thermorheologically simple material fall on one "
                        "curve.",
 }
-#: A median isotherm residual (relative rms) above this says the master function does not
-#: describe the isotherms at all (measurement noise is a few per cent at most).
-MISFIT_RMS = 0.05
 _LAW_NAMES = {"free": "free shifts", "wlf": "the WLF law", "arrhenius": "the Arrhenius law"}
 
 
@@ -36,7 +31,6 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     """Sentences in reading order, each with whether it is a caution: is superposition valid,
     does the master function describe every isotherm, which master function and which shift
     law the evidence supports, and whether the posterior is certified."""
-    from ..tts.joint import ISOTHERM_MISFIT
     from ..tts.validity import describe, describe_parts
 
     out: list[tuple[str, bool]] = []
@@ -49,18 +43,9 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
         text = describe_parts(parts)
         out.append((text[0].upper() + text[1:] + ".",
                     not parts["consistent"] and mc.vertical == "none"))
-    fit = mc.tts_checks.get("isotherm_fit", {})
-    misfit = fit.get("misfit") or []
-    rms = [r for r in fit.get("rms_relative", []) if r is not None]
-    if rms and float(np.median(rms)) > MISFIT_RMS:
-        out.append((f"The joint fit of {mc.structure} misses the isotherms by "
-                    f"{100 * min(rms):.2g}–{100 * max(rms):.2g} % rms (median "
-                    f"{100 * float(np.median(rms)):.2g} %): it does not describe them; other "
-                    "master functions (or 'spectrum', which needs no structure) may.", True))
-    elif misfit:
-        out.append((f"The joint fit of {mc.structure} misses the isotherm(s) at "
-                    f"{', '.join(f'{t:g}' for t in misfit)} °C (relative residuals over "
-                    f"{ISOTHERM_MISFIT:g} times the median isotherm's).", True))
+    text = mc.misfit()
+    if text:
+        out.append((text, True))
     ranked = [r for r in mc.ranking if r.get("log_evidence") is not None]
     if len(ranked) > 1:
         gap = ranked[0]["log_evidence"] - ranked[1]["log_evidence"]

@@ -275,6 +275,23 @@ def _checked(data, window, points, cost) -> tuple[float, float]:
     return w_lo, w_hi
 
 
+def _named_notes(ranked, names) -> list[str]:
+    """What the user should know of the structures ``--structures`` names: the best ranked
+    structure left out, and named structures that fail the posterior predictive checks (telling
+    apart two that miss the data may settle nothing)."""
+    notes = []
+    if ranked and ranked[0].name not in names:
+        notes.append(f"the best ranked structure, {ranked[0].name}, is not among those named; "
+                     "their probabilities are relative to each other only")
+    missing = [r.name for r in ranked if r.name in names and r.criteria.adequacy is not None
+               and not r.criteria.adequacy.adequate]
+    if missing:
+        notes.append(f"{', '.join(missing)} {'fails' if len(missing) == 1 else 'fail'} the "
+                     "posterior predictive checks: points that tell them apart may not tell "
+                     "which describes the material")
+    return notes
+
+
 def design(result, *, window=None, points: int = 3, structures=None, cost: str = "uniform",
            seed: int = 0) -> Design:
     """The frequencies to measure next to tell the structures of ``result`` apart.
@@ -312,6 +329,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
     w_lo, w_hi = _checked(data, window, points, cost)
     ranked = [result[n] for n in result.ranking]
+    notes = []
     if structures is not None:
         names = [structures] if isinstance(structures, str) else list(structures)
         known = {r.name for r in ranked}
@@ -319,6 +337,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
             if n not in known:
                 raise InputError(f"design: no structure '{n}' with a posterior in the "
                                  f"comparison; it has {', '.join(sorted(known))}")
+        notes += _named_notes(ranked, names)
         ranked = [r for r in ranked if r.name in names]
     # Probabilities from ln Z over the structures considered, equal prior odds.
     log_z = np.array([-np.inf if r.log_z is None else r.log_z for r in ranked])
@@ -326,13 +345,15 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         probs = np.exp(log_z - log_z.max()) if np.isfinite(log_z).any() else np.zeros(len(ranked))
     probs = probs / probs.sum() if probs.sum() > 0 else probs
     keep = [i for i in range(len(ranked)) if probs[i] >= MIN_PROBABILITY][:MAX_STRUCTURES]
-    notes = []
     if len(keep) < 2:
         leader = ranked[0].name if ranked else "none"
+        among = " among those --structures names" if structures is not None else ""
         raise InputError(
             "design needs two or more structures that could still win; "
-            + (f"{leader} has posterior probability {probs[0]:.4f} and the others below "
-               f"{MIN_PROBABILITY:g}: the choice is settled by these data"
+            + (f"{leader} has posterior probability {probs[0]:.4f}{among} and the others "
+               f"below {MIN_PROBABILITY:g}: the choice is settled by these data (--parameter "
+               f"NAME instead proposes the frequencies that best determine a parameter of "
+               f"{leader})"
                if len(ranked) > 1 else "the comparison has one structure with a posterior"))
     if len(keep) < sum(probs >= MIN_PROBABILITY):
         notes.append(f"the {MAX_STRUCTURES} most probable structures are considered")
@@ -359,8 +380,10 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     time = seconds(omega)
     chosen, proposed, info_so_far = [], [], 0.0
     for _ in range(points):
-        sets = np.array([chosen + [j] for j in c])
-        info, _ = pred.information(sets, log_prior, rng)
+        # The first point's information is the candidates' own (the same estimate, so that the
+        # proposal and the curve drawn of the candidates agree); later ones that of the set.
+        info = single if not chosen else pred.information(
+            np.array([chosen + [j] for j in c]), log_prior, rng)[0]
         gains = info - info_so_far
         gains[chosen] = -np.inf  # distinct frequencies, as a sweep measures them
         if chosen and gains.max() < max(NEGLIGIBLE, NEGLIGIBLE_SHARE * entropy):

@@ -32,6 +32,7 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
 
     fig = new_figure(fig, (11.0, 3.8))
     axes = fig.subplots(1, 3)
+    _apart(fig)
     modulus = mc.data.kind == "modulus"
     parts = ("storage", "loss") if modulus else ("storage_compliance", "loss_compliance")
     symbols = parts_of(mc.data.symbol, mc.data.kind)
@@ -94,10 +95,13 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     # (law="auto", against free shifts too), else from BIC on the shifts.
     p = ({k: v["probability"] for k, v in mc.law_evidence.items()} if mc.law_evidence
          else {k: v["probability"] for k, v in laws.items()})
+    # A law with as many constants as free shifts passes through them: they cannot test it.
+    untested = {k: ", untested" if laws[k].get("dof", 1) <= 0 else "" for k in laws}
     ax.plot(tt, wlf(tt, t_ref, c1, c2), "-", color="#0072B2",
-            label=f"WLF C1 {c1:.3g}, C2 {c2:.3g} °C (P {p['wlf']:.2f})")
+            label=f"WLF C1 {c1:.3g}, C2 {c2:.3g} °C (P {p['wlf']:.2f}{untested['wlf']})")
     ax.plot(tt, arrhenius(tt, t_ref, ea), "--", color="#D55E00",
-            label=f"Arrhenius Ea {ea / 1e3:.3g} kJ/mol (P {p['arrhenius']:.2f})")
+            label=f"Arrhenius Ea {ea / 1e3:.3g} kJ/mol (P {p['arrhenius']:.2f}"
+                  f"{untested['arrhenius']})")
     ax.set_xlabel("T [°C]")
     ax.set_ylabel("log10 a_T")
     ax.legend(loc="best", fontsize=7)
@@ -177,6 +181,7 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
 
     fig = new_figure(fig, (11.0, 3.6))
     axes = fig.subplots(1, 3)
+    _apart(fig)
     modulus = mc.data.kind == "modulus"
     symbols = parts_of(mc.data.symbol, mc.data.kind)
     temps = np.asarray(mc.temperatures)
@@ -233,3 +238,11 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
     ax.set_title("missed isotherms in red" if fit.get("misfit") else
                  "no isotherm missed", fontsize=8)
     return Drawn.build(fig, tuple(axes), values, artists)
+
+
+def _apart(fig) -> None:
+    """Room between the panels: the colour bar's label beside the second panel otherwise runs
+    into the third panel's axis label."""
+    engine = fig.get_layout_engine()
+    if engine is not None and hasattr(engine, "set"):
+        engine.set(wspace=0.08)

@@ -124,6 +124,8 @@ def plot_prediction(prediction, *, ax=None) -> Drawn:
     who = (p.structure if p.weights is None else
            f"{p.average} average of " + ", ".join(
                k for k, w in sorted(p.weights.items(), key=lambda kv: -kv[1]) if w >= 0.01))
+    if getattr(p, "temperature", None) is not None:
+        who += f" at {p.temperature:g} °C"
     (line,) = ax.plot(p.x, p.median, "k-", lw=1.2, label="posterior median")
     ax.set_title(who, fontsize=8, wrap=True)
     out = np.asarray(p.extrapolated, bool)

@@ -89,6 +89,9 @@ class Prediction:
         :mod:`bayesfo.data.symbols`).
     window : tuple of float or None
         The ends of that window, in the unit of x.
+    temperature : float or None
+        [°C] For a master curve: the temperature the function is at (the reference
+        temperature unless another was asked for); None for a comparison.
     """
 
     quantity: str
@@ -106,6 +109,7 @@ class Prediction:
     values: np.ndarray = field(default=None, repr=False)
     symbol: str = ""
     window: tuple[float, float] | None = None
+    temperature: float | None = None
 
     def to_dict(self) -> dict:
         """The JSON form (``bayesfo predict --json``): plain lists, NaN as None."""
@@ -119,6 +123,8 @@ class Prediction:
                "extrapolated": [bool(v) for v in self.extrapolated]}
         if self.window is not None:
             out["window"] = [float(v) for v in self.window]
+        if self.temperature is not None:
+            out["temperature"] = float(self.temperature)
         if self.weights is None:
             out["structure"] = self.structure
         else:
@@ -192,9 +198,11 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
         return _predict_master(result, quantity, x, structure, average, temperature, rng)
     if temperature is not None:
         raise InputError("predict: a temperature applies to a master curve only (bayesfo "
-                         "mastercurve); a comparison describes the data at their own")
+                         "mastercurve); a comparison describes the data at their own temperature")
     weights, notes, drawn = _mixture(result, structure, average, rng)
     values = np.concatenate([_evaluate(s, theta, quantity, x) for s, theta in drawn], axis=0)
+    if average is None:
+        notes += _misfit_note(result[next(iter(weights))])
     if quantity in ("relaxation_spectrum", "retardation_spectrum"):
         discrete = [n for n in weights if result[n].structure.integer and weights[n] >= 1e-3]
         if discrete:
@@ -227,7 +235,7 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
     shifts at ``temperature`` (the reference temperature by default)."""
     domain = QUANTITIES[quantity][0]
     t = mc.reference_temperature if temperature is None else temperature
-    master, theta, log_a, log_b = _master_draws(mc, structure, average, t, rng)
+    master, theta, log_a, log_b, mean_a = _master_draws(mc, structure, average, t, rng)
     a = 10.0 ** log_a[:, None]
     x_ref = x[None, :] * a if domain == "omega" else x[None, :] / a
     values = _evaluate(master, theta, quantity, x_ref)
@@ -239,18 +247,24 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
         f"draw's shifts (log10 a_T median {np.median(log_a):.3g}"
         + ("" if mc.vertical == "none" else f", log10 b_T median {np.median(log_b):.3g}")
         + ")"]
+    if (missed := mc.misfit()):
+        notes.append(missed[0].lower() + missed[1:].rstrip(".") + "; the band is the posterior "
+                     "of its mean function, without the data's scatter or its misfit, so "
+                     "measured values may lie outside it")
     median, lo, hi = _band(values)
-    window = mc.reduced_omega() / 10.0 ** float(np.median(log_a))
+    # At the posterior mean shift, as the reduced window: an isotherm's own frequencies at its
+    # own temperature are then inside it.
+    window = mc.reduced_omega() / 10.0 ** mean_a
     return Prediction(
         quantity=quantity, unit=_unit(quantity, mc.data), x=x, x_unit=X_UNITS[domain],
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, window),
         structure=mc.structure, notes=tuple(notes), values=values,
-        symbol=_symbol(quantity, mc.data), window=_window(domain, window))
+        symbol=_symbol(quantity, mc.data), window=_window(domain, window), temperature=float(t))
 
 
 def _master_draws(mc, structure, average, temperature, rng) -> tuple:
-    """The master structure, :data:`MAX_DRAWS` of its draws and their log10 shifts (a_T, b_T)
-    at ``temperature``."""
+    """The master structure, :data:`MAX_DRAWS` of its draws, their log10 shifts (a_T, b_T) at
+    ``temperature``, and the posterior mean of log10 a_T there (over every draw)."""
     if average is not None:
         raise InputError("predict: a master curve holds the posterior of one master "
                           f"structure ({mc.structure}), so there is nothing to average")
@@ -266,7 +280,8 @@ def _master_draws(mc, structure, average, temperature, rng) -> tuple:
         from ..structures import get_structure
 
         master = get_structure(mc.structure)
-    return master, np.asarray(mc.master_draws, float)[rows], log_a[rows], log_b[rows]
+    return (master, np.asarray(mc.master_draws, float)[rows], log_a[rows], log_b[rows],
+            float(np.mean(log_a)))
 
 
 def long_time_modulus(result, *, structure: str | None = None, average: str | None = None,
@@ -292,8 +307,8 @@ def long_time_modulus(result, *, structure: str | None = None, average: str | No
         raise InputError("long_time_modulus: give a structure or an average, not both")
     rng = np.random.default_rng(seed)
     if hasattr(result, "shift_draws"):
-        master, theta, _, log_b = _master_draws(result, structure, average,
-                                                result.reference_temperature, rng)
+        master, theta, _, log_b, _ = _master_draws(result, structure, average,
+                                                   result.reference_temperature, rng)
         return equilibrium_modulus(master, theta) / 10.0 ** log_b
     _, _, drawn = _mixture(result, structure, average, rng)
     return np.concatenate([equilibrium_modulus(s, theta) for s, theta in drawn])
@@ -437,6 +452,19 @@ def _mixture(result, structure, average, rng) -> tuple[dict, list, list]:
     drawn = [(result[name].structure, _draws(result[name], n, rng))
              for name, n in _draw_counts(weights, rng).items() if n > 0]
     return weights, notes, drawn
+
+
+def _misfit_note(r) -> list[str]:
+    """A note where the structure predicted from fails the posterior predictive checks: its
+    band is the posterior of the model's mean function, which measured values may then leave."""
+    adequacy = r.criteria.adequacy
+    if adequacy is None or adequacy.adequate:
+        return []
+    how = ("misses the data systematically, if by little" if adequacy.misfit_small
+           else "does not fit the data")
+    return [f"{r.name} {how} (posterior predictive checks): the band is the posterior of its "
+            "mean function, without the data's scatter or its misfit, so measured values may "
+            "lie outside it"]
 
 
 def _draw_counts(weights: dict, rng) -> dict:

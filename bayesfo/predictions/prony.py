@@ -153,8 +153,11 @@ class Prony:
             lines += [f"{t:.10g},{g:.10g}" for t, g in zip(self.tau, self.g, strict=True)]
         elif fmt == "abaqus":
             lines = [f"** {h}" for h in head]
-            lines.append(f"** instantaneous modulus G0 = {self.g_0:.10g}: give it in "
-                         "*ELASTIC, MODULI=INSTANTANEOUS")
+            # *ELASTIC takes Young's modulus and Poisson's ratio: a shear series' G0 is
+            # E0 = 2 (1 + nu) G0 there; a tensile series' own G0 is E0.
+            lines.append(f"** instantaneous modulus {e}0 = {self.g_0:.10g}: give "
+                         + ("it" if mode == "tensile" else f"E0 = 2 (1 + nu) {e}0")
+                         + " with Poisson's ratio nu in *ELASTIC, MODULI=INSTANTANEOUS")
             lines.append("*VISCOELASTIC, TIME=PRONY")
             lines += [f"{g / self.g_0:.10g}, 0., {t:.10g}"
                       for t, g in zip(self.tau, self.g, strict=True)]

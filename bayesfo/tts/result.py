@@ -13,6 +13,10 @@ from ..data import FrequencyResponse
 from ..errors import InputError
 from .isotherms import _Isotherms, _reduced
 
+#: A median isotherm residual (relative rms) above this says the master function does not
+#: describe the isotherms at all (measurement noise is a few per cent at most).
+MISFIT_RMS = 0.05
+
 
 # ---------------------------------------------------------------------------- result
 @dataclass(frozen=True)
@@ -89,6 +93,26 @@ class MasterCurve:
             found.append(parts["consistent"])
         known = [v for v in found if v is not None]
         return None if not known else all(known)
+
+    def misfit(self) -> str:
+        """Whether the joint fit misses the isotherms, in a sentence (the median isotherm's
+        relative rms over :data:`MISFIT_RMS`, or isotherms named by the isotherm-fit check);
+        empty where it does not."""
+        from .joint import ISOTHERM_MISFIT
+
+        fit = self.tts_checks.get("isotherm_fit", {})
+        missed = fit.get("misfit") or []
+        rms = [r for r in fit.get("rms_relative", []) if r is not None]
+        if rms and float(np.median(rms)) > MISFIT_RMS:
+            return (f"The joint fit of {self.structure} misses the isotherms by "
+                    f"{100 * min(rms):.2g}–{100 * max(rms):.2g} % rms (median "
+                    f"{100 * float(np.median(rms)):.2g} %): it does not describe them; other "
+                    "master functions (or 'spectrum', which needs no structure) may.")
+        if missed:
+            return (f"The joint fit of {self.structure} misses the isotherm(s) at "
+                    f"{', '.join(f'{t:g}' for t in missed)} °C (relative residuals over "
+                    f"{ISOTHERM_MISFIT:g} times the median isotherm's).")
+        return ""
 
     @property
     def log_shift_mean(self) -> np.ndarray:

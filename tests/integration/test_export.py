@@ -144,6 +144,9 @@ def test_the_long_time_modulus_follows_the_model(written, tmp_path, run_cli):
     assert f"the model has the long-time modulus {solid.model_g_inf:.6g} Pa" \
         in solid.text("abaqus")
     assert prony_series(result, structure="voigt", liquid=True).g_inf == 0.0
+    # *ELASTIC takes Young's modulus: the shear series' G0 is converted there by the user.
+    assert (f"instantaneous modulus G0 = {solid.g_0:.10g}: give E0 = 2 (1 + nu) G0 with "
+            "Poisson's ratio nu in *ELASTIC, MODULI=INSTANTANEOUS") in solid.text("abaqus")
 
     status, text, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "l.csv",
                                 "--structure", "maxwell-int")

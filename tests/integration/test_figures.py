@@ -414,6 +414,13 @@ def test_twelve_structures_have_distinct_styles_shared_by_compare_and_batch_figu
     for n in names:
         assert to_rgba(bars[n].get_facecolor()) == compare_style[n][0]
     assert len({(to_rgba(b.get_facecolor()), b.get_hatch()) for b in bars.values()}) == 12
+    # The title is the figure's (the legends beside the axes narrow them); a best structure
+    # that fails the posterior predictive checks is labelled as the least misfit.
+    assert fig.get_suptitle().startswith("Best structure (equal prior odds)")
+    assert not fig.axes[0].get_title()
+    rows[0]["adequate"] = False
+    labels = [t.get_text() for t in plot_batch_summary(rows, names).axes[0].texts]
+    assert labels == [f"{names[0]}\n(misfits)", names[0]]
 
 
 # ---------------------------------------------------------------------------------------------

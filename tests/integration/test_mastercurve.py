@@ -179,7 +179,7 @@ def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
     assert summary["shift_law"]["reference_temperature"] == 20.0
     # The default master structures, ranked by ln Z; the shifts are the best one's.
     ranked = summary["structures"]
-    assert {r["structure"] for r in ranked} == {"zener", "fractional_zener_sl", "max-n2m1"}
+    assert {r["structure"] for r in ranked} == {"zener", "max-n2m1", "fractional_zener_ll"}
     z = [r["log_evidence"] for r in ranked]
     assert z == sorted(z, reverse=True) and summary["structure"] == ranked[0]["structure"]
     assert sum(r["probability"] for r in ranked) == pytest.approx(1.0)
@@ -323,6 +323,12 @@ def test_material_functions_at_a_temperature_follow_each_draws_shifts(wlf_case):
     plain = bf.predict(mc, "storage", W)
     np.testing.assert_allclose(plain.median, bf.predict(mc, "storage", W, temperature=20.0).median)
     assert not plain.extrapolated.any() and not plain.notes
+    assert plain.temperature == 20.0 and plain.to_dict()["temperature"] == 20.0
+    # At the coldest and the warmest isotherm's own temperature, its own frequencies (whose ends
+    # are the window's ends there) are inside the window.
+    for t in (TEMPS[0], TEMPS[-1]):
+        own = bf.predict(mc, "storage", W, temperature=t)
+        assert not own.extrapolated.any() and own.temperature == t
     with pytest.raises(InputError, match="temperature 60 °C is outside the isotherms"):
         bf.predict(mc, "storage", W, temperature=60.0)
     with pytest.raises(InputError, match="nothing to average"):
@@ -602,3 +608,26 @@ def test_temperatures_given_for_files_that_do_not_say_them(tmp_path, run_cli):
     status, _, err = run_cli("mastercurve", tmp_path, "--temperatures", "0,x",
                              "--out", tmp_path / "mc")
     assert status == 2 and "--temperatures takes comma-separated numbers" in err
+
+
+def test_a_master_function_that_misses_the_isotherms_is_said_where_it_is_used(wlf_case):
+    """The misfit of the joint fit (median isotherm rms over 5 %, or isotherms named by the
+    isotherm-fit check) is one sentence, which the report's verdict, the command and the
+    predictions from the master curve repeat; a fit within the noise says nothing."""
+    from dataclasses import replace
+
+    _, mc = wlf_case
+    assert mc.misfit() == ""
+    assert not any("misses the isotherms" in n for n in bf.predict(mc, "storage", W).notes)
+    checks = dict(mc.tts_checks, isotherm_fit=dict(mc.tts_checks["isotherm_fit"],
+                                                   rms_relative=[0.08, 0.2, 0.09], misfit=[]))
+    missing = replace(mc, tts_checks=checks)
+    assert missing.misfit() == ("The joint fit of zener misses the isotherms by 8–20 % rms "
+                                "(median 9 %): it does not describe them; other master "
+                                "functions (or 'spectrum', which needs no structure) may.")
+    notes = bf.predict(missing, "storage", W).notes
+    assert any(n.startswith("the joint fit of zener misses the isotherms by 8–20 % rms") and
+               "measured values may lie outside it" in n for n in notes)
+    from bayesfo.output.mastercurve_report import mastercurve_verdict
+
+    assert (missing.misfit(), True) in mastercurve_verdict(missing)

@@ -153,6 +153,8 @@ def test_predictions_and_prony_files_speak_the_tensile_letter(comparison):
     text = prony.text("abaqus")
     assert "(E', E'':" in text and "E(t):" in text and "G(t)" not in text
     assert "stand for the shear ratios the code takes under a constant Poisson's ratio" in text
+    assert (f"instantaneous modulus E0 = {prony.g_0:.10g}: give it with Poisson's ratio nu in "
+            "*ELASTIC, MODULI=INSTANTANEOUS") in text
     # The Voigt's modulus grows without bound: g_0 is the model two decades past the data,
     # and the file says how far above the largest measured |E*| it lies.
     assert prony.g_0 > 1.5 * prony.measured_max

@@ -155,7 +155,14 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
                             if math.isfinite(fp[0].log_evidence) else np.inf))
     from dataclasses import replace
 
-    from .validity import describe, describe_parts, shifts_by_part, van_gurp_palmen
+    from .validity import (
+        describe,
+        describe_joint_against_parts,
+        describe_parts,
+        joint_against_parts,
+        shifts_by_part,
+        van_gurp_palmen,
+    )
 
     chosen = fits[best]
     law_evidence, law_notes = {}, []
@@ -166,7 +173,8 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
             chosen, dict(zip(LAW_FITS, fit_laws(best, LAW_FITS, ceiling), strict=True)))
     vgp = van_gurp_palmen(iso.data, iso.temperatures)
     parts = shifts_by_part(iso.data, iso.temperatures)
-    checks = {"van_gurp_palmen": vgp, "shift_parts": parts,
+    against = joint_against_parts(parts, chosen.shift_draws)
+    checks = {"van_gurp_palmen": vgp, "shift_parts": parts, "joint_against_parts": against,
               "isotherm_fit": chosen.tts_checks["isotherm_fit"]}
     notes = list(chosen.notes) + law_notes
     if vgp["valid"] is not True:
@@ -175,6 +183,8 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
         notes.append(describe_parts(parts) + (
             "" if vertical == "none" else " (the model's vertical shifts account for the "
                                           "former)"))
+    if against["apart"] and vertical == "none":
+        notes.append(describe_joint_against_parts(against, chosen.structure, chosen.law))
     misfit = checks["isotherm_fit"]["misfit"]
     if misfit:
         notes.append(f"the joint fit of {chosen.structure} misses the isotherm(s) at "

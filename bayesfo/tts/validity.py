@@ -241,3 +241,50 @@ def describe_parts(check: dict) -> str:
             f"{high:g} °C isotherm laid onto the {low:g} °C one by {shown} decades of ω, "
             f"log10 a_T({high:g} °C) − log10 a_T({low:g} °C)): a vertical shift (tan δ is free "
             "of it) or a material that is not thermorheologically simple")
+
+
+def joint_against_parts(parts: dict, shift_draws, tolerance: float = PARTS_TOLERANCE) -> dict:
+    """The joint fit's shift between each pair of neighbouring isotherms against the shift
+    that the isotherms themselves give (:func:`shifts_by_part`: the overlay of G′, G″ and
+    tan δ, without a model), where the parts agree. A master function that misses the
+    isotherms moves the shifts to where it misfits least, which the overlay does not.
+
+    ``shift_draws``: the joint posterior's log10 a_T (draws, isotherms), the isotherms in the
+    order of ``parts``. Returns ``pairs`` (per pair compared: ``temperatures``, the joint
+    difference log10 a_T(upper) − log10 a_T(lower) as ``joint`` mean and ``joint_sd``, the
+    overlay's inverse-variance mean ``overlay`` and ``overlay_se``, and ``apart``: the two
+    differ by more than ``tolerance`` decades and three standard errors) and ``apart``, the
+    pairs' temperatures where they differ."""
+    draws = np.asarray(shift_draws, float)
+    out = []
+    for i, pair in enumerate(parts["pairs"]):
+        have = [pair[name] for name in PARTS if pair.get(name) is not None]
+        if not have or pair.get("agree") is False or i + 1 >= draws.shape[1]:
+            continue
+        w = np.array([1.0 / max(p["se"], 1e-6) ** 2 for p in have])
+        overlay = float(np.sum(w * [p["log_shift"] for p in have]) / w.sum())
+        overlay_se = float(1.0 / math.sqrt(w.sum()))
+        diff = draws[:, i + 1] - draws[:, i]
+        joint, sd = float(np.mean(diff)), float(np.std(diff))
+        apart = abs(joint - overlay) > max(tolerance, Z_FAIL * math.hypot(sd, overlay_se))
+        out.append({"temperatures": pair["temperatures"], "joint": joint, "joint_sd": sd,
+                    "overlay": overlay, "overlay_se": overlay_se, "apart": bool(apart)})
+    return {"pairs": out, "apart": [p["temperatures"] for p in out if p["apart"]]}
+
+
+def describe_joint_against_parts(check: dict, structure: str, law: str = "free") -> str:
+    """The pairs whose joint shift differs from the overlay, in words (``law``: the shift law
+    the joint shifts follow, or ``"free"``); empty where none."""
+    apart = [p for p in check["pairs"] if p["apart"]]
+    if not apart:
+        return ""
+    shown = "; ".join(f"{low:g}/{high:g} °C: {p['joint']:+.3f} ± {p['joint_sd']:.3f} against "
+                      f"{p['overlay']:+.3f} ± {p['overlay_se']:.3f}"
+                      for p in apart for low, high in [p["temperatures"]])
+    return (f"the joint fit's shifts between neighbouring isotherms differ from those the "
+            f"isotherms' own overlay gives (log10 a_T(upper) − log10 a_T(lower), joint against "
+            f"overlay: {shown}): "
+            + (f"{structure}'s misfit moves the shifts; a master function that describes the "
+               "isotherms gives shifts nearer the overlay's" if law == "free" else
+               f"the {'WLF' if law == 'wlf' else 'Arrhenius'} law that the shifts follow, or "
+               f"{structure}'s misfit, moves them there"))

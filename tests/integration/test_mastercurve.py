@@ -631,3 +631,32 @@ def test_a_master_function_that_misses_the_isotherms_is_said_where_it_is_used(wl
     from bayesfo.output.mastercurve_report import mastercurve_verdict
 
     assert (missing.misfit(), True) in mastercurve_verdict(missing)
+
+
+def test_joint_shifts_are_held_against_the_isotherms_own_overlay():
+    """Between neighbouring isotherms the joint fit's shift is compared with the overlay of the
+    isotherms' G′, G″ and tan δ (where these agree): apart by more than 0.1 decade and three
+    standard errors is named (a master function that misses the isotherms moves its shifts;
+    the polystyrene at 145/160 °C with max-n2m1: −0.864 ± 0.033 against −0.977 ± 0.003)."""
+    from bayesfo.tts.validity import describe_joint_against_parts, joint_against_parts
+
+    part = {"log_shift": -0.977, "se": 0.003}
+    parts = {"pairs": [{"temperatures": [130.0, 145.0], "storage": part, "loss": part,
+                        "tan_delta": None, "spread": 0.0, "agree": False},
+                       {"temperatures": [145.0, 160.0], "storage": part, "loss": part,
+                        "tan_delta": None, "spread": 0.0, "agree": True}]}
+    rng = np.random.default_rng(0)
+    draws = np.zeros((4000, 3))
+    draws[:, 0] = 1.35 + 0.01 * rng.normal(size=4000)
+    for centre, apart in ((-0.864, True), (-0.96, False)):
+        draws[:, 2] = centre + 0.033 * rng.normal(size=4000)
+        check = joint_against_parts(parts, draws)
+        # The pair whose parts disagree is not compared; the other is, by its overlay.
+        assert [p["temperatures"] for p in check["pairs"]] == [[145.0, 160.0]]
+        pair = check["pairs"][0]
+        assert pair["overlay"] == pytest.approx(-0.977)
+        assert pair["overlay_se"] == pytest.approx(0.003 / np.sqrt(2))
+        assert pair["joint"] == pytest.approx(centre, abs=0.003)
+        assert pair["apart"] is apart and (check["apart"] == [[145.0, 160.0]]) is apart
+        text = describe_joint_against_parts(check, "max-n2m1")
+        assert ("max-n2m1's misfit moves the shifts" in text) is apart

@@ -28,14 +28,7 @@ def add_data_options(p):
                         "for storage/loss columns, else generic)")
     p.add_argument("--reciprocal", action="store_true",
                    help="use 1/G of the data (sigma propagated)")
-    p.add_argument("--columns", default=None, metavar="ROLE=COLUMN,...",
-                   help="which column is what, for columns not recognised or to choose, e.g. "
-                        "omega=\"Ang. Freq.\",storage=\"G'\",loss=\"G''\"; roles omega [rad/s], "
-                        "freq [Hz], storage, loss, real, imag, magnitude, phase, phase_deg, "
-                        "tan_delta, viscosity, eta_dyn, eta_out, sigma, series, temperature, "
-                        "block; a column is its header or its number from 1, a unit in "
-                        "brackets replaces the file's (E_stor=\"E_stor [Pa]\"), empty means none "
-                        "(temperature=)")
+    add_column_options(p)
     p.add_argument("--block", default=None, metavar="N|LABEL",
                    help="for a file of several data sets (steps, intervals, isotherms): which "
                         "one, by number from 1 (\"#20\" where a bare 20 could also be a "
@@ -48,6 +41,18 @@ def add_data_options(p):
     p.add_argument("--duplicates", default="error", choices=("error", "first", "mean"),
                    help="rows that repeat a frequency: refuse (default), keep the first, or "
                         "average them (overlapping isotherms of a master curve)")
+
+
+def add_column_options(p) -> None:
+    """``--columns``: which column is what, and a unit where the file gives none."""
+    p.add_argument("--columns", default=None, metavar="ROLE=COLUMN,...",
+                   help="which column is what, for columns not recognised or to choose, e.g. "
+                        "omega=\"Ang. Freq.\",storage=\"G'\",loss=\"G''\"; roles omega [rad/s], "
+                        "freq [Hz], storage, loss, real, imag, magnitude, phase, phase_deg, "
+                        "tan_delta, viscosity, eta_dyn, eta_out, sigma, series, temperature, "
+                        "block; a column is its header or its number from 1, a unit in "
+                        "brackets replaces the file's (E_stor=\"E_stor [Pa]\"), empty means none "
+                        "(temperature=)")
 
 
 def read_data(args, every: bool = False):

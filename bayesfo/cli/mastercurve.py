@@ -14,6 +14,8 @@ DEFAULT_STRUCTURES = "zener,max-n2m1,fractional_zener_ll"
 
 def add_parser(subparsers):
     """Register ``bayesfo mastercurve``."""
+    from ._common import add_column_options
+
     p = subparsers.add_parser(
         "mastercurve", help="master curve of isotherms: shift factors, WLF/Arrhenius laws and "
                             "the master structure, in one posterior",
@@ -57,6 +59,7 @@ def add_parser(subparsers):
                    help="processes fitting the master structures, then the shift laws, side by "
                         "side (default 0: one per CPU; 1: one after the other here); the "
                         "numbers do not depend on it")
+    add_column_options(p)
     p.add_argument("--out", default=None, metavar="DIR",
                    help="output directory (default bayesfo-mastercurve)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
@@ -64,10 +67,11 @@ def add_parser(subparsers):
     return p
 
 
-def read_isotherm_files(paths, temperatures=None) -> list[tuple]:
+def read_isotherm_files(paths, temperatures=None, columns=None) -> list[tuple]:
     """(FrequencyResponse, temperature) of every isotherm in ``paths`` (files, or directories
     of ``*.csv``); ``temperatures`` (°C, one per file in that order) where the files do not
-    say them."""
+    say them; ``columns`` (``{role: column}``, :func:`~bayesfo.data.columns_from_text`) for
+    every file, as ``--columns`` of ``compare``."""
     from ..data import read_isotherms
     from ..data.temperature import temperature_of_file
 
@@ -88,7 +92,7 @@ def read_isotherm_files(paths, temperatures=None) -> list[tuple]:
                          "per file, in that order")
     out = []
     for k, f in enumerate(files):
-        sets = read_isotherms(f)
+        sets = read_isotherms(f, columns=columns)
         if temperatures is not None:
             if len(sets) != 1:
                 raise InputError(f"'{f}' holds {len(sets)} data sets: --temperatures gives "
@@ -128,7 +132,9 @@ def run(args) -> int:
     structures = _master_names(args.structures)  # an unknown name fails before reading
     temperatures = (parse_floats(args.temperatures, "--temperatures")
                     if args.temperatures is not None else None)
-    isotherms = read_isotherm_files(args.data, temperatures)
+    from ..data import columns_from_text
+
+    isotherms = read_isotherm_files(args.data, temperatures, columns_from_text(args.columns))
     target = Path(args.out or "bayesfo-mastercurve")
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))

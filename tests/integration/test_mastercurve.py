@@ -608,6 +608,20 @@ def test_temperatures_given_for_files_that_do_not_say_them(tmp_path, run_cli):
     status, _, err = run_cli("mastercurve", tmp_path, "--temperatures", "0,x",
                              "--out", tmp_path / "mc")
     assert status == 2 and "--temperatures takes comma-separated numbers" in err
+    # --columns, as compare's: a unit for files that give none (here the '# units:' line
+    # left out), in every file.
+    bare = tmp_path / "bare"
+    bare.mkdir()
+    for name, source in (("a.csv", "Tp000C.csv"), ("b.csv", "Tp020C.csv")):
+        (bare / name).write_text("\n".join(
+            line for line in (ADHESIVE / source).read_text().splitlines()
+            if not line.startswith(("# name:", "# units:"))) + "\n")
+    assert read_isotherm_files([bare], [0.0, 20.0])[0][0].units == ""
+    pairs = read_isotherm_files([bare], [0.0, 20.0],
+                                {"storage": "storage [kPa]", "loss": "loss [kPa]"})
+    assert [d.units for d, _ in pairs] == ["Pa", "Pa"]
+    np.testing.assert_allclose(pairs[1][0].response.real,
+                               1e3 * bf.read(ADHESIVE / "Tp020C.csv").response.real)
 
 
 def test_a_master_function_that_misses_the_isotherms_is_said_where_it_is_used(wlf_case):

@@ -39,12 +39,20 @@ class _Isotherms:
     @property
     def title(self) -> str:
         """What the isotherms are called together: the label they share (one file's, before
-        the temperature), else the directory their files share, else the first label."""
+        the temperature), else the label they share once their numbers are left out
+        (oscillation_ps130_data, oscillation_ps145_data: "oscillation_ps_data"), else the
+        directory their files share, else the first label."""
+        import re
         from pathlib import Path
 
         bases = {d.label.split(",")[0] for d in self.data}
         if len(bases) == 1:
             return bases.pop()
+        number = r"[-+]?\d+(?:[.p]\d+)?(?:\s*°?[CK](?![A-Za-z]))?"  # with its unit, if any
+        bare = {re.sub(r"[_\s]{2,}", "_", re.sub(number, "", b)).strip("_ ") for b in bases}
+        name = bare.pop() if len(bare) == 1 else ""
+        if sum(c.isalpha() for c in name) >= 3:
+            return name
         folders = {Path(d.source).parent for d in self.data if d.source}
         if len(folders) == 1 and len(self.data) == sum(bool(d.source) for d in self.data):
             name = folders.pop().resolve().name

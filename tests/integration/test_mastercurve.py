@@ -674,3 +674,23 @@ def test_joint_shifts_are_held_against_the_isotherms_own_overlay():
         assert pair["apart"] is apart and (check["apart"] == [[145.0, 160.0]]) is apart
         text = describe_joint_against_parts(check, "max-n2m1")
         assert ("max-n2m1's misfit moves the shifts" in text) is apart
+
+
+def test_the_isotherms_are_named_by_what_they_share():
+    """The label they share before the temperature; else the label they share without its
+    numbers (and their units); else the directory of their files."""
+    from bayesfo.tts.isotherms import _isotherms
+
+    g = get_structure("zener").response([ZENER], W, "modulus")[0]
+
+    def named(names, folder="/data/original"):
+        pairs = [(FrequencyResponse(W, g, kind="modulus", name=n, source=f"{folder}/{n}.csv"), t)
+                 for n, t in zip(names, (130.0, 145.0, 160.0), strict=False)]
+        return _isotherms(pairs, None).title
+
+    assert named(["PS, 130 °C", "PS, 145 °C", "PS, 160 °C"]) == "PS"
+    assert named(["oscillation_ps130_data", "oscillation_ps145_data",
+                  "oscillation_ps160_data"]) == "oscillation_ps_data"
+    assert named(["sample A 130 °C", "sample A 145 °C"]) == "sample A"
+    # Tm/Tp names differ by more than their numbers: the directory.
+    assert named(["Tm010C", "Tp000C", "Tp010C"], "/data/adhesive") == "adhesive"

@@ -122,14 +122,23 @@ def _stdout_gone() -> bool:
         return False
 
 
-def _negative_blocks(argv) -> list[str]:
-    """``--block -40C`` as ``--block=-40C``: argparse takes a value that starts with '-' and is
-    not a number for an option, and a temperature below zero is a natural block."""
+#: Options whose value may start with a minus sign: a temperature below zero (``--block
+#: -40C``), or a list whose first number is negative (``--time -1,2``, refused then by its own
+#: check with a message that says why).
+NEGATIVE_VALUES = ("--block", "--time", "--omega", "--tau", "--temperatures", "--holdout",
+                   "--window", "--temperature", "--reference-temperature")
+
+
+def _negative_values(argv) -> list[str]:
+    """``--block -40C`` as ``--block=-40C`` (and so for :data:`NEGATIVE_VALUES`): argparse
+    takes a value that starts with '-' and is not a plain number for an option ("expected one
+    argument")."""
     argv = [str(a) for a in argv]
     out, i = [], 0
     while i < len(argv):
-        if argv[i] == "--block" and i + 1 < len(argv) and re.match(r"-[0-9.]", argv[i + 1]):
-            out.append(f"--block={argv[i + 1]}")
+        if argv[i] in NEGATIVE_VALUES and i + 1 < len(argv) and re.match(r"-[0-9.]",
+                                                                        argv[i + 1]):
+            out.append(f"{argv[i]}={argv[i + 1]}")
             i += 2
             continue
         out.append(argv[i])
@@ -152,7 +161,7 @@ def main(argv=None) -> int:
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
-        args = parser.parse_args(_negative_blocks(sys.argv[1:] if argv is None else argv))
+        args = parser.parse_args(_negative_values(sys.argv[1:] if argv is None else argv))
         if args.command is None:
             parser.print_help()
             return 2

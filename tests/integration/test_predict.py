@@ -157,6 +157,16 @@ def test_the_command_prints_writes_and_refuses(result, tmp_path, run_cli):
                                    "angular frequency: give --omega, not --time\n")
     status, text, err = run_cli("predict", out, "--quantity", "storage", "--omega", "1:0:3")
     assert status == 2 and "0 < LOW < HIGH" in err
+    # A list that starts with a negative number reaches its own check (argparse alone took
+    # "-1,2" for an option and said "expected one argument").
+    status, text, err = run_cli("predict", out, "--quantity", "relaxation_modulus", "--time",
+                                "-1,2")
+    assert status == 2 and err == "bayesfo: error: the times must be finite and > 0; got -1\n"
+    # A folder on the way that is a file is named as such.
+    (tmp_path / "afile").write_text("")
+    status, text, err = run_cli("predict", out, "--quantity", "storage", "--omega", "1",
+                                "--out", tmp_path / "afile" / "g.csv")
+    assert status == 2 and f"('{tmp_path / 'afile'}' is a file, not a folder)" in err
     status, text, err = run_cli("predict", tmp_path / "none", "--quantity", "storage",
                                 "--omega", "1")
     assert status == 2 and err.count("\n") == 1

@@ -96,6 +96,15 @@ def run(args) -> int:
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
           f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
+    from ..data.symbols import modulus_symbol
+    from ..predictions.prony import EXTRAPOLATED, TAU_MARGIN
+
+    e = modulus_symbol(prony.symbol)
+    if prony.g_0 > EXTRAPOLATED * prony.measured_max:
+        print(f"note: {e}0 is the model's modulus {TAU_MARGIN} decades past the highest "
+              f"measured frequency, {prony.g_0 / prony.measured_max:.3g} x the largest measured "
+              f"|{e}*|: the ratios g_i/{e}0 that Abaqus and ANSYS take depend on that "
+              "extrapolation")
     for line in prony.long_time_text():
         if prony.model_g_inf == 0.0:
             line += (" (--liquid sets G_inf = 0)" if prony.g_inf > 0 else

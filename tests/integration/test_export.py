@@ -152,11 +152,21 @@ def test_the_long_time_modulus_follows_the_model(written, tmp_path, run_cli):
                                 "--structure", "maxwell-int")
     assert status == 0, err
     assert "G_inf = 0 Pa" in text
+    assert "the largest measured" not in text  # its G0 is within what was measured
     assert "note: g_inf = 0: the model relaxes fully (a liquid) (--no-liquid fits G_inf" in text
     status, text, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "f.csv",
                                 "--structure", "springpot", "--no-liquid")
     assert status == 0, err
     assert "the model relaxes fully (a liquid) (--liquid sets G_inf = 0)" in text
+    # The Voigt's G0, the model two decades past the data far above what was measured: said
+    # on the command line too.
+    status, text, err = run_cli("export", out, "--format", "abaqus", "--out", tmp_path / "v.inp",
+                                "--structure", "voigt")
+    assert status == 0, err
+    prony = prony_series(result, structure="voigt")
+    assert prony.g_0 > 1.5 * prony.measured_max
+    assert (f"note: G0 is the model's modulus 2 decades past the highest measured frequency, "
+            f"{prony.g_0 / prony.measured_max:.3g} x the largest measured |G*|") in text
 
 
 def test_bad_requests(written, tmp_path, run_cli):

@@ -50,8 +50,9 @@ def run(args) -> int:
 
     from .._io import atomic_write_text, write_error
     from ..comparison import load
+    from ..data.symbols import modulus_symbol
     from ..errors import InputError
-    from ..predictions.prony import prony_series
+    from ..predictions.prony import EXTRAPOLATED, TAU_MARGIN, prony_series
 
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     try:
@@ -96,9 +97,6 @@ def run(args) -> int:
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
           f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
-    from ..data.symbols import modulus_symbol
-    from ..predictions.prony import EXTRAPOLATED, TAU_MARGIN
-
     e = modulus_symbol(prony.symbol)
     if prony.g_0 > EXTRAPOLATED * prony.measured_max:
         print(f"note: {e}0 is the model's modulus {TAU_MARGIN} decades past the highest "

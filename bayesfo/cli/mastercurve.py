@@ -120,6 +120,7 @@ def read_isotherm_files(paths, temperatures=None, columns=None) -> list[tuple]:
 
 
 def run(args) -> int:
+    from ..data import columns_from_text
     from ..options import parse_floats
     from ..outdir import check_output_directory, staged_run
     from ..tts import mastercurve
@@ -132,8 +133,6 @@ def run(args) -> int:
     structures = _master_names(args.structures)  # an unknown name fails before reading
     temperatures = (parse_floats(args.temperatures, "--temperatures")
                     if args.temperatures is not None else None)
-    from ..data import columns_from_text
-
     isotherms = read_isotherm_files(args.data, temperatures, columns_from_text(args.columns))
     target = Path(args.out or "bayesfo-mastercurve")
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))

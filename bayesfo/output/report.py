@@ -198,8 +198,7 @@ def _ranking_table(comparison) -> str:
             "says where it is unreliable (WAIC, which estimates the same without a diagnostic "
             "of its own, is in ranking.csv and summary.json); AIC and BIC: lower is better; "
             "RMSE at the posterior mode (thesis eq. (3.23)), in the data's unit; orders: each "
-            "fractional order by "
-            "its symbol, posterior mean and 94 % HDI.</p>")
+            "fractional order by its symbol, posterior mean and 94 % HDI.</p>")
     return f"<table>{head}{''.join(body)}</table>{note}"
 
 

@@ -36,7 +36,7 @@ from ..errors import InputError
 from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F401
 from .laws import _fit_laws
 from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
-from .result import MasterCurve, _num
+from .result import ISOTHERM_MISFIT, MasterCurve, _num
 from .spectrum import NAME as SPECTRUM
 from .spectrum import Spectrum
 
@@ -51,9 +51,6 @@ LAW_MISS = 4.0
 #: Isotherms from which ``law="auto"`` also fits the laws inside the posterior: with fewer,
 #: WLF has as many parameters as there are shifts, and the comparison says nothing.
 AUTO_LAWS_MIN = 4
-#: An isotherm whose relative residuals under the joint fit (rms) exceed this many times the
-#: median isotherm's is named as one the master structure misses.
-ISOTHERM_MISFIT = 3.0
 #: A shift law whose best joint fit lies this many nats below the free shifts' ln Z is not
 #: sampled (``law="auto"``): ln Z ≤ max ln L for any normalised prior, so its posterior
 #: probability is below e^-LAW_BOUND_MARGIN, and certifying a posterior that far behind (often

@@ -16,6 +16,9 @@ from .isotherms import _Isotherms, _reduced
 #: A median isotherm residual (relative rms) above this says the master function does not
 #: describe the isotherms at all (measurement noise is a few per cent at most).
 MISFIT_RMS = 0.05
+#: An isotherm whose relative residuals under the joint fit (rms) exceed this many times the
+#: median isotherm's is named as one the master structure misses.
+ISOTHERM_MISFIT = 3.0
 
 
 # ---------------------------------------------------------------------------- result
@@ -98,8 +101,6 @@ class MasterCurve:
         """Whether the joint fit misses the isotherms, in a sentence (the median isotherm's
         relative rms over :data:`MISFIT_RMS`, or isotherms named by the isotherm-fit check);
         empty where it does not."""
-        from .joint import ISOTHERM_MISFIT
-
         fit = self.tts_checks.get("isotherm_fit", {})
         missed = fit.get("misfit") or []
         rms = [r for r in fit.get("rms_relative", []) if r is not None]

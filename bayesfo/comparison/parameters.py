@@ -220,15 +220,18 @@ def _bound(x: float) -> str:
             else "0" if x == 0 else f"{x:.3g}")
 
 
-def with_determination(block: dict, poorly_determined=None, draws=None) -> dict:
+def with_determination(block: dict, poorly_determined=None, draws=None, limited=None) -> dict:
     """``block`` (``{name: summary}``) with ``not_determined`` (bool) and
     ``not_determined_reason`` (:func:`not_determined`, None where determined) in each summary,
     and ``poorly_determined`` copied from ``poorly_determined`` (``{name: bool}`` of the
     sampled parameters) for the names it holds. ``draws`` (``{name: draws}``) are the draws
     each quantity is judged on (:func:`not_determined`); a name without them is judged on its
-    summary's HDI."""
+    summary's HDI. ``limited`` (``{name: reason}``, :func:`prior_limited`): quantities whose
+    posterior a prior bound ends, not determined for that reason where not already for
+    another."""
     poorly_determined = poorly_determined or {}
     draws = draws or {}
+    limited = limited or {}
     out = {}
     percent = f"{100 * HDI_PROB:g} %"
     for name, s in block.items():
@@ -236,7 +239,7 @@ def with_determination(block: dict, poorly_determined=None, draws=None) -> dict:
         # shown and what is judged (as not_determined judges it).
         judged = _positive_log_hdi(s, draws.get(name))
         reason = (not_determined(s, draws.get(name)) if judged is None
-                  else _judged(*judged, percent))
+                  else _judged(*judged, percent)) or limited.get(name)
         out[name] = dict(s) | {"not_determined": reason is not None,
                                "not_determined_reason": reason}
         if judged is not None:
@@ -246,8 +249,61 @@ def with_determination(block: dict, poorly_determined=None, draws=None) -> dict:
     return out
 
 
+#: A quantity of the picture follows a coefficient whose posterior a prior bound ends where
+#: their rank correlation over the draws is at least this (:func:`physical_forms`): G_e = 1/b0
+#: follows b0 wholly (1.0), while a modulus a1/b1 of two coefficients that run to their bounds
+#: together along a ridge is fixed by the data (|rho| under 0.1 on the adhesive at -10 °C).
+FOLLOWS = 0.5
+
+
+def prior_limited(structure, summary: dict) -> dict:
+    """``{name: reason}`` of the sampled parameters whose posterior a prior bound ends
+    (``ParameterSummary.at_prior_bound``): every parameter but the orders, whose bounds (0 and
+    1) are the structure's own (an order at 0 is an element that vanishes). A coefficient's
+    prior is a range as wide as the data's scale allows (log-uniform over eight decades of the
+    scaled problem): a posterior that runs into it is one the data leave open on that side,
+    whose HDI the prior alone sets (a zero-shear viscosity at the prior's top)."""
+    orders = set(structure.exponent_params)
+    side = {"low": "lower", "high": "upper"}
+    return {n: (f"its posterior runs to the prior's {side[s.at_prior_bound]} bound, which the "
+                f"prior, not the data, sets (--prior {n}=... widens it, on the scaled problem)")
+            for n, s in summary.items() if getattr(s, "at_prior_bound", "") and n not in orders}
+
+
+def _following(structure, form: dict, draws: dict, limited: dict) -> dict:
+    """``{name: reason}`` of the quantities of ``form`` (``{name: (values, unit)}``) that follow
+    a coefficient of ``limited`` (:func:`prior_limited`): one their expression names, with a
+    rank correlation over the draws of at least :data:`FOLLOWS`."""
+    if not limited or not structure.pictures:
+        return {}
+    pic = picture_of(structure)
+    expressions = {p.name: p.value for p in (*pic.parameters, *pic.derived)}
+
+    def ranks(x):
+        return np.argsort(np.argsort(np.asarray(x, float).ravel()))
+
+    out = {}
+    for name, (values, _) in form.items():
+        if name in limited or name not in expressions:
+            continue
+        for n in sorted(expressions[name].names & set(limited)):
+            v, c = np.asarray(values, float).ravel(), np.asarray(draws[n], float).ravel()
+            ok = np.isfinite(v) & np.isfinite(c)
+            if ok.sum() < 10 or np.ptp(v[ok]) == 0:
+                continue
+            rho = float(np.corrcoef(ranks(v[ok]), ranks(c[ok]))[0, 1])
+            if abs(rho) >= FOLLOWS:
+                out[name] = (f"it follows {n} (rank correlation {rho:+.2f}), "
+                             + limited[n].split(", which the prior", 1)[0].replace(
+                                 "its posterior", "whose posterior")
+                             + f", which the prior, not the data, sets (--prior {n}=... widens "
+                             "it, on the scaled problem)")
+                break
+    return out
+
+
 def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: str = "",
-                   poorly_determined=None) -> dict:
+                   poorly_determined=None, limited=None) -> dict:
     """The parameters of ``structure`` in both forms, summarised, with units.
 
     Parameters
@@ -263,6 +319,10 @@ def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: s
     poorly_determined : dict, optional
         ``{name: bool}`` of the sampled parameters (``ParameterSummary.poorly_determined``),
         copied into the summaries of the same names.
+    limited : dict, optional
+        ``{name: reason}`` of the sampled parameters whose posterior a prior bound ends
+        (:func:`prior_limited`): they, and the quantities that follow one of them, are not
+        determined for that reason.
 
     Returns
     -------
@@ -283,10 +343,13 @@ def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: s
     physical, coefficients = (natural, other) if modulus else (other, natural)
     map_physical, map_coefficients = (at_map if modulus else at_map[::-1])
 
+    limited = limited or {}
+
     def block(form, at):
         return with_determination({n: summarise_draws(v, at[n][0], u)
                                    for n, (v, u) in form.items()}, poorly_determined,
-                                  draws={n: v for n, (v, _) in form.items()})
+                                  draws={n: v for n, (v, _) in form.items()},
+                                  limited=limited | _following(structure, form, draws, limited))
 
     has_picture = bool(structure.pictures)
     phys = block(physical, map_physical) if has_picture else block(coefficients, map_coefficients)

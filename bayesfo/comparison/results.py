@@ -22,6 +22,7 @@ from .parameters import (  # noqa: F401  (re-exported: the names results offered
     parameter_units,
     physical_forms,
     physical_text,
+    prior_limited,
     shown_hdi,
     summarise_draws,
     with_determination,
@@ -96,7 +97,8 @@ class StructureResult:
         poor = {n: s.poorly_determined for n, s in post.summary.items()}
         try:
             return physical_forms(self.structure, draws, at_map, self.data_kind, self.data_units,
-                                  poorly_determined=poor)
+                                  poorly_determined=poor,
+                                  limited=prior_limited(self.structure, post.summary))
         except StructureError:
             return None
 
@@ -116,7 +118,8 @@ class StructureResult:
                  for k, v in post.summary.items()}
         draws = {k: post.samples[:, post.param_names.index(k)] for k in block
                  if k in post.param_names}
-        return with_determination(block, draws=draws)
+        return with_determination(block, draws=draws,
+                                  limited=prior_limited(self.structure, post.summary))
 
     @property
     def natural_parameters(self) -> dict:

@@ -357,9 +357,11 @@ def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> Posterior
     pointwise = np.asarray(idata.log_likelihood["G"].values, dtype=float)
     loglik = pointwise.reshape(-1, data.n_frequencies).sum(axis=1)
     fields = [f.name for f in dataclasses.fields(ParameterSummary)]
+    # A run written before a field existed lacks it: its default (at_prior_bound "").
     summary = {n: ParameterSummary(**{
-        f: bool(params[n][f]) if f in ("poorly_determined", "multimodal") else _num(params[n][f])
-        for f in fields}) for n in names}
+        f: bool(params[n][f]) if f in ("poorly_determined", "multimodal")
+        else str(params[n][f]) if f == "at_prior_bound" else _num(params[n][f])
+        for f in fields if f in params[n]}) for n in names}
     attrs = draws.attrs
     return PosteriorResult(
         structure=s["name"], param_names=names, noise=s["noise"], noise_reason=s["noise_reason"],

@@ -25,6 +25,12 @@ HDI_PROB = 0.94
 
 RHAT_MAX = 1.01
 
+#: A posterior whose 94 % HDI ends within this share of the prior range of a finite prior
+#: bound (in the sampling coordinate: log for log-uniform priors) runs into that bound
+#: (``ParameterSummary.at_prior_bound``): 1 % of the default coefficient priors' 18.4 units of
+#: ln is a factor of 1.2.
+AT_BOUND = 0.01
+
 
 ESS_MIN = 400
 
@@ -35,7 +41,9 @@ class ParameterSummary:
 
     ``poorly_determined``: the 94 % HDI covers more than half of the prior range (in the sampling
     coordinate, i.e. in log for log-uniform priors). ``multimodal``: the marginal density has more
-    than one clearly separated peak.
+    than one clearly separated peak. ``at_prior_bound``: ``"low"`` or ``"high"`` where the HDI
+    reaches within :data:`AT_BOUND` of the prior range of that finite bound (in the sampling
+    coordinate): the prior, not the data, ends the posterior there; ``""`` otherwise.
     """
 
     mean: float
@@ -46,10 +54,11 @@ class ParameterSummary:
     median: float
     poorly_determined: bool
     multimodal: bool
+    at_prior_bound: str = ""
 
     def to_dict(self) -> dict:
-        return {k: (bool(v) if isinstance(v, (bool, np.bool_)) else float(v))
-                for k, v in self.__dict__.items()}
+        return {k: (bool(v) if isinstance(v, (bool, np.bool_)) else v if isinstance(v, str)
+                    else float(v)) for k, v in self.__dict__.items()}
 
 
 @dataclass(frozen=True, eq=False)
@@ -323,10 +332,13 @@ def _summaries(lik, tr, flat_phys, flat_u, map_theta) -> dict:
         u = flat_u[:, i]
         ulo, uhi = hdi(u, HDI_PROB)
         wide = bool(np.isfinite(phi - plo) and (uhi - ulo) > 0.5 * (phi - plo))
+        near = AT_BOUND * (phi - plo) if np.isfinite(phi - plo) else 0.0
+        bound = ("low" if near and ulo - plo <= near else
+                 "high" if near and phi - uhi <= near else "")
         out[name] = ParameterSummary(
             mean=float(x.mean()), sd=float(x.std(ddof=1)), hdi_low=float(lo), hdi_high=float(hi),
             map=float(map_theta[i]), median=float(np.median(x)), poorly_determined=wide,
-            multimodal=_count_modes(u, plo, phi) > 1,
+            multimodal=_count_modes(u, plo, phi) > 1, at_prior_bound=bound,
         )
     return out
 

@@ -110,7 +110,7 @@ def _print_undetermined(result) -> None:
     from ..data.symbols import parameter_label
 
     symbol = result.data.symbol
-    vague, poor = [], []
+    vague, poor, modes = [], [], []
     for row in result.table():
         if row.get("error"):
             continue
@@ -122,10 +122,17 @@ def _print_undetermined(result) -> None:
                   if n in r.posterior.summary and r.posterior.summary[n].poorly_determined]
         if orders:
             poor.append(f"{r.name}: {', '.join(orders)}")
+        split = [n for n in r.structure.exponent_params
+                 if n in r.posterior.summary and r.posterior.summary[n].multimodal]
+        if split:
+            modes.append(f"{r.name}: {', '.join(split)}")
     if vague:
         print(f"not determined by the data (94 % HDI over more than {UNDETERMINED_DECADES:g} "
               "decades on a log scale, reaching 0 or infinity, or undefined; the values in the "
               "report, summary.json and ranking.csv are not estimates): " + "; ".join(vague))
+    if modes:
+        print("orders with several separated modes (their means lie between the modes; the "
+              "q_posteriors figure shows them): " + "; ".join(modes))
     if poor:
         print("orders poorly determined (94 % HDI wider than half the prior range): "
               + "; ".join(poor))

@@ -83,10 +83,20 @@ def _adequacy_sentences(comparison, rows) -> list[tuple[str, bool]]:
     level = f"{100 * best.level:g} %"
     if not any(a.adequate for _, a in checked):
         small = [n for n, a in checked if a.misfit_small]
+        reason = f" {name}: {_sentence(best.reasons[0])}" if best.reasons else ""
+        if best.misfit_small:
+            # The best one misses by little: said first, not after "none describes".
+            text = (f"No candidate passes the posterior predictive checks at the {level} level, "
+                    f"but the best supported, {name}, misses the data by little (within 2° in "
+                    "phase and 3.5 % in magnitude): systematically, so its numbers describe "
+                    f"the data up to that.{reason}")
+            others = [n for n in small if n != name]
+            if others:
+                text += f" The misfit is as small for {_join(others)}."
+            return [(text.rstrip(), True)]
         text = ("None of the candidates describes these data: every structure fails the "
                 f"posterior predictive checks at the {level} level, so the ranking says only "
-                "which misfits least." + (f" {name}: {_sentence(best.reasons[0])}"
-                                          if best.reasons else ""))
+                f"which misfits least.{reason}")
         if small:
             text += (f" The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
                      f"{_join(small)}.")

@@ -318,3 +318,33 @@ def test_a_runner_up_whose_exponents_hang_on_an_undecided_noise_model_is_named()
     assert _undecided_noise("zener", result(0.891, sensitive=False)) == ""
     assert _undecided_noise("zener", SimpleNamespace(
         criteria=SimpleNamespace(noise_models=None))) == ""
+
+
+def test_a_best_structure_that_misses_by_little_is_said_so_first():
+    """Every structure fails the checks: where the best one's misfit is small, the verdict
+    leads with that, not with "none describes these data" (a new user read the two as
+    contradicting each other); where it is not small, "none describes" stays."""
+    from types import SimpleNamespace
+
+    from bayesfo.output.verdict import _adequacy_sentences
+
+    def check(small):
+        return SimpleNamespace(adequate=False, misfit_small=small, level=0.01,
+                               reasons=["residuals are correlated along frequency"])
+
+    def sentences(best_small, other_small):
+        results = {"maxwell": SimpleNamespace(adequacy=check(best_small)),
+                   "zener": SimpleNamespace(adequacy=check(other_small))}
+        rows = [{"structure": "maxwell"}, {"structure": "zener"}]
+        return _adequacy_sentences(results, rows)
+
+    [(text, flagged)] = sentences(True, True)
+    assert flagged and text.startswith(
+        "No candidate passes the posterior predictive checks at the 1 % level, but the best "
+        "supported, maxwell, misses the data by little (within 2° in phase and 3.5 % in "
+        "magnitude)")
+    assert text.endswith("The misfit is as small for zener.")
+    [(text, flagged)] = sentences(False, True)
+    assert flagged and text.startswith("None of the candidates describes these data")
+    assert text.endswith("The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
+                         "zener.")

@@ -459,6 +459,17 @@ def test_compare_names_the_parameters_the_data_do_not_determine(zener_on_voigt, 
         "not determined by the data (94 % HDI over more than 2 decades on a log scale, reaching "
         "0 or infinity, or undefined; the values in the report, summary.json and ranking.csv "
         "are not estimates): zener: G_m, tau\n")
+    # An order of several separated modes is named too: its mean lies between them.
+    from dataclasses import replace
+
+    r = result["zener"]
+    q = replace(r.posterior.summary["q"], multimodal=True)
+    split = replace(r, posterior=replace(r.posterior, summary={**r.posterior.summary, "q": q}))
+    _print_undetermined(replace(result, results=tuple(
+        split if x.name == "zener" else x for x in result.results)))
+    assert capsys.readouterr().out.endswith(
+        "orders with several separated modes (their means lie between the modes; the "
+        "q_posteriors figure shows them): zener: q\n")
 
 
 @pytest.fixture(scope="module")

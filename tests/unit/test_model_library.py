@@ -326,7 +326,8 @@ def test_each_physical_parameter_says_what_it_is():
     # The card's descriptions, and for the orders the elements they are or enter: the
     # thesis' alpha is no element's order, only part of the second springpot's.
     assert maxwell["delta"] == "order of the second springpot"
-    assert maxwell["E"] == "the thesis' modulus E = c_beta/tau^beta"
+    assert maxwell["E"] == ("modulus E of the thesis' eq. (2.16), c_beta/tau^beta (a shear "
+                            "modulus for shear data)")
     assert maxwell["beta"] == ("order of the springpot c_beta; in the order beta - alpha of the "
                                "springpot c_delta")
     assert maxwell["alpha"] == "in the order beta - alpha of the springpot c_delta"

@@ -23,10 +23,29 @@ def run(args) -> int:
     print(f"{'':<{width}}  J(s): the card in its parameters (the compliance; for generic data "
           "the transfer function); G*(s) = 1/J(s) in the physical parameters that modulus "
           "data report")
+    pad = " " * width
     for s in lib.values():
         priors = ", ".join(f"{p.name}~{p.prior.describe()}" for p in s.parameters)
-        print(f"{s.name:<{width}}  J(s) = {s.formula}")
+        print(f"{s.name:<{width}}  {_title(s)}")
+        network = s.pictures[0].network if s.pictures else None
+        if network is not None:
+            print(f"{pad}  network {network.text}")
+        print(f"{pad}  J(s) = {s.formula}")
         if s.modulus_formula is not None:
-            print(f"{'':<{width}}  G*(s) = {s.modulus_formula}")
-        print(f"{'':<{width}}  priors: {priors}")
+            print(f"{pad}  G*(s) = {s.modulus_formula}")
+        inequalities = [c.text for c in s.constraints if not isinstance(c, str)]
+        if inequalities:
+            print(f"{pad}  constraints: {', '.join(inequalities)} (and stable, passive)")
+        print(f"{pad}  priors: {priors}")
     return 0
+
+
+def _title(s) -> str:
+    """What the structure is, in words: its title, the degrees of a max-order member, the
+    names it also answers to."""
+    text = s.title or s.name
+    if s.degrees is not None:
+        n, m = s.degrees
+        text += f": denominator of degree n = {n}, numerator of degree m = {m} in s^q"
+    aliases = getattr(s, "aliases", ())
+    return text + (f" (also {', '.join(aliases)})" if aliases else "")

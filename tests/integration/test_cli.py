@@ -121,13 +121,21 @@ def test_models_option_before_or_after_the_command(tmp_path, run_cli):
     assert "kv2" not in out
     # Each structure with a mechanical picture in the modulus form too, its orders as fixed.
     lines = out.splitlines()
+    # Each structure: what it is (title, aliases), its network, J(s), G*(s), inequalities, priors.
     at = next(i for i, line in enumerate(lines) if line.startswith("voigt "))
-    assert lines[at].split(None, 1)[1] == "J(s) = b0 / (1 + a1 s^q)"
-    assert lines[at + 1].strip() == "G*(s) = G_e + c_q s^q"
+    assert lines[at].split(None, 1)[1] == ("Fractional Voigt model (also "
+                                           "fractional_kelvin_voigt_s, fkvs)")
+    assert lines[at + 1].strip() == "network parallel(spring(G_e), springpot(c_q, q))"
+    assert lines[at + 2].strip() == "J(s) = b0 / (1 + a1 s^q)"
+    assert lines[at + 3].strip() == "G*(s) = G_e + c_q s^q"
     at = next(i for i, line in enumerate(lines) if line.startswith("maxwell-int "))
-    assert lines[at + 1].strip() == "G*(s) = 1/(1/(c_beta s) + 1/c_delta)"
+    assert lines[at + 3].strip() == "G*(s) = 1/(1/(c_beta s) + 1/c_delta)"
+    at = next(i for i, line in enumerate(lines) if line.startswith("maxwell "))
+    assert lines[at + 4].strip() == "constraints: alpha <= beta (and stable, passive)"
     at = next(i for i, line in enumerate(lines) if line.startswith("voigt-inv "))
-    assert lines[at + 1].strip().startswith("priors:")  # no network: no modulus form
+    assert lines[at + 2].strip().startswith("priors:")  # no network: no modulus form
+    at = next(i for i, line in enumerate(lines) if line.startswith("max-n2m1 "))
+    assert lines[at].endswith("denominator of degree n = 2, numerator of degree m = 1 in s^q")
 
 
 ADHESIVE = EXAMPLES / "adhesive_468mp" / "Tp020C.csv"

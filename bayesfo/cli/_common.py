@@ -95,7 +95,10 @@ def add_comparison_options(p, each: str = "the fit"):
                         "that pyRheo fits, only when asked for)")
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1; "
-                        "one per parameter")
+                        "one per parameter; the card's coefficients are sampled on the scaled "
+                        "problem (frequencies and magnitudes divided by the data's reference "
+                        "values, which the report's priors section states), so their bounds "
+                        "are on that scale, not in Pa or s")
     p.add_argument("--seed", type=seed_argument, default=0,
                    help="seed of every random step (the same numbers whatever the workers)")
     p.add_argument("--holdout", default=None, metavar="W1,W2",

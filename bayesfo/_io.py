@@ -35,6 +35,11 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
     return path
 
 
+#: What to do with a directory where a data file was expected.
+DIRECTORY_HINT = ("give a file of it (bayesfo batch and bayesfo mastercurve take a directory of "
+                  "data sets or isotherms)")
+
+
 def write_error(path: str | os.PathLike, exc: OSError) -> str:
     """Why ``path`` could not be written, in words: the nearest existing folder on its way
     that is a file ("'out/run' is a file, not a folder"; the system says "File exists" or
@@ -89,7 +94,7 @@ def read_text_file(path: str | os.PathLike, what: str = "file",
     except OSError as exc:
         raise InputError(f"{where} cannot be read: {exc.strerror}") from None
     if stat.S_ISDIR(info.st_mode):
-        raise InputError(f"{where} is a directory")
+        raise InputError(f"{where} is a directory: {DIRECTORY_HINT}")
     if not stat.S_ISREG(info.st_mode):
         kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(info.st_mode)
                 else "a socket" if stat.S_ISSOCK(info.st_mode)
@@ -109,7 +114,7 @@ def read_text_file(path: str | os.PathLike, what: str = "file",
                 raise InputError(f"{where} is not a regular file")
             raw = fh.read() if max_bytes is None else fh.read(max_bytes + 1)
     except IsADirectoryError:
-        raise InputError(f"{where} is a directory") from None
+        raise InputError(f"{where} is a directory: {DIRECTORY_HINT}") from None
     except OSError as exc:
         raise InputError(f"{where} cannot be read: {exc.strerror}") from None
     if max_bytes is not None and len(raw) > max_bytes:

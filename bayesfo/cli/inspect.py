@@ -92,7 +92,9 @@ def _print(info: dict, seen: set | None = None) -> None:
           + (f", units {info['units']}" if info["units"] else ""))
     letter = response_symbol(symbol, info["kind"])
     star = "*" if info["kind"] in ("modulus", "compliance") else ""
-    print(f"|{letter}{star}| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}; "
+    unit = f" {info['units']}" if info["units"] else ""
+    print(f"|{letter}{star}| from {info['magnitude_min']:.4g} to {info['magnitude_max']:.4g}"
+          f"{unit}; "
           f"scaling omega_ref = {info['omega_ref']:.4g} rad/s, g_ref = {info['g_ref']:.4g}")
     print("sigma: " + ("given per point" if info["has_sigma"] else "not given (estimated when fitting)"))
     bad = info["dissipation_violations"]

@@ -322,9 +322,11 @@ class FrequencyResponse:
         frequencies cannot be told apart from its own overfit, so this is the floor.
         """
         if self.n_frequencies < n_params:
+            n = self.n_frequencies
             raise InputError(
-                f"{self.where()} has {self.n_frequencies} frequencies, fewer than the "
-                f"{n_params} parameters of {what}"
+                f"{self.where()} has {n} {'frequency' if n == 1 else 'frequencies'}, fewer "
+                f"than the {n_params} parameters of {what}: measure more frequencies, or "
+                "choose structures of fewer parameters (--structures)"
             )
 
     # ------------------------------------------------------------------ constructors

@@ -160,7 +160,9 @@ def test_to_csv_round_trip(tmp_path):
 def test_enough_points():
     fr = FrequencyResponse(W[:3], G[:3], source="d.csv")
     fr.check_enough_points(3, "structure 'zener'")
-    with pytest.raises(InputError, match="file 'd.csv' has 3 frequencies, fewer than the 4 parameters of structure 'zener'"):
+    with pytest.raises(InputError, match="file 'd.csv' has 3 frequencies, fewer than the 4 "
+                                         "parameters of structure 'zener': measure more "
+                                         "frequencies, or choose structures of fewer"):
         fr.check_enough_points(4, "structure 'zener'")
 
 
@@ -200,7 +202,8 @@ def test_bad_csv_is_named(write_csv, text, message):
 def test_missing_file_and_directory(tmp_path):
     with pytest.raises(InputError, match="does not exist"):
         read_csv(tmp_path / "nope.csv")
-    with pytest.raises(InputError, match="is a directory"):
+    with pytest.raises(InputError, match="is a directory: give a file of it \\(bayesfo batch "
+                                         "and bayesfo mastercurve take a directory"):
         read_csv(tmp_path)
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from .._io import show
 from ..errors import InputError
 from .columns import identify
-from .tables import Line, Table
+from .tables import Line, Table, number_like
 from .temperature import temperature_in_text
 
 REPTATE_PARAMS = re.compile(r"^\s*(?:[A-Za-z][\w ]*=[^;=]*;)+\s*$")
@@ -123,11 +123,15 @@ def no_table(where: str, lines: list[Line]) -> InputError:
         return InputError(f"{where} is empty: expected a header row and rows of numbers")
     for ln in content:
         if len(ln.cells) == 1:
-            for d, dname in ((";", "semicolon"), ("\t", "tab"), (",", "comma")):
-                if d in ln.cells[0]:
+            for d, dname, cli in ((";", "semicolon", ";"), ("\t", "tab", "tab"),
+                                  (",", "comma", ",")):
+                # A row of numbers left whole: the delimiter (not a header row alone, which
+                # has no numbers to split).
+                if sum(number_like(c.strip()) for c in ln.cells[0].split(d)) >= 2:
                     return InputError(
                         f"{where}, line {ln.number}: found one column {show(ln.cells[0])}: the "
                         f"delimiter looks like {dname} ({d!r}); give delimiter={d!r} "
-                        "(--delimiter), or leave it out to have it sniffed")
-    return InputError(f"{where}: no rows of numbers (at least two numbers per row) found; is it "
-                      "a data file?")
+                        f"(--delimiter {cli}), or leave it out to have it sniffed")
+    return InputError(f"{where}: no rows of numbers (at least two numbers per row) found"
+                      + (" after its header: the file has no data rows" if content else "")
+                      + "; is it a data file?")

@@ -432,7 +432,12 @@ def test_excel_without_openpyxl_says_what_to_install(tmp_path, monkeypatch):
 # ---------------------------------------------------------------------- bad input, precisely
 BAD = [
     ("omega;storage;loss\n1;2;3\n2;3;4\n", {"delimiter": ","},
-     r"line 1: found one column 'omega;storage;loss': the delimiter looks like semicolon"),
+     r"line 2: found one column '1;2;3': the delimiter looks like semicolon \(';'\); give "
+     r"delimiter=';' \(--delimiter ;\)"),
+    # A header and a units row without data: said so, not taken for a wrong delimiter.
+    ("Angular Frequency\tStorage Modulus\tLoss Modulus\nrad/s\tPa\tPa\n", {},
+     r"no rows of numbers \(at least two numbers per row\) found after its header: the file "
+     r"has no data rows"),
     ("Angular Frequency,Storage,Loss\n1,2,3\n2,3,x\n", {},
      r"line 3, column 'Loss': 'x' is not a number"),
     ("Angular Frequency,Torque,Strain\n1,2,3\n2,3,4\n", {},

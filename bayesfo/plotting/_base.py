@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -103,10 +104,14 @@ def _plain_formatter():
 
             def __call__(self, x, pos=None):
                 label = super().__call__(x, pos)
-                if not label or self.axis is None:
+                if self.axis is None:
                     return label
                 lo, hi = sorted(self.axis.get_view_interval())
-                if PLAIN_LOG_RANGE[0] <= lo and hi < PLAIN_LOG_RANGE[1]:
+                if not (PLAIN_LOG_RANGE[0] <= lo and hi < PLAIN_LOG_RANGE[1]):
+                    return label
+                # Within a decade every tick is labelled: the usual subset (2, 3, 5 times a
+                # power) can leave one label on an axis of 0.6 to 1.5.
+                if label or (lo > 0 and math.log10(hi / lo) < 1.0):
                     return f"{x:g}"
                 return label
 

@@ -75,7 +75,16 @@ def _readable_log_ticks(ax) -> None:
     lo, hi = ax.get_ylim()
     if not (lo > 0 and hi / lo < 10):
         return
-    ax.yaxis.set_major_locator(mticker.LogLocator(base=10, subs=(1.0, 2.0, 3.0, 5.0, 7.0)))
+    # The sparsest set of multiples of each power of ten that puts three ticks in view: on an
+    # axis of 0.71 to 1.19, 1, 2, 3, 5, 7 gave only 1.
+    for subs in ((1.0, 2.0, 3.0, 5.0, 7.0), (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0),
+                 tuple(np.round(np.arange(1.0, 10.0, 0.5), 1)),
+                 tuple(np.round(np.arange(1.0, 10.0, 0.1), 1))):
+        powers = 10.0 ** np.arange(np.floor(np.log10(lo)), np.ceil(np.log10(hi)) + 1)
+        ticks = np.outer(powers, subs).ravel()
+        if np.sum((ticks >= lo) & (ticks <= hi)) >= 3:
+            break
+    ax.yaxis.set_major_locator(mticker.LogLocator(base=10, subs=subs))
     ax.yaxis.set_major_formatter(mticker.FuncFormatter(lambda v, _: f"{v:g}"))
     ax.yaxis.set_minor_formatter(mticker.NullFormatter())
 

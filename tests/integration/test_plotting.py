@@ -739,3 +739,35 @@ def test_corner_and_trace_of_modulus_data_draw_the_physical_parameters():
         "G_e", "c_q", "q", "sigma_rel"]
     np.testing.assert_allclose(np.ravel(trace.values["G_e"]), phys["G_e"][0], rtol=1e-12)
     plt.close("all")
+
+
+def test_a_narrow_log_axis_gets_three_plain_labels():
+    """A logarithmic axis of less than a decade is labelled with plain numbers, at the sparsest
+    multiples of each power of ten that put three ticks in view (0.71 to 1.19: 0.8, 0.9, 1,
+    where 1, 2, 3, 5, 7 gave 1 alone); a log axis within 0.01-1e4 elsewhere gets plain labels
+    too (40, 60, 100), one reaching beyond keeps powers of ten."""
+    import matplotlib.pyplot as plt
+
+    from bayesfo.plotting._base import plain_log_labels
+    from bayesfo.plotting.moduli import _readable_log_ticks
+
+    fig, (a, b, c) = plt.subplots(1, 3)
+    try:
+        for ax, (lo, hi) in ((a, (0.71, 1.19)), (b, (35.0, 250.0)), (c, (1e-3, 1e3))):
+            ax.set_yscale("log")
+            ax.set_ylim(lo, hi)
+        _readable_log_ticks(a)
+        plain_log_labels(fig)
+        fig.canvas.draw()
+
+        def shown(ax):
+            lo, hi = ax.get_ylim()
+            return [t.get_text() for t, v in zip(ax.get_yticklabels(), ax.get_yticks(),
+                                                  strict=True) if lo <= v <= hi and t.get_text()]
+
+        assert shown(a) == ["0.8", "0.9", "1"]
+        assert shown(b) == ["100"] and "40" in [t.get_text() for t in b.get_yticklabels(
+            minor=True)]
+        assert all("10^" in t or "mathdefault" in t for t in shown(c))
+    finally:
+        plt.close(fig)

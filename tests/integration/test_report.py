@@ -154,10 +154,14 @@ def test_ranking_table_numbers_match_the_comparison(comparison):
                 # A ln Z from the tempered ladder is marked L (as in the terminal table).
                 mark = " L" if key == "log_evidence" and row["evidence_method"] == "ladder" else ""
                 assert text == f"{row[key]:.2f}{mark}"
-        assert cells[-1][0] == ("yes" if row["converged"] else "NO")
+        assert cells[-2][0] == ("yes" if row["converged"] else "NO")
+        # The posterior predictive checks, as the terminal says them.
+        assert cells[-1][0] == (row["fits"] or "–").replace("no", "NO")
         # Every fractional order by its symbol, as in ranking.csv (none for integer orders).
-        assert cells[-2][0] == (row["orders"] or "–")
-    assert any("q " in parser.rows[f"row-{r['structure']}"][-2][0] for r in table)
+        assert cells[-3][0] == (row["orders"] or "–")
+    assert any("q " in parser.rows[f"row-{r['structure']}"][-3][0] for r in table)
+    assert any(parser.rows[f"row-{r['structure']}"][-1][0] in ("yes", "small", "partly", "NO")
+               for r in table)
 
 
 def test_parameter_summaries_and_priors_are_listed(comparison):

@@ -294,7 +294,8 @@ def _parameters_section(comparison) -> str:
             parts.append(f"<h3>{_e(name)}</h3>{sampled}")
             continue
         physical = _physical_table(phys["physical"], symbol,
-                                   meanings(r.structure, phys["picture"]))
+                                   meanings(r.structure, phys["picture"]),
+                                   _beyond_window(phys["physical"], comparison.data.omega))
         picture = _picture_text(r.structure, phys["picture"], symbol)
         compliance = _e(in_symbol(r.structure.formula, symbol))
         if phys["natural_form"] == "physical":
@@ -336,12 +337,29 @@ def _flags(s: dict) -> list[str]:
             else []) + (["poorly determined"] if s.get("poorly_determined") else [])
 
 
-def _physical_table(block: dict, symbol: str = "G", meaning: dict | None = None) -> str:
+def _beyond_window(block: dict, omega) -> dict[str, str]:
+    """``{name: flag}`` of the times of ``block`` whose 94 % HDI lies wholly outside the times
+    the data cover (1/ω_max to 1/ω_min): the model's extrapolation, however narrow its HDI."""
+    t_lo, t_hi = 1.0 / float(max(omega)), 1.0 / float(min(omega))
+    out = {}
+    for name, s in block.items():
+        lo, hi = s.get("hdi_low"), s.get("hdi_high")
+        if s.get("unit") != "s" or s.get("not_determined") or not (_finite(lo) and _finite(hi)):
+            continue
+        if hi < t_lo or lo > t_hi:
+            out[name] = (f"beyond the data window (t = 1/ω from {t_lo:.3g} to {t_hi:.3g} s): "
+                         "the model's extrapolation")
+    return out
+
+
+def _physical_table(block: dict, symbol: str = "G", meaning: dict | None = None,
+                    beyond: dict | None = None) -> str:
     """The physical parameters' summaries, with what each is (``meaning``, from
-    :func:`~bayesfo.structures.physical.meanings`) in a last column where given."""
+    :func:`~bayesfo.structures.physical.meanings`) in a last column where given, and the flags
+    of ``beyond`` (:func:`_beyond_window`) beside their own."""
     rows = []
     for p, s in block.items():
-        flags = _flags(s)
+        flags = _flags(s) + ([beyond[p]] if beyond and p in beyond else [])
         rows.append(
             f"<tr>{_text_cell(parameter_label(p, symbol))}"
             f"{_text_cell(in_symbol(s['unit'], symbol))}"

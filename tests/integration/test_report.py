@@ -352,3 +352,19 @@ def test_a_best_structure_that_misses_by_little_is_said_so_first():
     assert flagged and text.startswith("None of the candidates describes these data")
     assert text.endswith("The misfit is small (within 2° in phase and 3.5 % in magnitude) for "
                          "zener.")
+
+
+def test_a_time_beyond_the_data_window_is_flagged_as_extrapolation():
+    """A time whose HDI lies wholly outside 1/ω_max … 1/ω_min (the Zener's τ = 1.5e-4 s on the
+    adhesive at 150 °C, measured over 0.63-126 rad/s) is the model's extrapolation, however
+    narrow; one overlapping the window, an undetermined one, or a modulus are not flagged."""
+    from bayesfo.output.report import _beyond_window
+
+    omega = np.array([0.628, 125.7])
+    block = {"tau": {"unit": "s", "hdi_low": 1.0e-4, "hdi_high": 2.1e-4},
+             "tau_k": {"unit": "s", "hdi_low": 5e-3, "hdi_high": 2e-2},
+             "tau_m": {"unit": "s", "hdi_low": 10.0, "hdi_high": 20.0, "not_determined": True},
+             "G_m": {"unit": "Pa", "hdi_low": 1e5, "hdi_high": 2e5}}
+    assert _beyond_window(block, omega) == {
+        "tau": "beyond the data window (t = 1/ω from 0.00796 to 1.59 s): the model's "
+               "extrapolation"}

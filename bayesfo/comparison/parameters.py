@@ -226,7 +226,7 @@ def with_determination(block: dict, poorly_determined=None, draws=None, limited=
     and ``poorly_determined`` copied from ``poorly_determined`` (``{name: bool}`` of the
     sampled parameters) for the names it holds. ``draws`` (``{name: draws}``) are the draws
     each quantity is judged on (:func:`not_determined`); a name without them is judged on its
-    summary's HDI. ``limited`` (``{name: reason}``, :func:`prior_limited`): quantities whose
+    summary's HDI. ``limited`` (``{name: reason}``, :func:`limit_reasons`): quantities whose
     posterior a prior bound ends, not determined for that reason where not already for
     another."""
     poorly_determined = poorly_determined or {}
@@ -257,22 +257,31 @@ FOLLOWS = 0.5
 
 
 def prior_limited(structure, summary: dict) -> dict:
-    """``{name: reason}`` of the sampled parameters whose posterior a prior bound ends
-    (``ParameterSummary.at_prior_bound``): every parameter but the orders, whose bounds (0 and
-    1) are the structure's own (an order at 0 is an element that vanishes). A coefficient's
-    prior is a range as wide as the data's scale allows (log-uniform over eight decades of the
-    scaled problem): a posterior that runs into it is one the data leave open on that side,
-    whose HDI the prior alone sets (a zero-shear viscosity at the prior's top)."""
+    """``{name: side}`` (``"lower"`` or ``"upper"``) of the sampled parameters whose posterior
+    a prior bound ends (``ParameterSummary.at_prior_bound``): every parameter but the orders,
+    whose bounds (0 and 1) are the structure's own (an order at 0 is an element that vanishes).
+    A coefficient's prior is a range as wide as the data's scale allows (log-uniform over eight
+    decades of the scaled problem): a posterior that runs into it is one the data leave open on
+    that side, whose HDI the prior alone sets (a zero-shear viscosity at the prior's top)."""
     orders = set(structure.exponent_params)
     side = {"low": "lower", "high": "upper"}
-    return {n: (f"its posterior runs to the prior's {side[s.at_prior_bound]} bound, which the "
-                f"prior, not the data, sets (--prior {n}=... widens it, on the scaled problem)")
-            for n, s in summary.items() if getattr(s, "at_prior_bound", "") and n not in orders}
+    return {n: side[s.at_prior_bound] for n, s in summary.items()
+            if getattr(s, "at_prior_bound", "") and n not in orders}
+
+
+def limit_reasons(limited: dict) -> dict:
+    """``{name: reason}`` of :func:`prior_limited`'s parameters, as ``not_determined_reason``
+    gives it."""
+    return {n: f"its posterior runs to the prior's {side} bound, {_WIDEN.format(n)}"
+            for n, side in limited.items()}
+
+
+_WIDEN = "which the prior, not the data, sets (--prior {}=... widens it, on the scaled problem)"
 
 
 def _following(structure, form: dict, draws: dict, limited: dict) -> dict:
     """``{name: reason}`` of the quantities of ``form`` (``{name: (values, unit)}``) that follow
-    a coefficient of ``limited`` (:func:`prior_limited`): one their expression names, with a
+    a parameter of ``limited`` (:func:`prior_limited`): one their expression names, with a
     rank correlation over the draws of at least :data:`FOLLOWS`."""
     if not limited or not structure.pictures:
         return {}
@@ -293,11 +302,8 @@ def _following(structure, form: dict, draws: dict, limited: dict) -> dict:
                 continue
             rho = float(np.corrcoef(ranks(v[ok]), ranks(c[ok]))[0, 1])
             if abs(rho) >= FOLLOWS:
-                out[name] = (f"it follows {n} (rank correlation {rho:+.2f}), "
-                             + limited[n].split(", which the prior", 1)[0].replace(
-                                 "its posterior", "whose posterior")
-                             + f", which the prior, not the data, sets (--prior {n}=... widens "
-                             "it, on the scaled problem)")
+                out[name] = (f"it follows {n} (rank correlation {rho:+.2f}), whose posterior "
+                             f"runs to the prior's {limited[n]} bound, {_WIDEN.format(n)}")
                 break
     return out
 
@@ -320,7 +326,7 @@ def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: s
         ``{name: bool}`` of the sampled parameters (``ParameterSummary.poorly_determined``),
         copied into the summaries of the same names.
     limited : dict, optional
-        ``{name: reason}`` of the sampled parameters whose posterior a prior bound ends
+        ``{name: side}`` of the sampled parameters whose posterior a prior bound ends
         (:func:`prior_limited`): they, and the quantities that follow one of them, are not
         determined for that reason.
 
@@ -349,7 +355,8 @@ def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: s
         return with_determination({n: summarise_draws(v, at[n][0], u)
                                    for n, (v, u) in form.items()}, poorly_determined,
                                   draws={n: v for n, (v, _) in form.items()},
-                                  limited=limited | _following(structure, form, draws, limited))
+                                  limited=limit_reasons(limited)
+                                  | _following(structure, form, draws, limited))
 
     has_picture = bool(structure.pictures)
     phys = block(physical, map_physical) if has_picture else block(coefficients, map_coefficients)

@@ -19,6 +19,7 @@ from ..structures import Structure
 from .criteria_types import Criteria
 from .parameters import (  # noqa: F401  (re-exported: the names results offered before)
     NOISE_UNITS,
+    limit_reasons,
     parameter_units,
     physical_forms,
     physical_text,
@@ -118,8 +119,8 @@ class StructureResult:
                  for k, v in post.summary.items()}
         draws = {k: post.samples[:, post.param_names.index(k)] for k in block
                  if k in post.param_names}
-        return with_determination(block, draws=draws,
-                                  limited=prior_limited(self.structure, post.summary))
+        return with_determination(
+            block, draws=draws, limited=limit_reasons(prior_limited(self.structure, post.summary)))
 
     @property
     def natural_parameters(self) -> dict:

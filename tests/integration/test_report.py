@@ -356,15 +356,23 @@ def test_a_best_structure_that_misses_by_little_is_said_so_first():
 
 def test_a_time_beyond_the_data_window_is_flagged_as_extrapolation():
     """A time whose HDI lies wholly outside 1/ω_max … 1/ω_min (the Zener's τ = 1.5e-4 s on the
-    adhesive at 150 °C, measured over 0.63-126 rad/s) is the model's extrapolation, however
-    narrow; one overlapping the window, an undetermined one, or a modulus are not flagged."""
+    adhesive at 150 °C, measured over 0.63-126 rad/s), or a modulus wholly above 1.5 times the
+    largest measured |G*|, is the model's extrapolation, however narrow; one overlapping the
+    data's, or an undetermined one, is not flagged."""
+    from types import SimpleNamespace
+
     from bayesfo.output.report import _beyond_window
 
-    omega = np.array([0.628, 125.7])
+    data = SimpleNamespace(omega=np.array([0.628, 125.7]), kind="modulus", units="Pa",
+                           symbol="G", response=np.array([1e4 + 2e4j, 2e4 + 3e4j]))
     block = {"tau": {"unit": "s", "hdi_low": 1.0e-4, "hdi_high": 2.1e-4},
              "tau_k": {"unit": "s", "hdi_low": 5e-3, "hdi_high": 2e-2},
              "tau_m": {"unit": "s", "hdi_low": 10.0, "hdi_high": 20.0, "not_determined": True},
-             "G_m": {"unit": "Pa", "hdi_low": 1e5, "hdi_high": 2e5}}
-    assert _beyond_window(block, omega) == {
+             "G_m": {"unit": "Pa", "hdi_low": 1e5, "hdi_high": 2e5},
+             "G_e": {"unit": "Pa", "hdi_low": 1e4, "hdi_high": 2e4}}
+    # The Zener's G_m on the adhesive at 150 °C: four times the largest |G*| (3.6e4 there).
+    assert _beyond_window(block, data) == {
         "tau": "beyond the data window (t = 1/ω from 0.00796 to 1.59 s): the model's "
-               "extrapolation"}
+               "extrapolation",
+        "G_m": "above every measured |G*| (at most 3.61e+04): the model's extrapolation past "
+               "the highest frequency"}

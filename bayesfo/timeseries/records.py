@@ -337,11 +337,14 @@ def extract_frequency_response(
     notes = [f"extracted from {len(analyses)} sine records"]
     if lacking and len(lacking) < len(analyses):
         notes.append("sigma unknown: some record has a single series or identical series")
-    for r in analyses:
+    for r, path in results:
         if r.nonlinear:
             notes.append(
                 f"nonlinear at omega = {r.omega:.6g} rad/s (output THD {r.thd_output:.3g})"
             )
+        if r.omega_estimated:
+            notes.append(f"{path}: no '# omega:' or '# freq:' line; omega = {r.omega:.6g} rad/s "
+                         "estimated from the input's spectrum")
     try:
         source = os.path.commonpath([str(p.resolve().parent) for p in paths])
     except ValueError:  # records on different drives

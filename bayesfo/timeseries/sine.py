@@ -287,6 +287,11 @@ def _estimate_omega(t: np.ndarray, u_mean: np.ndarray) -> float:
     return float(res.x)
 
 
+#: Least share of the input's power (past its offset and trend) in its component at omega for
+#: the record to be a sine response: a square wave's is 81 %, broadband noise's a few per cent.
+MIN_INPUT_SHARE = 0.5
+
+
 def _analyze(t, u, y, omega, n_harmonics, threshold, where: str) -> HarmonicAnalysis:
     """Checked inputs -> HarmonicAnalysis; ``where`` prefixes warning messages."""
     n = t.size
@@ -353,6 +358,15 @@ def _analyze(t, u, y, omega, n_harmonics, threshold, where: str) -> HarmonicAnal
                 f"at {(j + 1) * 2 * np.pi / (n_keep * dt):g} rad/s with "
                 f"{others[j] / abs(u_fund):.3g} times the amplitude at omega"
             )
+    # The input must be a sine at omega: its component there holds most of its power (past the
+    # offset and trend). Noise or a chirp fed in gives a ratio of two small components, not G.
+    power = np.abs(spectra[0, 1:]) ** 2
+    share = float(abs(u_fund) ** 2 / power.sum()) if power.sum() > 0 else 1.0
+    if share < MIN_INPUT_SHARE:
+        raise InputError(
+            f"the input is not a sine at omega = {omega:g} rad/s: its component there "
+            f"holds {100 * share:.0f} % of its power (a sine's holds nearly all); give records "
+            "of a sinusoidal input, one frequency per record")
     response = complex(y_fund / u_fund)
 
     def ratios(spec_row: np.ndarray) -> np.ndarray:
@@ -386,6 +400,20 @@ def _analyze(t, u, y, omega, n_harmonics, threshold, where: str) -> HarmonicAnal
         spread = np.sum(np.abs(g_series - g_series.mean()) ** 2) / (n_series - 1)
         sigma = float(np.sqrt(spread / n_series))
 
+    distorted = h_in[np.isfinite(h_in)]
+    if distorted.size and np.max(distorted) > threshold:
+        # Harmonics of the input pass through a linear system as harmonics of the output:
+        # the output's cannot tell whether the system is linear.
+        worst = int(np.nanargmax(h_in)) + 2
+        warnings.warn(
+            f"{where}omega = {omega:.6g} rad/s: the input is not a pure sine (its harmonic "
+            f"{worst} is {h_in[worst - 2]:.3g} of the fundamental, threshold {threshold:g}): G "
+            "is the ratio of the fundamentals, which holds for a linear system, but the output's "
+            "harmonics may come from the input's, so linearity is not tested",
+            NonlinearityWarning,
+            stacklevel=4,
+        )
+        finite = finite[:0]
     nonlinear = bool(finite.size and np.max(finite) > threshold)
     if nonlinear:
         worst = int(np.nanargmax(h_out)) + 2

@@ -602,3 +602,36 @@ def test_bundled_example_records():
         assert abs(fr.response[k] - g[k]) < 5 * sd
         assert not a.nonlinear
     assert fr.sigma is not None and fr.source.endswith("sine_records")
+
+
+def test_an_input_that_is_not_a_sine_is_refused_or_leaves_linearity_untested():
+    """Broadband noise as the input holds a few per cent of its power at omega: refused (its
+    'gain' was a ratio of two small components). A square wave's fundamental holds 8/pi^2 = 81 %:
+    G is the ratio of the fundamentals, which is right for a linear system, but the output's
+    harmonics are the input's, so the record is not called nonlinear, and a warning says so."""
+    import warnings as w
+
+    from bayesfo.errors import NonlinearityWarning
+
+    omega = 1.0
+    t = grid(omega, 200, 8)
+    rng = np.random.default_rng(0)
+    # A weak sine in broadband noise: the largest line of the input's spectrum is at omega
+    # (so omega matches it), but it holds a few per cent of the input's power.
+    noisy = 0.3 * np.sin(omega * t) + rng.standard_normal(t.size)
+    with pytest.raises(InputError, match=r"the input is not a sine at omega = 1 rad/s: its "
+                                         r"component there holds [1-9] % of its power"):
+        analyze_sine(t, noisy, 0.5 * noisy, omega)
+    # A square wave (its harmonics up to the fifth, those the analysis fits) through a linear
+    # system, harmonic by harmonic.
+    g = g_true
+    u = sum(4 / np.pi / k * np.sin(k * omega * t) for k in (1, 3, 5))
+    y = sum(4 / np.pi / k * abs(g(k * omega)) * np.sin(k * omega * t + np.angle(g(k * omega)))
+            for k in (1, 3, 5))
+    with w.catch_warnings(record=True) as caught:
+        w.simplefilter("always")
+        res = analyze_sine(t, u, y, omega)
+    assert not res.nonlinear
+    assert res.response == pytest.approx(g(omega), rel=1e-9)
+    assert any(issubclass(c.category, NonlinearityWarning)
+               and "the input is not a pure sine" in str(c.message) for c in caught)

@@ -254,7 +254,13 @@ class FrequencyResponse:
             )
         mag2 = np.abs(self.response) ** 2
         kind = {"compliance": "modulus", "modulus": "compliance"}.get(self.kind, self.kind)
-        units = f"1/({self.units})" if self.units else ""
+        # 1/(1/Pa) is Pa; 1/Pa stays 1/Pa, and a compound unit is bracketed (1/(m/N)).
+        u = self.units.strip() if self.units else ""
+        inner = u[2:].strip() if u.startswith("1/") else None
+        if inner is not None and inner.startswith("(") and inner.endswith(")"):
+            inner = inner[1:-1]
+        units = (inner if inner is not None else
+                 "" if not u else f"1/{u}" if u.isidentifier() else f"1/({u})")
         symbol = RECIPROCAL[self.symbol] if kind != self.kind else self.symbol
         return replace(
             self,

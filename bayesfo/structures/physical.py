@@ -272,7 +272,21 @@ def _time_text(text: str) -> str:
 
 
 def format_unit(stress: float, time: str, stress_symbol: str) -> str:
-    """A unit such as ``Pa s^alpha``, ``1/Pa``, ``s^q/Pa`` or ``s``."""
+    """A unit such as ``Pa s^alpha``, ``1/Pa``, ``s^q/Pa`` or ``s``; a stress symbol that is a
+    reciprocal itself (``1/(m/N)`` of a generic transfer function in m/N) is inverted, not
+    divided again (``m/N``, not ``1/(1/(m/N))``).
+
+    Examples
+    --------
+    >>> format_unit(-1, "0", "1/(m/N)"), format_unit(1, "0", "1/(m/N)")
+    ('m/N', '1/(m/N)')
+    >>> format_unit(-1, "q", "1/[J]"), format_unit(1, "q", "Pa")
+    ('[J] s^q', 'Pa s^q')
+    """
+    if stress and stress_symbol.startswith("1/"):
+        inner = stress_symbol[2:].strip()
+        inner = inner[1:-1] if inner.startswith("(") and inner.endswith(")") else inner
+        stress, stress_symbol = -stress, inner
     t = _time_text(str(time))
     p = abs(stress)
     if p == 0:

@@ -103,8 +103,10 @@ def test_reciprocal_values_sigma_and_kind():
     inv = fr.reciprocal()
     np.testing.assert_allclose(inv.response, 1 + (1j * W) ** 0.5, rtol=1e-14)
     np.testing.assert_allclose(inv.sigma, 0.01 / np.abs(G) ** 2, rtol=1e-14)
-    assert (inv.kind, inv.units) == ("modulus", "1/(1/Pa)")
-    assert inv.reciprocal().kind == "compliance"
+    assert (inv.kind, inv.units) == ("modulus", "Pa")  # not 1/(1/Pa)
+    assert (inv.reciprocal().kind, inv.reciprocal().units) == ("compliance", "1/Pa")
+    generic = FrequencyResponse(W, G, kind="generic", units="m/N").reciprocal()
+    assert generic.units == "1/(m/N)" and generic.reciprocal().units == "m/N"
 
 
 def test_reciprocal_sigma_first_order_against_monte_carlo():

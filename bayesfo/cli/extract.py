@@ -40,8 +40,7 @@ def run(args) -> int:
         distorted = bool(np.any(np.nan_to_num(a.harmonic_ratio_input) > args.threshold))
         print(f"{a.omega:14.6g} {a.gain:12.6g} {a.phase_deg:12.4f} {a.thd_output:8.4f}  "
               + ("untested" if distorted else "no" if a.nonlinear else "yes"))
-    for note in fr.notes[1:]:
-        if "estimated from the input's spectrum" in note:
-            print(f"note: {note}")
+    for note in fr.notes[1:]:  # past "extracted from N sine records"
+        print(f"note: {note}")
     print(f"wrote {written} and {harmonics} (each record's harmonics)")
     return 0

@@ -98,7 +98,9 @@ class HarmonicAnalysis:
         over the measurable harmonics ``k = 2 .. K``.
     nonlinear : bool
         True when some output harmonic ratio exceeds the threshold; a
-        :class:`~bayesfo.errors.NonlinearityWarning` was issued.
+        :class:`~bayesfo.errors.NonlinearityWarning` was issued. False where the input itself
+        has a harmonic over the threshold (its own warning says so): the output's harmonics
+        may then be the input's, and linearity is not tested.
     n_samples : int
         Samples per series used (the whole periods at the end of the record).
     omega_estimated : bool

@@ -97,6 +97,9 @@ def test_extract_bundled_sine_records(run_cli, tmp_path):
     # Records are 1/(1 + s^0.5) with noise sd 0.01 over many periods: within 5 sigma.
     assert np.all(np.abs(fr.response - g_spec(fr.omega)) < 5 * fr.sigma + 1e-3)
     assert (tmp_path / "fr_harmonics.csv").exists()
+    # The command names both files it wrote, and every record's input is a clean sine.
+    assert f"wrote {out_csv} and {tmp_path / 'fr_harmonics.csv'}" in out
+    assert "untested" not in out and "note:" not in out
 
 
 def test_identify_max_order_loop(run_cli, gspec_csv):

@@ -129,7 +129,7 @@ def test_terminal_lines_of_inspect_and_compare(comparison, tmp_path, capsys):
     assert lines[0] == ("NREL PV-module polymer, DMA master curve (reference -5 °C): 205 "
                         "frequencies, 6.283e-12 to 6.283e+14 rad/s, kind modulus (tensile "
                         "modulus E* = E′ + iE″), units MPa")
-    assert lines[1].startswith("|E*| from 89.42 to 9585; ")
+    assert lines[1].startswith("|E*| from 89.42 to 9585 MPa; ")  # with the data's unit
     path = tmp_path / "dma.csv"
     path.write_text(_data().to_csv_text())
     assert main(["compare", str(path), "--structures", "voigt", "--no-figures",

@@ -50,9 +50,8 @@ def run(args) -> int:
 
     from .._io import atomic_write_text, write_error
     from ..comparison import load
-    from ..data.symbols import modulus_symbol
     from ..errors import InputError
-    from ..predictions.prony import EXTRAPOLATED, TAU_MARGIN, prony_series
+    from ..predictions.prony import prony_series
 
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     try:
@@ -97,12 +96,8 @@ def run(args) -> int:
     print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
           f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
           f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
-    e = modulus_symbol(prony.symbol)
-    if prony.g_0 > EXTRAPOLATED * prony.measured_max:
-        print(f"note: {e}0 is the model's modulus {TAU_MARGIN} decades past the highest "
-              f"measured frequency, {prony.g_0 / prony.measured_max:.3g} x the largest measured "
-              f"|{e}*|: the ratios g_i/{e}0 that Abaqus and ANSYS take depend on that "
-              "extrapolation")
+    for line in prony.extrapolation_text():
+        print(f"note: {line}")
     for line in prony.long_time_text():
         if prony.model_g_inf == 0.0:
             line += (" (--liquid sets G_inf = 0)" if prony.g_inf > 0 else

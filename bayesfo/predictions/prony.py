@@ -137,11 +137,7 @@ class Prony:
                 f" ({e}', {e}'': {self.max_rel_error_modulus:.3g}; {e}(t): "
                 f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of {e}(t) is at "
                 f"least +-{self.band_rel_halfwidth:.3g} (relative) there"]
-        if self.g_0 > EXTRAPOLATED * self.measured_max:
-            head.append(f"g_0 is the model's modulus {TAU_MARGIN} decades past the highest "
-                        f"measured frequency, {self.g_0 / self.measured_max:.3g} x the largest "
-                        f"measured |{e}*| ({self.measured_max:.4g}): ratios g_i/g_0 depend on "
-                        "that extrapolation")
+        head += self.extrapolation_text()
         if mode == "tensile" and fmt in ("abaqus", "ansys"):
             head.append("a tensile series: its ratios g_i/g_0 stand for the shear ratios the "
                         "code takes under a constant Poisson's ratio")
@@ -236,6 +232,19 @@ class Prony:
         return [f"relaxation times {lo:.4g} to {hi:.4g} s: those beyond the data window stand "
                 "for the model's extrapolation there, so that the series follows the model to "
                 "the window's ends"]
+
+    def extrapolation_text(self) -> list[str]:
+        """That g_0 is the model extrapolated past the highest measured frequency, where it lies
+        more than :data:`EXTRAPOLATED` times above the largest measured |G*|; empty otherwise."""
+        if not self.g_0 > EXTRAPOLATED * self.measured_max:
+            return []
+        from ..data.symbols import modulus_symbol
+
+        e = modulus_symbol(self.symbol)
+        return [f"{e}0 is the model's modulus {TAU_MARGIN} decades past the highest measured "
+                f"frequency, {self.g_0 / self.measured_max:.3g} x the largest measured |{e}*| "
+                f"({self.measured_max:.4g}): the ratios g_i/{e}0 that Abaqus and ANSYS take "
+                "depend on that extrapolation"]
 
     def long_time_text(self) -> list[str]:
         """What g_inf stands for, beside the model's own long-time modulus."""

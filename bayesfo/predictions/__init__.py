@@ -2,15 +2,8 @@
 over structures (:func:`predict`), the long-time modulus (:func:`long_time_modulus`), and
 Prony series for finite-element codes (:func:`prony_series`)."""
 
-from .functions import (
-    AVERAGES,
-    QUANTITIES,
-    Prediction,
-    equilibrium_modulus,
-    evaluate,
-    long_time_modulus,
-    predict,
-)
+from .functions import AVERAGES, QUANTITIES, Prediction, evaluate, predict
+from .long_time import equilibrium_modulus, long_time_modulus
 from .prony import FORMATS, Prony, prony_series
 
 __all__ = ["AVERAGES", "FORMATS", "QUANTITIES", "Prediction", "Prony", "equilibrium_modulus",

@@ -291,7 +291,7 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
     liquid : bool, optional
         True: G∞ = 0 (a liquid relaxes completely); False: G∞ fitted with the terms; None
         (default): 0 where the model's long-time modulus is 0 for the median draw
-        (:func:`~bayesfo.predictions.functions.long_time_modulus`), else fitted.
+        (:func:`~bayesfo.predictions.long_time.long_time_modulus`), else fitted.
     structure : str, optional
         The structure (default: the best ranked), as in :func:`bayesfo.predict`.
     average : {"bma", "stacking"}, optional
@@ -309,7 +309,8 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
     """
     from scipy.optimize import nnls
 
-    from .functions import long_time_modulus, predict
+    from .functions import predict
+    from .long_time import long_time_modulus
 
     if isinstance(per_decade, bool) or not isinstance(per_decade, int) or not 1 <= per_decade <= 10:
         raise InputError(f"export: terms per decade must be an integer from 1 to 10, got "

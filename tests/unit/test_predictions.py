@@ -161,7 +161,7 @@ def test_bad_arguments_name_what_is_wrong(x, message):
     ("maxwell-inv", [1e3, 2.0, 0.3, 0.8], np.inf),         # C(s) -> 0: G(t) grows
 ])
 def test_long_time_modulus_from_the_lowest_powers(name, theta, expected):
-    from bayesfo.predictions.functions import equilibrium_modulus
+    from bayesfo.predictions.long_time import equilibrium_modulus
 
     got = equilibrium_modulus(get_structure(name), [theta, theta])
     np.testing.assert_array_equal(got, [expected, expected])
@@ -170,7 +170,7 @@ def test_long_time_modulus_from_the_lowest_powers(name, theta, expected):
 def test_long_time_modulus_is_where_integer_orders_relax_to():
     """An independent computation: G(t) by the Talbot inversion, long after the last
     relaxation time, for structures of integer orders (exponential relaxation)."""
-    from bayesfo.predictions.functions import equilibrium_modulus
+    from bayesfo.predictions.long_time import equilibrium_modulus
 
     for name, theta in [("zener-int", [2.0, 3.0, 0.5]), ("maxwell-int", [2.0, 0.5]),
                         ("max-n2m1-int", [2.0, 1.0, 0.2, 0.1])]:

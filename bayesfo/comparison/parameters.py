@@ -308,6 +308,33 @@ def _following(structure, form: dict, draws: dict, limited: dict) -> dict:
     return out
 
 
+def extrapolated(block: dict, data) -> dict[str, str]:
+    """``{name: flag}`` of the quantities of ``block`` (``{name: summary}``) that the model
+    extrapolates, however narrow their 94 % HDI: a time whose HDI lies wholly outside the times
+    ``data`` cover (1/ω_max to 1/ω_min), and, for modulus data, a modulus whose HDI lies
+    wholly above :data:`~bayesfo.predictions.prony.EXTRAPOLATED` times the largest measured
+    |G*| (a plateau beyond the highest frequency). Quantities not determined are left out."""
+    from ..predictions.prony import EXTRAPOLATED
+    from ..structures.physical import stress_unit
+
+    t_lo, t_hi = 1.0 / float(np.max(data.omega)), 1.0 / float(np.min(data.omega))
+    modulus = stress_unit("modulus", data.units or "") if data.kind == "modulus" else None
+    top = float(np.max(np.abs(data.response)))
+    out = {}
+    for name, s in block.items():
+        lo, hi = s.get("hdi_low"), s.get("hdi_high")
+        if (s.get("not_determined") or lo is None or hi is None
+                or not (math.isfinite(lo) and math.isfinite(hi))):
+            continue
+        if s.get("unit") == "s" and (hi < t_lo or lo > t_hi):
+            out[name] = (f"beyond the data window (t = 1/ω from {t_lo:.3g} to {t_hi:.3g} s): "
+                         "the model's extrapolation")
+        elif modulus is not None and s.get("unit") == modulus and lo > EXTRAPOLATED * top:
+            out[name] = (f"above every measured |{data.symbol}*| (at most {top:.3g}): the "
+                         "model's extrapolation past the highest frequency")
+    return out
+
+
 def physical_forms(structure, draws: dict, map_values: dict, kind: str, units: str = "",
                    poorly_determined=None, limited=None) -> dict:
     """The parameters of ``structure`` in both forms, summarised, with units.

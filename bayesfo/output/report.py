@@ -23,10 +23,8 @@ import base64
 import html
 from pathlib import Path
 
-import numpy as np
-
 from .._io import atomic_write_text
-from ..comparison.parameters import UNDETERMINED_DECADES, shown_hdi
+from ..comparison.parameters import UNDETERMINED_DECADES, extrapolated, shown_hdi
 from ..comparison.table import number
 from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
@@ -297,7 +295,7 @@ def _parameters_section(comparison) -> str:
             continue
         physical = _physical_table(phys["physical"], symbol,
                                    meanings(r.structure, phys["picture"]),
-                                   _beyond_window(phys["physical"], comparison.data))
+                                   extrapolated(phys["physical"], comparison.data))
         picture = _picture_text(r.structure, phys["picture"], symbol)
         compliance = _e(in_symbol(r.structure.formula, symbol))
         if phys["natural_form"] == "physical":
@@ -339,38 +337,11 @@ def _flags(s: dict) -> list[str]:
             else []) + (["poorly determined"] if s.get("poorly_determined") else [])
 
 
-def _beyond_window(block: dict, data) -> dict[str, str]:
-    """``{name: flag}`` of the quantities of ``block`` that the model extrapolates, however
-    narrow their 94 % HDI: a time whose HDI lies wholly outside the times the data cover
-    (1/ω_max to 1/ω_min), and, for modulus data, a modulus whose HDI lies wholly above
-    :data:`~bayesfo.predictions.prony.EXTRAPOLATED` times the largest measured |G*| (a
-    plateau beyond the highest frequency)."""
-    from ..predictions.prony import EXTRAPOLATED
-    from ..structures.physical import stress_unit
-
-    omega = data.omega
-    t_lo, t_hi = 1.0 / float(max(omega)), 1.0 / float(min(omega))
-    modulus = stress_unit("modulus", data.units or "") if data.kind == "modulus" else None
-    top = float(np.max(np.abs(data.response)))
-    out = {}
-    for name, s in block.items():
-        lo, hi = s.get("hdi_low"), s.get("hdi_high")
-        if s.get("not_determined") or not (_finite(lo) and _finite(hi)):
-            continue
-        if s.get("unit") == "s" and (hi < t_lo or lo > t_hi):
-            out[name] = (f"beyond the data window (t = 1/ω from {t_lo:.3g} to {t_hi:.3g} s): "
-                         "the model's extrapolation")
-        elif modulus is not None and s.get("unit") == modulus and lo > EXTRAPOLATED * top:
-            out[name] = (f"above every measured |{data.symbol}*| (at most {top:.3g}): the "
-                         "model's extrapolation past the highest frequency")
-    return out
-
-
 def _physical_table(block: dict, symbol: str = "G", meaning: dict | None = None,
                     beyond: dict | None = None) -> str:
     """The physical parameters' summaries, with what each is (``meaning``, from
     :func:`~bayesfo.structures.physical.meanings`) in a last column where given, and the flags
-    of ``beyond`` (:func:`_beyond_window`) beside their own."""
+    of ``beyond`` (:func:`~bayesfo.comparison.parameters.extrapolated`) beside their own."""
     rows = []
     for p, s in block.items():
         flags = _flags(s) + ([beyond[p]] if beyond and p in beyond else [])

@@ -361,7 +361,7 @@ def test_a_time_beyond_the_data_window_is_flagged_as_extrapolation():
     data's, or an undetermined one, is not flagged."""
     from types import SimpleNamespace
 
-    from bayesfo.output.report import _beyond_window
+    from bayesfo.comparison.parameters import extrapolated
 
     data = SimpleNamespace(omega=np.array([0.628, 125.7]), kind="modulus", units="Pa",
                            symbol="G", response=np.array([1e4 + 2e4j, 2e4 + 3e4j]))
@@ -371,7 +371,7 @@ def test_a_time_beyond_the_data_window_is_flagged_as_extrapolation():
              "G_m": {"unit": "Pa", "hdi_low": 1e5, "hdi_high": 2e5},
              "G_e": {"unit": "Pa", "hdi_low": 1e4, "hdi_high": 2e4}}
     # The Zener's G_m on the adhesive at 150 °C: four times the largest |G*| (3.6e4 there).
-    assert _beyond_window(block, data) == {
+    assert extrapolated(block, data) == {
         "tau": "beyond the data window (t = 1/ω from 0.00796 to 1.59 s): the model's "
                "extrapolation",
         "G_m": "above every measured |G*| (at most 3.61e+04): the model's extrapolation past "

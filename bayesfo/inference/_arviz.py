@@ -148,12 +148,16 @@ def write_tree(tree, path) -> None:
     crashes the process (segmentation fault) instead of raising, while a plain write raises
     ``OSError`` (``ENOSPC``) that the command reports.
     """
-    import dask
-
-    # Inside a Dask worker xarray would take a distributed lock named after the target, which
-    # an in-memory file has not; the arrays are in memory, so the local scheduler's lock serves.
-    with dask.config.set(scheduler="synchronous"):
+    try:
+        import dask
+    except ImportError:  # a plain install: xarray writes without a scheduler to ask
         data = tree.to_netcdf(engine=ENGINE)
+    else:
+        # Inside a Dask worker xarray would take a distributed lock named after the target,
+        # which an in-memory file has not; the arrays are in memory, so the local scheduler's
+        # lock serves.
+        with dask.config.set(scheduler="synchronous"):
+            data = tree.to_netcdf(engine=ENGINE)
     with open(path, "wb") as f:
         f.write(data)
 

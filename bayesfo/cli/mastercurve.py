@@ -43,12 +43,22 @@ def add_parser(subparsers):
                         "temperature")
     p.add_argument("--reference-temperature", type=float, default=None, metavar="T",
                    help="reference temperature [°C], an isotherm's (default: the middle one)")
-    p.add_argument("--noise", default="proportional", choices=("proportional", "constant",
-                                                               "known"),
-                   help="noise model (default proportional: isotherms span decades)")
-    p.add_argument("--vertical", default="none", choices=("none", "density", "free"),
-                   help="vertical shift b_T: none (default); density: b_T = T_ref/T in kelvin "
-                        "(constant density); free: one log10 b_T per isotherm")
+    p.add_argument("--noise", default="auto",
+                   choices=("auto", "relative_parts", "proportional", "constant", "known"),
+                   help="noise model: auto (default: relative noise of each part, a "
+                        "rheometer's, or noise proportional to |G*|, whichever the model-free "
+                        "master's ln Z prefers; with --shifts joint, proportional), "
+                        "relative_parts, proportional, constant, known (the data's sigma)")
+    p.add_argument("--vertical", default="auto", choices=("auto", "none", "density", "free"),
+                   help="vertical shift b_T: auto (default: the one of highest ln Z of the "
+                        "model-free master among the three; with --shifts joint, none); none; "
+                        "density: b_T = T_ref/T in kelvin (constant density); free: one "
+                        "log10 b_T per isotherm")
+    p.add_argument("--shifts", default="smooth", choices=("smooth", "joint"),
+                   help="where the shifts come from: smooth (default: a model-free master, "
+                        "smooth curves of ln G′ and ln G″ integrated out, so that no "
+                        "structure's misfit moves them; the structures are then fitted to the "
+                        "isotherms so shifted), joint (sampled with each master structure)")
     p.add_argument("--law", default="auto", choices=("auto", "free", "wlf", "arrhenius"),
                    help="horizontal shifts: auto (default: free shifts, then the best master "
                         "structure with the WLF and the Arrhenius law inside the joint "
@@ -138,8 +148,8 @@ def run(args) -> int:
     out = check_output_directory(target, directories=() if args.no_figures else ("figures",))
     load_libraries(() if args.no_figures else ("png",))
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
-                     noise=args.noise, vertical=args.vertical, law=args.law, seed=args.seed,
-                     workers=args.workers)
+                     noise=args.noise, vertical=args.vertical, law=args.law,
+                     shifts=args.shifts, seed=args.seed, workers=args.workers)
     from ..output.write import _finite
     from ..tts.stored import summary_fields
 
@@ -191,16 +201,27 @@ def run(args) -> int:
 
 
 def _print(mc, out) -> None:
-    print(f"{mc.data.label}: master structures ranked by ln Z of the joint posterior")
+    smooth = mc.shifts_from == "smooth"
+    print(f"{mc.data.label}: master structures ranked by ln Z "
+          + ("on the isotherms at the model-free master's shifts" if smooth
+             else "of the joint posterior"))
     for r in mc.ranking:
         z = "-" if r["log_evidence"] is None else (f"{r['log_evidence']:.2f} ± "
                                                     f"{r['log_evidence_err']:.2f}")
         p = "-" if r["probability"] is None else f"{r['probability']:.3f}"
+        if r.get("dropped"):
+            print(f"   {r['structure']:<22} dropped: {r['dropped']}")
+            continue
         print(f"   {r['structure']:<22} ln Z {z:>20}  P {p:>6}  "
               f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")
-    if mc.law_evidence:
-        print(f"shifts of {mc.structure} ranked by ln Z (free, or by a law inside the posterior)")
-        for how, r in sorted(mc.law_evidence.items(),
+    for title, evidence in (("vertical shifts", mc.vertical_evidence),
+                            ("horizontal shifts", mc.law_evidence)):
+        if not evidence:
+            continue
+        print(f"{title} ranked by ln Z "
+              + ("of the model-free master" if smooth
+                 else f"of {mc.structure} (free, or by a law inside the posterior)"))
+        for how, r in sorted(evidence.items(),
                              key=lambda kv: -(kv[1]["log_evidence"]
                                               or kv[1].get("log_evidence_upper") or -math.inf)):
             if r.get("log_evidence_upper") is not None:  # not sampled: bounded from above
@@ -209,10 +230,13 @@ def _print(mc, out) -> None:
                 continue
             z = "-" if r["log_evidence"] is None else (f"{r['log_evidence']:.2f} ± "
                                                         f"{r['log_evidence_err']:.2f}")
-            print(f"   {how:<22} ln Z {z:>20}  P {r['probability']:6.3f}  "
+            p = "-" if r["probability"] is None else f"{r['probability']:.3f}"
+            print(f"   {how:<22} ln Z {z:>20}  P {p:>6}  "
                   f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")
     shifts = {"free": "", "wlf": " (WLF)", "arrhenius": " (Arrhenius)"}[mc.law]
-    print(f"shift factors{shifts} of {mc.structure}, T_ref = {mc.reference_temperature:g} °C:")
+    print(f"shift factors{shifts} "
+          + ("of the model-free master" if smooth else f"of {mc.structure}")
+          + f", T_ref = {mc.reference_temperature:g} °C:")
     vertical = mc.vertical != "none"
     print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}"
           + (f" {'log10 b_T':>10} {'sd':>7} {'94 % HDI':>20} ({mc.vertical})" if vertical
@@ -231,7 +255,13 @@ def _print(mc, out) -> None:
                          for k, v in law["parameters"].items())
         untested = ("; as many constants as free shifts: not tested by them"
                     if law.get("dof", 1) <= 0 else "")
-        print(f"{name:>10}: {text}; probability {law['probability']:.3f}{untested}")
+        prob = law.get("probability")
+        prob = ("-" if prob is None else f"≤ {prob:.1e}" if law.get("probability_upper")
+                else f"{prob:.3f}")
+        left = law.get("left_out") or []
+        left = (f"; fitted without {', '.join(f'{t:g}' for t in left)} °C (shift not "
+                "determined)" if left else "")
+        print(f"{name:>10}: {text}; probability {prob}{untested}{left}")
     from ..tts.validity import describe, describe_parts
 
     vgp = mc.tts_checks.get("van_gurp_palmen")

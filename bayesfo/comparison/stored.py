@@ -339,7 +339,10 @@ def _mastercurve(summary: dict, d: Path, library):
         isotherms=isotherms, notes=tuple(summary["notes"]), ranking=tuple(summary["structures"]),
         tts_checks=summary["tts_checks"], vertical=vertical,
         vertical_draws=None if vertical == "none" else shifted.log_vertical(theta),
-        master=master, law=law, law_evidence=summary.get("law_evidence") or {})
+        master=master, law=law, law_evidence=summary.get("law_evidence") or {},
+        shifts_from=summary.get("shifts_from") or "joint",
+        vertical_evidence=summary.get("vertical_evidence") or {},
+        shift_evidence=summary.get("shift_evidence") or {})
 
 
 def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> PosteriorResult:

@@ -37,11 +37,16 @@ from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F
 from .laws import _fit_laws
 from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
 from .result import ISOTHERM_MISFIT, MasterCurve, _num
+from .smooth import UNDETERMINED
 from .spectrum import NAME as SPECTRUM
 from .spectrum import Spectrum
 
 #: The vertical shifts ``mastercurve`` knows.
 VERTICAL = ("none", "density", "free")
+#: Where the shifts come from: the model-free master, or each structure's joint posterior.
+SHIFTS_FROM = ("smooth", "joint")
+#: The noise models of a master curve.
+NOISE_MODELS = ("relative_parts", "proportional", "constant", "known")
 #: Free vertical shifts beyond this many decades (a factor of 1.26) exceed the density and
 #: temperature ratios they stand for: a note says they likely absorb a misfit of the master.
 VERTICAL_PLAUSIBLE = 0.1
@@ -70,8 +75,8 @@ class _Bounded:
 
 # ---------------------------------------------------------------------------- the fit
 def mastercurve(isotherms, structures="zener", *, reference_temperature: float | None = None,
-                noise: str = "proportional", vertical: str = "none", law: str = "auto",
-                seed: int = 0, workers: int = 1) -> MasterCurve:
+                noise: str = "auto", vertical: str = "auto", law: str = "auto",
+                shifts: str = "smooth", seed: int = 0, workers: int = 1) -> MasterCurve:
     """One joint posterior of a master structure and the isotherms' shifts; with several
     structures, each is fitted and the one of highest ln Z is returned, with the ranking.
 
@@ -87,11 +92,18 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         (:mod:`bayesfo.tts.spectrum`).
     reference_temperature : float, optional
         [°C]; an isotherm's temperature (default: the middle isotherm).
-    noise : {"proportional", "constant", "known"}
-        ``proportional`` suits data spanning decades (as isotherms do).
-    vertical : {"none", "density", "free"}
+    noise : {"auto", "relative_parts", "proportional", "constant", "known"}
+        ``relative_parts`` (independent relative noise of G′ and G″, a rheometer's) and
+        ``proportional`` (complex noise proportional to |G*|) suit data spanning decades, as
+        isotherms do; ``"auto"`` (default) chooses between the two by the ln Z of the
+        model-free master, and the structures are fitted with the model chosen (with
+        ``shifts="joint"``, ``"auto"`` is ``"proportional"``). ``constant`` and ``known``
+        apply to the structures; the model-free master then chooses its own.
+    vertical : {"auto", "none", "density", "free"}
         The vertical shift b_T: none; the density correction b_T = T_ref/T [K] (constant
-        density); or one free log10 b_T per isotherm (see the module).
+        density); or one free log10 b_T per isotherm (see the module). ``"auto"`` (default)
+        chooses among the three by the ln Z of the model-free master (with
+        ``shifts="joint"``, ``"auto"`` is ``"none"``).
     law : {"auto", "free", "wlf", "arrhenius"}
         The horizontal shifts: one free log10 a_T per isotherm (``"free"``), or those of the
         WLF or Arrhenius law with its parameters sampled jointly (``"wlf"``,
@@ -100,6 +112,16 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         (a law is kept only where its posterior is certified); ``law_evidence`` says how
         the three compare. With fewer than :data:`AUTO_LAWS_MIN` isotherms, ``"auto"`` is
         ``"free"``.
+    shifts : {"smooth", "joint"}
+        Where the shifts come from. ``"smooth"`` (default): a model-free master function
+        (smooth curves of ln G′ and ln G″ against log10 a_T ω, integrated out in closed form;
+        :mod:`bayesfo.tts.smooth`), whose posterior of the shifts does not depend on a
+        structure describing the data; the vertical shift and the law are chosen by its ln Z
+        (:mod:`bayesfo.tts.shifts`), and each master structure is then fitted to the isotherms
+        so shifted (:mod:`bayesfo.tts.conditional`: its ln Z ranks the structures, its draws
+        are paired with the shifts' draws). A structure that cannot be fitted is dropped with
+        its reason (``ranking``); where none can, the relaxation spectrum is the master.
+        ``"joint"``: the shifts sampled jointly with each master structure (below).
     seed : int
     workers : int
         Processes fitting the master structures side by side, and then the best one under
@@ -116,12 +138,21 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         Fewer than two isotherms, a missing or repeated temperature, isotherms of different
         kinds or units, a reference temperature without an isotherm.
     """
-    if vertical not in VERTICAL:
-        raise InputError(f"vertical must be one of {', '.join(VERTICAL)}, got {vertical!r}")
+    if vertical not in ("auto", *VERTICAL):
+        raise InputError(f"vertical must be one of auto, {', '.join(VERTICAL)}, got "
+                         f"{vertical!r}")
     if law not in ("auto", *LAWS):
         raise InputError(f"law must be one of auto, {', '.join(LAWS)}, got {law!r}")
+    if shifts not in SHIFTS_FROM:
+        raise InputError(f"shifts must be one of {', '.join(SHIFTS_FROM)}, got {shifts!r}")
     names = _master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
+    if noise not in ("auto", *NOISE_MODELS):
+        raise InputError(f"noise must be one of auto, {', '.join(NOISE_MODELS)}, got {noise!r}")
+    if shifts == "smooth":
+        return _on_smooth_shifts(iso, names, noise, vertical, law, seed, workers)
+    vertical = "none" if vertical == "auto" else vertical
+    noise = "proportional" if noise == "auto" else noise
     first = "free" if law == "auto" else law
     auto_laws = law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN
     from ..parallel import executor
@@ -152,6 +183,22 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
                             if math.isfinite(fp[0].log_evidence) else np.inf))
     from dataclasses import replace
 
+    chosen = fits[best]
+    law_evidence, law_notes = {}, []
+    if law == "auto":
+        ceiling = (chosen.log_evidence - LAW_BOUND_MARGIN if math.isfinite(chosen.log_evidence)
+                   else None)
+        chosen, law_evidence, law_notes = _choose_law(
+            chosen, dict(zip(LAW_FITS, fit_laws(best, LAW_FITS, ceiling), strict=True)))
+    checks, notes = _checks(iso, chosen, vertical)
+    return replace(chosen, ranking=ranking, tts_checks=checks,
+                   notes=tuple(list(chosen.notes) + law_notes + notes),
+                   law_evidence=law_evidence)
+
+
+def _checks(iso, chosen: MasterCurve, vertical: str) -> tuple[dict, list]:
+    """The model-free tests of superposition and the isotherms' fit of ``chosen``:
+    ``(tts_checks, notes)``."""
     from .validity import (
         describe,
         describe_joint_against_parts,
@@ -161,34 +208,146 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
         van_gurp_palmen,
     )
 
-    chosen = fits[best]
-    law_evidence, law_notes = {}, []
-    if law == "auto":
-        ceiling = (chosen.log_evidence - LAW_BOUND_MARGIN if math.isfinite(chosen.log_evidence)
-                   else None)
-        chosen, law_evidence, law_notes = _choose_law(
-            chosen, dict(zip(LAW_FITS, fit_laws(best, LAW_FITS, ceiling), strict=True)))
     vgp = van_gurp_palmen(iso.data, iso.temperatures)
     parts = shifts_by_part(iso.data, iso.temperatures)
     against = joint_against_parts(parts, chosen.shift_draws)
     checks = {"van_gurp_palmen": vgp, "shift_parts": parts, "joint_against_parts": against,
               "isotherm_fit": chosen.tts_checks["isotherm_fit"]}
-    notes = list(chosen.notes) + law_notes
+    notes = []
     if vgp["valid"] is not True:
         notes.append(describe(vgp))
     if parts["consistent"] is False:
         notes.append(describe_parts(parts) + (
             "" if vertical == "none" else " (the model's vertical shifts account for the "
                                           "former)"))
-    if against["apart"] and vertical == "none":
+    if against["apart"] and vertical == "none" and chosen.shifts_from == "joint":
         notes.append(describe_joint_against_parts(against, chosen.structure, chosen.law))
     misfit = checks["isotherm_fit"]["misfit"]
     if misfit:
-        notes.append(f"the joint fit of {chosen.structure} misses the isotherm(s) at "
-                     f"{', '.join(f'{t:g}' for t in misfit)} °C: their relative residuals are "
-                     f"over {ISOTHERM_MISFIT:g} times the median isotherm's")
-    return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes),
-                   law_evidence=law_evidence)
+        notes.append(f"the fit of {chosen.structure} misses the isotherm(s) at "
+                     f"{', '.join(f'{t:g}' for t in misfit)} °C: their relative residuals "
+                     f"(of |G*|, G′ or G″) are over {ISOTHERM_MISFIT:g} times the median "
+                     "isotherm's")
+    return checks, notes
+
+
+def _on_smooth_shifts(iso, names, noise: str, vertical: str, law: str, seed: int,
+                      workers: int) -> MasterCurve:
+    """The master curve whose shifts come from the model-free master (see
+    :func:`mastercurve`)."""
+    from dataclasses import replace
+
+    from ..parallel import executor
+    from .shifts import smooth_shifts
+
+    shifts0 = _seed_shifts(iso)
+    reach = max(SHIFT_RANGE, float(np.max(np.abs(shifts0))) + SHIFT_MARGIN)
+    with executor(workers, max(len(names), 3)) as pool:
+        sh = smooth_shifts(iso, vertical=vertical, law=law, seed=seed,
+                           noise=noise if noise in ("relative_parts", "proportional")
+                           else "auto", submit=None if workers == 1 else pool.submit)
+        noise = sh.noise if noise == "auto" else noise
+        tried = dict(zip(names, [f.result() for f in [
+            pool.submit(_try_on_shifts, iso, s, noise, seed, sh, reach) for s in names]],
+            strict=True))
+        fits = [f for f in tried.values() if isinstance(f, MasterCurve)]
+        dropped = {(s if isinstance(s, str) else s.name): why for s, why in tried.items()
+                   if isinstance(why, str)}
+        if not fits and SPECTRUM not in names:
+            spectrum = _try_on_shifts(iso, SPECTRUM, noise, seed, sh, reach)
+            if isinstance(spectrum, MasterCurve):
+                fits = [spectrum]
+            else:
+                dropped[SPECTRUM] = spectrum
+    if not fits:
+        raise InputError("no master function could be fitted to the shifted isotherms: "
+                         + "; ".join(f"{k}: {v}" for k, v in dropped.items()))
+    z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
+    best = int(np.argmax(z))
+    p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
+    p = p / np.nansum(p)
+    ranking = [{"structure": f.structure, "log_evidence": _num(f.log_evidence),
+                "log_evidence_err": _num(f.log_evidence_err), "probability": _num(pi),
+                "certified": bool(f.posterior.converged), "sampler": f.posterior.sampler}
+               for f, pi in sorted(zip(fits, p, strict=True), key=lambda fp: -fp[0].log_evidence
+                                   if math.isfinite(fp[0].log_evidence) else np.inf)]
+    ranking += [{"structure": k, "log_evidence": None, "log_evidence_err": None,
+                 "probability": None, "certified": False, "sampler": "dropped", "dropped": v}
+                for k, v in dropped.items()]
+    chosen = fits[best]
+    notes = [f"the shifts come from a model-free master (smooth curves of ln G′ and ln G″ "
+             f"against log10 a_T ω, integrated out), not from {chosen.structure}: its misfit "
+             f"cannot move them; {chosen.structure} is fitted to the isotherms so shifted"]
+    notes += list(sh.notes)
+    notes += [f"{k} was dropped: {v}" for k, v in dropped.items()]
+    gone = sh.posterior.undetermined()
+    if gone:
+        notes.append("the data do not fix the shift of the isotherm(s) at "
+                     + ", ".join(f"{iso.temperatures[i]:g}" for i in gone)
+                     + f" °C (94 % interval wider than {UNDETERMINED:g} decade): it slides "
+                       "along a featureless stretch of the master curve; it is left out of the "
+                       "fits of the shift laws")
+    if chosen.vertical == "free":
+        mean_b = chosen.vertical_draws.mean(axis=0)
+        far = [i for i in range(mean_b.size) if abs(mean_b[i]) > VERTICAL_PLAUSIBLE]
+        if far:
+            notes.append("the free vertical shifts reach "
+                         + ", ".join(f"{mean_b[i]:+.2f} decades at {iso.temperatures[i]:g} °C"
+                                     for i in far)
+                         + f", beyond the density and temperature ratios they stand "
+                           f"for (±{VERTICAL_PLAUSIBLE:g}): there the isotherms' shapes "
+                           "differ, which superposition does not explain (see the van "
+                           "Gurp–Palmen test)")
+    chosen = replace(chosen, shifts_from="smooth", vertical_evidence=sh.vertical_evidence,
+                     shift_evidence=_shift_evidence(sh))
+    checks, check_notes = _checks(iso, chosen, chosen.vertical)
+    laws = _laws_once(chosen.laws, sh.law_evidence)
+    return replace(chosen, ranking=tuple(ranking), tts_checks=checks, laws=laws,
+                   notes=tuple(notes + list(chosen.notes) + check_notes),
+                   law_evidence=sh.law_evidence)
+
+
+def _shift_evidence(sh) -> dict:
+    """What ``summary.json`` says of the model-free master chosen."""
+    post = sh.posterior
+    names = post.model.param_names
+    hyper = {n: float(np.median(post.draws[:, j])) for j, n in enumerate(names)
+             if n.startswith(("smoothness_", "sigma_"))}
+    return {"master": "smooth", "vertical": sh.vertical, "law": sh.law, "noise": sh.noise,
+            "noise_evidence": sh.noise_evidence,
+            "log_evidence": _num(post.log_evidence),
+            "log_evidence_err": _num(post.log_evidence_err),
+            "max_log_likelihood": _num(post.max_log_likelihood), "sampler": post.sampler,
+            "certified": bool(post.converged), "pareto_k": _num(post.k_hat),
+            "ess": _num(post.ess), "hyperparameters": hyper,
+            "undetermined": [post.model.temperatures[i] for i in post.undetermined()]}
+
+
+def _laws_once(laws: dict, law_evidence: dict) -> dict:
+    """The laws fitted to the shifts, their probabilities those of the evidence where the
+    laws were weighed inside the model (one probability per law in a run), else BIC's."""
+    out = {k: dict(v) for k, v in laws.items()}
+    weighed = {k: v for k, v in law_evidence.items() if k in out}
+    if len(weighed) == len(out):
+        for k in out:
+            out[k]["probability"] = weighed[k]["probability"]
+            out[k]["probability_upper"] = bool(weighed[k].get("probability_upper", False))
+            out[k]["probability_method"] = ("ln Z of the model-free master with the law inside "
+                                            "(beside free shifts: law_evidence)")
+    else:
+        for k in out:
+            out[k]["probability_method"] = "BIC of the law fitted to the shifts' posterior"
+    return out
+
+
+def _try_on_shifts(iso, structure, noise, seed, sh, reach):
+    """:func:`~bayesfo.tts.conditional.fit_on_shifts`, or the reason it failed (a string)."""
+    from .conditional import fit_on_shifts
+
+    try:
+        return fit_on_shifts(iso, structure, noise, seed, sh, reach)
+    except InputError as exc:
+        return str(exc)
 
 
 def _master_names(structures) -> list:

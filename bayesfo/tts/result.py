@@ -59,7 +59,18 @@ class MasterCurve:
     law_evidence : dict
         With ``law="auto"``: ``{"free" | "wlf" | "arrhenius": {"log_evidence",
         "log_evidence_err", "probability", "certified", "sampler"}}`` of the best master
-        structure under each (probabilities from the ln Z of the certified ones).
+        structure under each (probabilities from the ln Z of the certified ones); with
+        shifts from the model-free master, of that master under each.
+    shifts_from : {"smooth", "joint"}
+        Where the shifts come from: the model-free master (:mod:`bayesfo.tts.smooth`), or the
+        joint posterior with the master structure.
+    vertical_evidence : dict
+        With ``vertical="auto"``: the same as ``law_evidence`` for the vertical shifts
+        (``"none"``, ``"density"``, ``"free"``).
+    shift_evidence : dict
+        With shifts from the model-free master: its ln Z, sampler, certificate, smoothness
+        and noise (``hyperparameters``), and the isotherms whose shifts the data do not fix
+        (``undetermined`` [°C]).
     """
 
     structure: str
@@ -81,6 +92,9 @@ class MasterCurve:
     master: object = field(default=None, repr=False)
     law: str = "free"
     law_evidence: dict = field(default_factory=dict)
+    shifts_from: str = "joint"
+    vertical_evidence: dict = field(default_factory=dict)
+    shift_evidence: dict = field(default_factory=dict)
 
     @property
     def tts_valid(self) -> bool | None:
@@ -105,12 +119,14 @@ class MasterCurve:
         missed = fit.get("misfit") or []
         rms = [r for r in fit.get("rms_relative", []) if r is not None]
         if rms and float(np.median(rms)) > MISFIT_RMS:
-            return (f"The joint fit of {self.structure} misses the isotherms by "
+            return (f"The {'joint ' if self.shifts_from == 'joint' else ''}fit of "
+                    f"{self.structure} misses the isotherms by "
                     f"{100 * min(rms):.2g}–{100 * max(rms):.2g} % rms (median "
                     f"{100 * float(np.median(rms)):.2g} %): it does not describe them; other "
                     "master functions (or 'spectrum', which needs no structure) may.")
         if missed:
-            return (f"The joint fit of {self.structure} misses the isotherm(s) at "
+            return (f"The {'joint ' if self.shifts_from == 'joint' else ''}fit of "
+                    f"{self.structure} misses the isotherm(s) at "
                     f"{', '.join(f'{t:g}' for t in missed)} °C (relative residuals over "
                     f"{ISOTHERM_MISFIT:g} times the median isotherm's).")
         return ""
@@ -229,7 +245,9 @@ class MasterCurve:
                                for n, v in self.posterior.summary.items()
                                if not n.startswith(("log10_aT_", "log10_bT_"))},
                 "vertical": self.vertical, "law": self.law,
-                "law_evidence": self.law_evidence,
+                "law_evidence": self.law_evidence, "shifts_from": self.shifts_from,
+                "vertical_evidence": self.vertical_evidence,
+                "shift_evidence": self.shift_evidence,
                 "structures": list(self.ranking),
                 "shift_factors": self.shift_factors(), "shift_law": self.shift_law(),
                 "laws": self.laws, "tts_valid": self.tts_valid, "tts_checks": self.tts_checks,

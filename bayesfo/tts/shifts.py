@@ -1,0 +1,209 @@
+"""The shifts of a master curve from the model-free master (:mod:`bayesfo.tts.smooth`): the
+vertical shift (none, the density correction, free) and the horizontal law (free shifts, WLF,
+Arrhenius) each chosen by ln Z, with the same rule for the ones not worth sampling as the
+structures': ln Z ≤ max ln L under any normalised prior, so a model whose best fit lies more
+than :data:`~bayesfo.tts.joint.LAW_BOUND_MARGIN` nats below the leader's ln Z is set aside
+with that bound.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .model import SHIFT_MARGIN, SHIFT_RANGE
+from .smooth import NOISE, ShiftPosterior, SmoothMaster, best_fit, sample_shifts, start_of
+
+#: The vertical shifts that ``vertical="auto"`` chooses among, and the laws of ``law="auto"``.
+VERTICALS = ("none", "density", "free")
+LAWS = ("free", "wlf", "arrhenius")
+#: A model whose best fit lies this many nats below the leader's ln Z is not sampled.
+BOUND_MARGIN = 10.0
+#: Isotherms from which ``law="auto"`` also weighs the laws (fewer: WLF has as many
+#: constants as there are shifts to test it).
+AUTO_LAWS_MIN = 4
+
+_NAMES = {"relative_parts": "relative noise of each part",
+          "proportional": "noise proportional to |G*|", "free": "free shifts", "wlf": "the WLF law", "arrhenius": "the Arrhenius law",
+          "none": "no vertical shift", "density": "the density correction",
+          "free_vertical": "free vertical shifts"}
+
+
+@dataclass(frozen=True)
+class Shifts:
+    """The shifts' posterior chosen by evidence.
+
+    Attributes
+    ----------
+    posterior : ShiftPosterior
+        Of the model chosen.
+    vertical, law, noise : str
+        The model chosen.
+    vertical_evidence, law_evidence : dict
+        ``{option: {"log_evidence", "log_evidence_err", "probability", "certified",
+        "sampler"}}`` of the options weighed (``log_evidence_upper`` and
+        ``probability_upper`` for one set aside by its best fit); empty where one was asked.
+    notes : tuple of str
+    """
+
+    posterior: ShiftPosterior
+    vertical: str
+    law: str
+    vertical_evidence: dict = field(default_factory=dict)
+    law_evidence: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+    noise: str = "relative_parts"
+    noise_evidence: dict = field(default_factory=dict)
+
+
+def _z(post: ShiftPosterior) -> float:
+    return post.log_evidence if post.converged and math.isfinite(post.log_evidence) \
+        else -math.inf
+
+
+def _weigh(posts: dict, bounded: dict, what: str) -> tuple[str, dict, list]:
+    """The option of highest ln Z among ``posts`` (``{option: ShiftPosterior}``) and those set
+    aside (``{option: max ln L}``): ``(chosen, evidence, notes)``."""
+    z = {k: _z(p) for k, p in posts.items()}
+    top = max(z, key=z.get)
+    if not math.isfinite(z[top]):  # no ln Z: the best fit decides, and says so
+        top = max(posts, key=lambda k: posts[k].max_log_likelihood)
+        return top, {}, [f"no ln Z could be certified for {what}; {_label(top, what)} has the "
+                         "best fit"]
+    weights = {k: math.exp(v - z[top]) for k, v in z.items()}
+    weights.update({k: math.exp(min(0.0, b - z[top])) for k, b in bounded.items()})
+    total = sum(weights.values())
+    evidence = {}
+    for k, p in posts.items():
+        evidence[k] = {"log_evidence": p.log_evidence if math.isfinite(p.log_evidence) else None,
+                       "log_evidence_err": (p.log_evidence_err
+                                            if math.isfinite(p.log_evidence_err) else None),
+                       "probability": (weights[k] / total if math.isfinite(z[k]) else None),
+                       "certified": bool(p.converged),
+                       "sampler": p.sampler}
+    notes = []
+    for k, b in bounded.items():
+        evidence[k] = {"log_evidence": None, "log_evidence_err": None,
+                       "log_evidence_upper": b, "probability": weights[k] / total,
+                       "probability_upper": True, "certified": False,
+                       "sampler": "not sampled"}
+        notes.append(f"{_label(k, what)} was not sampled: its best fit reaches a "
+                     f"log-likelihood of {b:.1f}, which bounds its ln Z from above, "
+                     f"{z[top] - b:.0f} nats below the ln Z of {_label(top, what)}")
+    others = {k: v for k, v in z.items() if k != top}
+    others.update(bounded)
+    if others:
+        runner = max(others, key=others.get)
+        gap = z[top] - others[runner]
+        how = (f"ln Z {'over ' if runner in bounded else ''}{gap:.1f} above "
+               f"{_label(runner, what)}" if math.isfinite(gap)
+               else f"{_label(runner, what)} gave no certified ln Z")
+        notes.insert(0, f"{what}: {_label(top, what)} ({how})")
+    return top, evidence, notes
+
+
+def _label(option: str, what: str) -> str:
+    return _NAMES["free_vertical"] if option == "free" and what.startswith("vertical") \
+        else _NAMES[option]
+
+
+def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str = "auto",
+                  seed: int = 0, submit=None) -> Shifts:
+    """The shifts of the isotherms ``iso`` (:class:`~bayesfo.tts.isotherms._Isotherms`) under
+    the model-free master, the noise model, the vertical shift and the law chosen by ln Z
+    where ``"auto"`` (in that order: the noise model on the first vertical option with free
+    shifts, the vertical shift with free shifts, then the laws).
+
+    ``submit(function, *args)`` runs the models' fits side by side (a pool's ``submit``; it
+    returns futures); without it they run here one after the other.
+    """
+    from .isotherms import _seed_shifts
+
+    seeds = _seed_shifts(iso)
+    reach = max(SHIFT_RANGE, float(np.max(np.abs(seeds))) + SHIFT_MARGIN)
+    run = (lambda f, *a: f(*a)) if submit is None else None
+
+    def many(calls):
+        if run is not None:
+            return [f(*a) for f, *a in calls]
+        return [fut.result() for fut in [submit(f, *a) for f, *a in calls]]
+
+    verticals = VERTICALS if vertical == "auto" else (vertical,)
+    notes = []
+    chosen_noise, n_evidence = noise, {}
+    noise_posts = {}
+    if noise == "auto":
+        noises = NOISE
+        noise_posts = dict(zip(noises, many([
+            (_sampled, m, start_of(m, seeds), seed) for m in
+            [SmoothMaster.of(iso, verticals[0], "free", reach, k) for k in noises]]),
+            strict=True))
+        chosen_noise, n_evidence, n_notes = _weigh(noise_posts, {}, "noise")
+        notes += n_notes
+    models = {v: SmoothMaster.of(iso, v, "free", reach, chosen_noise) for v in verticals}
+    # Free vertical shifts contain the other two: they start from the better one's maximum
+    # (from the seeds, the optimiser may stop at a lower local maximum).
+    first = [v for v in verticals if v != "free"]
+    done = {verticals[0]: noise_posts[chosen_noise]} if noise_posts else {}
+    todo = [v for v in first if v not in done]
+    posts = dict(zip(todo, many([(_sampled, models[v], start_of(models[v], seeds), seed)
+                                 for v in todo]), strict=True))
+    posts.update(done)
+    if "free" in verticals:
+        start = start_of(models["free"], seeds)
+        if posts:
+            near = max(posts.values(), key=lambda p: p.max_log_likelihood)
+            start = _nested_start(models["free"], near)
+        posts["free"] = _sampled(models["free"], start, seed)
+    posts = {v: posts[v] for v in verticals}
+    chosen_v, v_evidence = verticals[0], {}
+    if len(verticals) > 1:
+        chosen_v, v_evidence, v_notes = _weigh(posts, {}, "vertical shift")
+        notes += v_notes
+    laws = (LAWS if law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN
+            else ("free",) if law == "auto" else (law,))
+    law_posts = {"free": posts[chosen_v]} if "free" in laws else {}
+    others = [k for k in laws if k != "free"]
+    bounded = {}
+    if others:
+        ceiling = _z(posts[chosen_v]) - BOUND_MARGIN if "free" in laws else -math.inf
+        best_shifts = posts[chosen_v].model.log_shifts(posts[chosen_v].map_theta)[0]
+        fits = many([(_bounded_or_sampled, SmoothMaster.of(iso, chosen_v, k, reach,
+                                                            chosen_noise),
+                      best_shifts, seed, ceiling) for k in others])
+        for k, f in zip(others, fits, strict=True):
+            if isinstance(f, float):
+                bounded[k] = f
+            else:
+                law_posts[k] = f
+    chosen_law, l_evidence = laws[0], {}
+    if len(laws) > 1:
+        chosen_law, l_evidence, l_notes = _weigh(law_posts, bounded, "horizontal shifts")
+        notes += l_notes
+    post = law_posts[chosen_law]
+    notes += [f"shifts ({_label(chosen_law, 'law')}): {m}" for m in post.messages]
+    return Shifts(post, chosen_v, chosen_law, v_evidence, l_evidence, tuple(notes),
+                  chosen_noise, n_evidence)
+
+
+def _sampled(model: SmoothMaster, start, seed: int) -> ShiftPosterior:
+    return sample_shifts(model, start, seed)
+
+
+def _nested_start(model: SmoothMaster, near: ShiftPosterior) -> np.ndarray:
+    """A start of the free-vertical ``model`` at the maximum of a model it contains."""
+    theta = near.map_theta
+    k = near.model.n_horizontal
+    vertical = np.delete(near.model.log_vertical(theta)[0], model.reference)
+    return np.r_[theta[:k], vertical, theta[k:]]
+
+
+def _bounded_or_sampled(model: SmoothMaster, seeds, seed: int, ceiling: float):
+    """The model's posterior, or its best fit's log-likelihood (a float) where that stays
+    below ``ceiling``."""
+    fit = best_fit(model, start_of(model, seeds))
+    if fit[1] < ceiling:
+        return fit[1]
+    return sample_shifts(model, start_of(model, seeds), seed, fit=fit)

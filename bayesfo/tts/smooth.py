@@ -1,0 +1,809 @@
+"""A model-free master function for the shifts: smooth curves of ln G′ and ln G″ against
+log10(a_T ω), integrated out in closed form, so that the posterior is over the shifts and a
+few hyperparameters only.
+
+Each part p of the response (storage and loss; a compliance's J′ and J″) of isotherm i at
+frequency ω is modelled in logs as
+
+    ln|G_p(ω)| = f_p(log10 ω + log10 a_T,i) − s·ln(10)·log10 b_T,i + ε,   ε ~ N(0, σ_p²),
+
+with s = 1 for a modulus (G_i = G_master(a_T ω)/b_T) and −1 for a compliance. A relative
+error of each part, the usual error model of a rheometer or DMA (``relative_parts``), is a
+constant error of its logarithm. The master function f_p is a cubic B-spline on equally spaced
+knots (:data:`KNOT_STEP` decades apart, spanning every reduced frequency the shifts' prior
+allows) whose coefficients have a Gaussian smoothness prior: second differences with sd ρ_p
+(a P-spline, Eilers & Marx 1996; Lang & Brezger 2004 for the Bayesian form) and a weak ridge
+(sd :data:`LEVEL_SD` around the mean of the data's logs) that makes the prior proper. Given
+the shifts the model is linear-Gaussian in the coefficients, which integrate out exactly:
+
+    ln p(y | shifts, ρ, σ) = −½ n ln(2πσ²) + ½ ln|P| − ½ ln|A| − ½ (r·r/σ² − c·A⁻¹c),
+
+with P the prior precision, A = P + BᵀB/σ², r the centred data and c = Bᵀr/σ². A and P are
+banded (half-bandwidth 3), so each evaluation is a banded Cholesky factorisation
+(``scipy.linalg.cholesky_banded``) per part: the shifts' posterior costs milliseconds per
+thousand parameter sets, whatever the master curve looks like. The parameters are the shifts
+(one free log10 a_T per isotherm other than the reference, or a law's constants), free
+log10 b_T where asked, and ρ_p, σ_p of each part (log-uniform).
+
+The shifts so found do not depend on a structure describing the data; the structures are
+fitted afterwards to the isotherms so shifted (:mod:`bayesfo.tts.joint`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from scipy.linalg import cho_solve_banded, cholesky_banded, eigvals_banded
+
+from ..errors import InputError
+from ..priors import LogUniform, Uniform
+from .laws import arrhenius, wlf
+from .model import EA_MAX, EA_MIN, KELVIN, VERTICAL_RANGE, WLF_C1_MAX, WLF_C2_MAX, shift_name
+
+#: The name of the model-free master in rankings, summaries and messages.
+NAME = "smooth"
+#: Knot spacing of the B-splines [decades of reduced frequency].
+KNOT_STEP = 0.25
+#: Prior sd of each spline coefficient around the mean of the data's logs (natural log): a
+#: weak ridge that makes the prior proper (ln G spans ±10 over nine decades).
+LEVEL_SD = 20.0
+#: Prior ranges of the smoothness (sd of the coefficients' second differences, natural log
+#: per knot step) and of the noise (sd of ln|G_p|, about the relative error of each part).
+SMOOTHNESS_RANGE = (1e-4, 3.0)
+NOISE_RANGE = (1e-4, 1.0)
+#: Noise models of the logs: the relative error of each part constant (``relative_parts``),
+#: or complex noise proportional to |G| (``proportional``: a part's relative error grows as
+#: the part is small against |G|).
+NOISE = ("relative_parts", "proportional")
+#: The parts of the response, in the order of the hyperparameters.
+PARTS = ("storage", "loss")
+#: Parameter sets evaluated at once (bounds the memory of a batch); up to FEW sets are
+#: factorised one by one by LAPACK, more by the vectorised factorisation.
+CHUNK = 2000
+FEW = 64
+
+
+def _basis(x: np.ndarray, lo: float, n_basis: int):
+    """Cubic B-splines on knots lo + k·KNOT_STEP at ``x`` (any shape): the index of the first
+    of the four non-zero basis functions at each point and their values (shape x.shape + (4,)).
+    """
+    u = (x - lo) / KNOT_STEP
+    k = np.clip(np.floor(u).astype(np.int64), 0, n_basis - 4)
+    t = np.clip(u - k, 0.0, 1.0)
+    t2, t3 = t * t, t * t * t
+    values = np.stack([(1 - t) ** 3, 3 * t3 - 6 * t2 + 4, -3 * t3 + 3 * t2 + 3 * t + 1, t3],
+                      axis=-1) / 6.0
+    return k, values
+
+
+def _banded_solve(band: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """ln|A| and c·A⁻¹c of many symmetric positive definite banded matrices at once:
+    ``band`` (n_sets, n_diagonals, n) in lower banded form (``band[:, d, j]`` = A[j + d, j]),
+    ``c`` (n_sets, n). Cholesky factorisation column by column, vectorised over the sets
+    (``scipy.linalg.cholesky_banded`` takes one matrix a call: a Python loop over thousands of
+    sets costs a hundred times more); NaN where a matrix is not positive definite."""
+    n_sets, nd, n = band.shape
+    low = np.zeros_like(band)
+    z = np.zeros((n_sets, n))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for j in range(n):
+            diag = band[:, 0, j].copy()
+            for k in range(1, min(nd, j + 1)):
+                diag -= low[:, k, j - k] ** 2
+            root = np.sqrt(diag)
+            low[:, 0, j] = root
+            for d in range(1, min(nd, n - j)):
+                acc = band[:, d, j].copy()
+                for k in range(1, nd - d):
+                    if j - k < 0:
+                        break
+                    acc -= low[:, k + d, j - k] * low[:, k, j - k]
+                low[:, d, j] = acc / root
+            acc = c[:, j].copy()
+            for k in range(1, min(nd, j + 1)):
+                acc -= low[:, k, j - k] * z[:, j - k]
+            z[:, j] = acc / root
+        log_det = 2.0 * np.sum(np.log(low[:, 0, :]), axis=1)
+    return log_det, np.sum(z * z, axis=1)
+
+
+def _banded_solve_each(band: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_banded_solve` one matrix at a time by LAPACK (faster for a few sets)."""
+    log_det = np.full(band.shape[0], np.nan)
+    quad = np.full(band.shape[0], np.nan)
+    for s in range(band.shape[0]):
+        try:
+            chol = cholesky_banded(band[s], lower=True, check_finite=False)
+        except np.linalg.LinAlgError:
+            continue
+        log_det[s] = 2.0 * float(np.sum(np.log(chol[0])))
+        quad[s] = float(c[s] @ cho_solve_banded((chol, True), c[s], check_finite=False))
+    return log_det, quad
+
+
+def _second_difference_band(n: int) -> np.ndarray:
+    """DᵀD of the second-difference matrix D ((n − 2) × n), in lower banded form (3, n)."""
+    d = np.zeros((n - 2, n))
+    idx = np.arange(n - 2)
+    d[idx, idx], d[idx, idx + 1], d[idx, idx + 2] = 1.0, -2.0, 1.0
+    full = d.T @ d
+    band = np.zeros((3, n))
+    for j in range(3):
+        band[j, :n - j] = np.diagonal(full, -j)
+    return band
+
+
+@dataclass(frozen=True, eq=False)
+class SmoothMaster:
+    """The shifts' likelihood under a smooth master function integrated out (see the module).
+
+    Attributes
+    ----------
+    log_omega : ndarray
+        log10 ω of every point of the joint data.
+    point_isotherm : ndarray of int
+        The isotherm of each point.
+    y : ndarray, shape (2, n_points)
+        ln of the storage and loss part of each point (NaN where a part is not positive, which
+        then leaves that part of the point out).
+    temperatures : tuple of float
+        [°C], ascending.
+    reference : int
+        The isotherm whose shifts are 0.
+    kind : {"modulus", "compliance"}
+    vertical : {"none", "density", "free"}
+    law : {"free", "wlf", "arrhenius"}
+    reach : float
+        Each free log10 a_T is uniform over ± this many decades.
+    """
+
+    log_omega: np.ndarray
+    point_isotherm: np.ndarray
+    y: np.ndarray
+    temperatures: tuple[float, ...]
+    reference: int
+    kind: str = "modulus"
+    vertical: str = "none"
+    law: str = "free"
+    reach: float = 15.0
+    noise: str = "relative_parts"
+    magnitude: np.ndarray | None = None
+
+    @classmethod
+    def of(cls, iso, vertical: str = "none", law: str = "free", reach: float = 15.0,
+           noise: str = "relative_parts") -> SmoothMaster:
+        """The model of checked isotherms (:class:`~bayesfo.tts.isotherms._Isotherms`)."""
+        j = iso.joint
+        sign = -1.0 if j.kind == "compliance" else 1.0  # J* = J′ − iJ″
+        with np.errstate(divide="ignore", invalid="ignore"):
+            y = np.log(np.vstack([j.response.real, sign * j.response.imag]))
+        y[~np.isfinite(y)] = np.nan
+        if noise not in NOISE:
+            raise InputError(f"noise of the model-free master must be one of "
+                             f"{', '.join(NOISE)}, got {noise!r}")
+        return cls(np.log10(j.omega), iso.point_isotherm, y, iso.temperatures, iso.reference,
+                   j.kind, vertical, law, reach, noise, np.log(np.abs(j.response)))
+
+    # ------------------------------------------------------------------ parameters
+    @property
+    def shifted(self) -> tuple[int, ...]:
+        return tuple(i for i in range(len(self.temperatures)) if i != self.reference)
+
+    @cached_property
+    def parameters(self) -> tuple[tuple[str, object], ...]:
+        """(name, prior) of every parameter, in order: the horizontal shifts (or the law's
+        constants), the free vertical shifts, then ρ and σ of each part."""
+        temps = np.asarray(self.temperatures, float)
+        t_ref = temps[self.reference]
+        if self.law == "wlf":
+            out = [("wlf_C1", Uniform(0.0, WLF_C1_MAX)),
+                   ("wlf_C2", Uniform(max(t_ref - temps.min(), 0.0) + 1.0, WLF_C2_MAX))]
+        elif self.law == "arrhenius":
+            out = [("Ea", LogUniform(EA_MIN, EA_MAX))]
+        elif self.law == "free":
+            out = [(shift_name(self.temperatures[i]), Uniform(-self.reach, self.reach))
+                   for i in self.shifted]
+        else:
+            raise InputError(f"law must be one of free, wlf, arrhenius, got {self.law!r}")
+        if self.vertical == "free":
+            out += [(shift_name(self.temperatures[i], "bT"),
+                     Uniform(-VERTICAL_RANGE, VERTICAL_RANGE)) for i in self.shifted]
+        out += [(f"smoothness_{p}", LogUniform(*SMOOTHNESS_RANGE)) for p in PARTS]
+        out += [(f"sigma_{p}", LogUniform(*NOISE_RANGE)) for p in PARTS]
+        return tuple(out)
+
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(n for n, _ in self.parameters)
+
+    @property
+    def n_horizontal(self) -> int:
+        return {"wlf": 2, "arrhenius": 1}.get(self.law, len(self.shifted))
+
+    @cached_property
+    def log_scale(self) -> np.ndarray:
+        """Which parameters are sampled as logs (the log-uniform ones)."""
+        return np.array([isinstance(p, LogUniform) for _, p in self.parameters])
+
+    @cached_property
+    def bounds(self) -> np.ndarray:
+        """(n_params, 2) bounds in the sampling coordinates (logs of the log-uniform ones), in
+        which every prior is uniform."""
+        b = np.array([p.bounds for _, p in self.parameters], float)
+        b[self.log_scale] = np.log(b[self.log_scale])
+        return b
+
+    @property
+    def log_prior_volume(self) -> float:
+        return float(np.sum(np.log(np.diff(self.bounds, axis=1))))
+
+    def to_params(self, u) -> np.ndarray:
+        u = np.asarray(u, float)
+        return np.where(self.log_scale, np.exp(u), u)
+
+    def to_u(self, theta) -> np.ndarray:
+        theta = np.asarray(theta, float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.log_scale, np.log(np.abs(theta)), theta)
+
+    # ------------------------------------------------------------------ shifts
+    def log_shifts(self, theta) -> np.ndarray:
+        """log10 a_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        temps = np.asarray(self.temperatures, float)[None, :]
+        t_ref = self.temperatures[self.reference]
+        if self.law == "wlf":
+            with np.errstate(all="ignore"):
+                return wlf(temps, t_ref, theta[:, 0:1], theta[:, 1:2])
+        if self.law == "arrhenius":
+            return arrhenius(temps, t_ref, theta[:, 0:1])
+        out = np.zeros((theta.shape[0], len(self.temperatures)))
+        out[:, list(self.shifted)] = theta[:, :len(self.shifted)]
+        return out
+
+    def log_vertical(self, theta) -> np.ndarray:
+        """log10 b_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        out = np.zeros((theta.shape[0], len(self.temperatures)))
+        if self.vertical == "density":
+            t = np.asarray(self.temperatures) + KELVIN
+            out[:] = np.log10(t[self.reference] / t)
+        elif self.vertical == "free":
+            k = self.n_horizontal
+            out[:, list(self.shifted)] = theta[:, k:k + len(self.shifted)]
+        return out
+
+    # ------------------------------------------------------------------ the spline
+    @cached_property
+    def _grid(self) -> tuple[float, int]:
+        """(lowest knot, number of basis functions): knots over every reduced frequency that
+        shifts within the prior reach, with three knot steps to spare at each end (where
+        the cubic B-splines sum to one)."""
+        lo = float(self.log_omega.min()) - self.reach - 1.0
+        hi = float(self.log_omega.max()) + self.reach + 1.0
+        return lo, int(math.ceil((hi - lo) / KNOT_STEP)) + 4
+
+    @cached_property
+    def _penalty(self) -> tuple[np.ndarray, np.ndarray]:
+        """DᵀD in lower banded form and its eigenvalues (for ln|P|)."""
+        band = _second_difference_band(self._grid[1])
+        return band, np.clip(eigvals_banded(band, lower=True), 0.0, None)
+
+    @cached_property
+    def _centred(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(the weight 1/κ of each part of each point, 0 where the part is left out; centred
+        logs, 0 where left out; the level of each part; Σ ln κ of each part): the variance of
+        a log is σ_p² κ, κ = 1 under ``relative_parts`` and |G|²/(2 G_p²) under
+        ``proportional`` (complex noise of sd σ|G|, half on each part)."""
+        ok = np.isfinite(self.y)
+        level = np.array([np.mean(self.y[p, ok[p]]) for p in range(2)])
+        r = np.where(ok, self.y - level[:, None], 0.0)
+        if self.noise == "proportional":
+            log_kappa = np.where(ok, 2.0 * (self.magnitude[None, :] - self.y) - math.log(2.0),
+                                 0.0)
+        else:
+            log_kappa = np.zeros_like(r)
+        weight = np.where(ok, np.exp(-log_kappa), 0.0)
+        return weight, r, level, log_kappa.sum(axis=1)
+
+    def _positions(self, theta):
+        """Each point's reduced log10 ω and the vertical shift of its log (natural log), for
+        parameter sets ``theta`` (n_sets, n_params)."""
+        x = self.log_omega[None, :] + self.log_shifts(theta)[:, self.point_isotherm]
+        v = self.log_vertical(theta)[:, self.point_isotherm] * math.log(10.0)
+        return x, (v if self.kind == "modulus" else -v)
+
+    def _normal_equations(self, x, v, p: int, rho, sigma):
+        """For part ``p``: the lower band of A = P + BᵀB/σ² (n_sets, 4, n_basis), c = Bᵀr/σ²,
+        r·r, the basis (first index and values at each point) and the centred data r."""
+        lo, n_basis = self._grid
+        weight, r0, *_ = self._centred
+        n_sets = x.shape[0]
+        k0, b = _basis(x, lo, n_basis)
+        w = weight[p][None, :]
+        r = np.where(w > 0, r0[p][None, :] + v, 0.0)
+        bw = b * w[..., None]
+        flat = np.arange(n_sets)[:, None] * n_basis + k0
+        size = n_sets * n_basis
+        btb = np.zeros((4, size))
+        btr = np.zeros(size)
+        for a in range(4):
+            idx = (flat + a).ravel()
+            btr += np.bincount(idx, (bw[..., a] * r).ravel(), size)
+            for d in range(4 - a):
+                btb[d] += np.bincount(idx, (bw[..., a] * b[..., a + d]).ravel(), size)
+        s2 = (sigma ** 2)[:, None, None]
+        band = np.moveaxis(btb.reshape(4, n_sets, n_basis), 0, 1) / s2
+        dtd, _ = self._penalty
+        band[:, :3] += dtd[None] / (rho ** 2)[:, None, None]
+        band[:, 0] += 1.0 / LEVEL_SD ** 2
+        c = btr.reshape(n_sets, n_basis) / s2[:, :, 0]
+        return band, c, np.sum(w * r * r, axis=1), k0, b, r
+
+    def log_likelihood(self, theta) -> np.ndarray:
+        """ln p(data | θ) with the master function integrated out, for parameter sets
+        ``theta`` (n_sets, n_params) in natural units; −inf where a set is not finite or
+        shifts a point beyond the knots."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        out = np.full(theta.shape[0], -np.inf)
+        rows = np.flatnonzero(np.all(np.isfinite(theta), axis=1))
+        for chunk in np.array_split(rows, max(1, -(-rows.size // CHUNK))):
+            if chunk.size:
+                out[chunk] = self._log_likelihood(theta[chunk])
+        return out
+
+    def _log_likelihood(self, th) -> np.ndarray:
+        lo, n_basis = self._grid
+        x, v = self._positions(th)
+        inside = np.all((x > lo + 3 * KNOT_STEP) & (x < lo + (n_basis - 3) * KNOT_STEP), axis=1)
+        weight, _, _, log_kappa = self._centred
+        _, eig = self._penalty
+        m = th.shape[1]
+        total = np.zeros(th.shape[0])
+        for p in range(2):
+            rho, sigma = th[:, m - 4 + p], th[:, m - 2 + p]
+            band, c, rr, *_ = self._normal_equations(x, v, p, rho, sigma)
+            log_det_a, quad = _banded_solve(band, c) if band.shape[0] > FEW else \
+                _banded_solve_each(band, c)
+            log_det_p = np.sum(np.log(eig[None, :] / (rho ** 2)[:, None]
+                                      + 1.0 / LEVEL_SD ** 2), axis=1)
+            n = int((weight[p] > 0).sum())
+            total += (-0.5 * n * np.log(2.0 * math.pi * sigma ** 2) - 0.5 * log_kappa[p]
+                      + 0.5 * log_det_p
+                      - 0.5 * log_det_a - 0.5 * (rr / sigma ** 2 - quad))
+        return np.where(inside & np.isfinite(total), total, -np.inf)
+
+    def gradient(self, theta) -> tuple[float, np.ndarray]:
+        """ln p(data | θ) and its gradient in the sampling coordinates (logs of the
+        log-uniform parameters) at one parameter set, in closed form: the envelope theorem
+        for the fitted coefficients β̂ = A⁻¹c and tr(A⁻¹ ∂A) for the determinant."""
+        th = np.atleast_2d(np.asarray(theta, float))[:1]
+        value = float(self.log_likelihood(th)[0])
+        m = th.shape[1]
+        grad = np.zeros(m)
+        if not math.isfinite(value):
+            return value, grad
+        lo, n_basis = self._grid
+        x, v = self._positions(th)
+        weight = self._centred[0]
+        dtd, eig = self._penalty
+        d_x = np.zeros(x.shape[1])   # ∂ ln p/∂x of each point
+        d_v = np.zeros(x.shape[1])   # ∂ ln p/∂(vertical offset of its log)
+        u = (x[0] - lo) / KNOT_STEP
+        k0, b = _basis(x, lo, n_basis)
+        k0, b = k0[0], b[0]
+        t = np.clip(u - k0, 0.0, 1.0)
+        db = np.stack([-3 * (1 - t) ** 2, 9 * t * t - 12 * t, -9 * t * t + 6 * t + 3,
+                       3 * t * t], axis=-1) / (6.0 * KNOT_STEP)
+        cols = k0[:, None] + np.arange(4)
+        for p in range(2):
+            rho, sigma = th[0, m - 4 + p], th[0, m - 2 + p]
+            s2 = sigma ** 2
+            band, c, rr, _, _, r = self._normal_equations(x, v, p, np.array([rho]),
+                                                          np.array([sigma]))
+            full = np.zeros((n_basis, n_basis))
+            for d in range(4):
+                idx = np.arange(n_basis - d)
+                full[idx + d, idx] = full[idx, idx + d] = band[0, d, :n_basis - d]
+            chol = cholesky_banded(band[0], lower=True, check_finite=False)
+            inv = cho_solve_banded((chol, True), np.eye(n_basis), check_finite=False)
+            beta = inv @ c[0]
+            w = weight[p]
+            fitted = np.sum(b * beta[cols], axis=1)
+            e = np.where(w > 0, r[0] - fitted, 0.0)
+            slope = np.sum(db * beta[cols], axis=1)
+            # B_n A⁻¹ B′_nᵀ of each point, from the 4 × 4 block of A⁻¹ at its knots.
+            block = inv[cols[:, :, None], cols[:, None, :]]
+            lever = np.einsum("na,nab,nb->n", b, block, db)
+            d_x += w * (e * slope - lever) / s2
+            d_v -= w * e / s2
+            # Hyperparameters (derivatives in ln ρ and ln σ).
+            pen = np.zeros((n_basis, n_basis))
+            for d in range(3):
+                idx = np.arange(n_basis - d)
+                pen[idx + d, idx] = pen[idx, idx + d] = dtd[d, :n_basis - d]
+            btb = (full - pen / rho ** 2 - np.eye(n_basis) / LEVEL_SD ** 2) * s2
+            grad[m - 4 + p] = (-np.sum((eig / rho ** 2) / (eig / rho ** 2 + 1 / LEVEL_SD ** 2))
+                               + (np.sum(inv * pen) + beta @ pen @ beta) / rho ** 2)
+            grad[m - 2 + p] = -int((w > 0).sum()) + (e @ (w * e) + np.sum(inv * btb)) / s2
+        # Shifts: each point's x moves with its isotherm's log10 a_T; its log with log10 b_T.
+        n_iso = len(self.temperatures)
+        per_iso_x = np.bincount(self.point_isotherm, d_x, n_iso)
+        per_iso_v = np.bincount(self.point_isotherm, d_v, n_iso) * math.log(10.0) \
+            * (1.0 if self.kind == "modulus" else -1.0)
+        temps = np.asarray(self.temperatures, float)
+        t_ref = temps[self.reference]
+        if self.law == "wlf":
+            c1, c2 = th[0, 0], th[0, 1]
+            dt = temps - t_ref
+            grad[0] = per_iso_x @ (-dt / (c2 + dt))
+            grad[1] = per_iso_x @ (c1 * dt / (c2 + dt) ** 2)
+        elif self.law == "arrhenius":
+            grad[0] = per_iso_x @ arrhenius(temps, t_ref, 1.0) * th[0, 0]
+        else:
+            grad[:len(self.shifted)] = per_iso_x[list(self.shifted)]
+        if self.vertical == "free":
+            k = self.n_horizontal
+            grad[k:k + len(self.shifted)] = per_iso_v[list(self.shifted)]
+        return value, grad
+
+    def master_curve(self, theta, log_omega_reduced) -> np.ndarray:
+        """The posterior mean of ln|G′| and ln|G″| of the master function at reduced
+        log10 ω, given one parameter set: shape (2, n)."""
+        theta = np.atleast_2d(np.asarray(theta, float))[:1]
+        lo, n_basis = self._grid
+        x = self.log_omega + self.log_shifts(theta)[0, self.point_isotherm]
+        v = self.log_vertical(theta)[0, self.point_isotherm] * math.log(10.0)
+        v = v if self.kind == "modulus" else -v
+        k0, b = _basis(x, lo, n_basis)
+        weight, r, level, _ = self._centred
+        dtd, _ = self._penalty
+        m = theta.shape[1]
+        kq, bq = _basis(np.asarray(log_omega_reduced, float), lo, n_basis)
+        out = []
+        for p in range(2):
+            rho, sigma = theta[0, m - 4 + p], theta[0, m - 2 + p]
+            design = np.zeros((x.size, n_basis))
+            for a in range(4):
+                design[np.arange(x.size), k0 + a] = b[:, a]
+            rp = np.where(weight[p] > 0, r[p] + v, 0.0) * weight[p]
+            full = design.T @ (design * weight[p][:, None]) / sigma ** 2
+            pen = np.zeros((n_basis, n_basis))
+            for d in range(3):
+                idx = np.arange(n_basis - d)
+                pen[idx + d, idx] = pen[idx, idx + d] = dtd[d, :n_basis - d]
+            full += pen / rho ** 2 + np.eye(n_basis) / LEVEL_SD ** 2
+            beta = np.linalg.solve(full, design.T @ rp / sigma ** 2)
+            vals = np.zeros(kq.shape)
+            for a in range(4):
+                vals += bq[..., a] * beta[kq + a]
+            out.append(vals + level[p])
+        return np.array(out)
+
+
+# ---------------------------------------------------------------------------- the posterior
+#: Importance draws per round, and the certificate of the weights (the thresholds of
+#: :mod:`bayesfo.inference.importance`: k̂ < 0.7 for the posterior, < 0.5 for ln Z).
+DRAWS = 4000
+K_HAT_MAX = 0.7
+K_HAT_EVIDENCE = 0.5
+ESS_MIN = 1000
+#: Steps of the emcee fallback (walkers: twice the parameters, plus two).
+EMCEE_STEPS = 1500
+#: Most draws of one proposal.
+MAX_DRAWS = 16000
+#: Degrees of freedom of the multivariate-t proposal (tails heavier than the Laplace normal).
+DF = 5
+#: Adapted rounds (proposal moments from the weighted draws) before emcee takes over.
+ROUNDS = 3
+#: A shift whose 94 % interval is wider than this [decades] is not determined by the data:
+#: an isotherm over a featureless plateau, whose shift slides along it.
+UNDETERMINED = 1.0
+
+
+@dataclass(frozen=True)
+class ShiftPosterior:
+    """The posterior of a :class:`SmoothMaster`'s parameters.
+
+    Attributes
+    ----------
+    model : SmoothMaster
+    draws : ndarray, shape (n_draws, n_params)
+        Equally weighted posterior draws, natural units.
+    log_evidence, log_evidence_err : float
+        ln Z of the model (the data's logs) and its Monte Carlo error (NaN where no route
+        gave one).
+    map_theta : ndarray
+        The maximum of the likelihood found (natural units).
+    max_log_likelihood : float
+    sampler : str
+        ``"importance"`` (weights certified: Pareto k̂ < 0.7, ESS ≥ 1000) or ``"emcee"``.
+    k_hat, ess : float
+        Of the last importance round (k̂ NaN after emcee); ESS of the draws.
+    converged : bool
+        The draws are certified.
+    messages : tuple of str
+    """
+
+    model: SmoothMaster
+    draws: np.ndarray
+    log_evidence: float
+    log_evidence_err: float
+    map_theta: np.ndarray
+    max_log_likelihood: float
+    sampler: str
+    k_hat: float
+    ess: float
+    converged: bool
+    messages: tuple[str, ...] = ()
+
+    @property
+    def shift_draws(self) -> np.ndarray:
+        return self.model.log_shifts(self.draws)
+
+    @property
+    def vertical_draws(self) -> np.ndarray | None:
+        return None if self.model.vertical == "none" else self.model.log_vertical(self.draws)
+
+    def undetermined(self) -> list[int]:
+        """The isotherms whose log10 a_T the data do not fix (94 % interval wider than
+        :data:`UNDETERMINED` decades)."""
+        from ..inference._arviz import hdi_columns
+
+        lo, hi = hdi_columns(self.shift_draws, 0.94)
+        return [i for i in range(lo.size) if i != self.model.reference
+                and not (hi[i] - lo[i] <= UNDETERMINED)]
+
+
+def start_of(model: SmoothMaster, log_shifts) -> np.ndarray:
+    """A start (natural units, inside the prior) from seed shifts of every isotherm: the
+    free shifts, or the law fitted to them; vertical shifts 0; smoothness 0.05, noise 0.05."""
+    from scipy.optimize import least_squares
+
+    temps = np.asarray(model.temperatures, float)
+    t_ref = temps[model.reference]
+    b = np.array([p.bounds for _, p in model.parameters], float)
+    seeds = np.asarray(log_shifts, float)
+    if model.law == "wlf":
+        c2 = min(max(51.6, b[1, 0] + 10.0), b[1, 1])
+        sol = least_squares(lambda q: wlf(temps, t_ref, q[0], q[1]) - seeds, [10.0, c2],
+                            bounds=(b[:2, 0] + 1e-9, b[:2, 1] - 1e-9))
+        horizontal = list(sol.x)
+    elif model.law == "arrhenius":
+        basis = arrhenius(temps, t_ref, 1.0)
+        horizontal = [float(basis @ seeds / (basis @ basis))]
+    else:
+        horizontal = list(np.delete(seeds, model.reference))
+    # Free vertical shifts start at the density correction, which they contain.
+    density = np.log10((temps[model.reference] + KELVIN) / (temps + KELVIN))
+    vertical = list(np.delete(density, model.reference)) if model.vertical == "free" else []
+    theta = np.array(horizontal + vertical + [0.05, 0.05, 0.05, 0.05])
+    span = b[:, 1] - b[:, 0]
+    return np.clip(theta, b[:, 0] + 1e-6 * span, b[:, 1] - 1e-6 * span)
+
+
+def _optimum(model: SmoothMaster, u0: np.ndarray, free=None) -> np.ndarray:
+    """The maximum of the log-likelihood in the sampling coordinates (L-BFGS-B within the
+    prior box, with the closed-form gradient), over the parameters ``free`` (a mask; default
+    all), the others held at ``u0``. Each parameter is measured in units of its curvature at
+    ``u0`` (shifts are fixed to thousandths of a decade, the hyperparameters to a tenth of
+    their log): L-BFGS then takes tens of steps where it took thousands."""
+    from scipy.optimize import minimize
+
+    free = np.ones(u0.size, bool) if free is None else free
+    scale = np.ones(u0.size)
+    if int(free.sum()) > 4:
+        curvature = -np.diag(_hessian(model, u0))
+        ok = np.isfinite(curvature) & (curvature > 0)
+        scale[ok] = 1.0 / np.sqrt(curvature[ok])
+    scale = scale[free]
+
+    def f_and_g(z):
+        u = u0.copy()
+        u[free] = z * scale
+        value, grad = model.gradient(model.to_params(u))
+        if not math.isfinite(value):
+            return 1e300, np.zeros(z.size)
+        return -value, -grad[free] * scale
+
+    sol = minimize(f_and_g, u0[free] / scale, jac=True, method="L-BFGS-B",
+                   bounds=model.bounds[free] / scale[:, None],
+                   options={"maxiter": 2000, "ftol": 1e-12, "gtol": 1e-6})
+    out = u0.copy()
+    out[free] = sol.x * scale
+    return out
+
+
+def _newton(model: SmoothMaster, u: np.ndarray, steps: int = 8):
+    """Newton steps from ``u`` (Hessian by differences of the gradient, halved steps until
+    the likelihood rises, the prior box kept): where horizontal and vertical shifts trade off
+    against each other, L-BFGS stops short of the maximum. Returns the point, its
+    log-likelihood and the Hessian there."""
+    bounds = model.bounds
+    value = float(model.log_likelihood(model.to_params(u))[0])
+    hess = _hessian(model, u)
+    for _ in range(steps):
+        _, grad = model.gradient(model.to_params(u))
+        w, v = np.linalg.eigh(-hess)
+        if w.min() <= 0:
+            break
+        step = v @ ((v.T @ grad) / w)
+        for _half in range(12):
+            trial = np.clip(u + step, bounds[:, 0], bounds[:, 1])
+            new = float(model.log_likelihood(model.to_params(trial))[0])
+            if new > value:
+                break
+            step = step / 2
+        else:
+            break
+        gain = new - value
+        u, value = trial, new
+        hess = _hessian(model, u)
+        if gain < 1e-4:
+            break
+    return u, value, hess
+
+
+def _hessian(model: SmoothMaster, u: np.ndarray, h: float = 1e-4) -> np.ndarray:
+    """The Hessian of the log-likelihood at ``u`` (sampling coordinates) by central
+    differences of the closed-form gradient."""
+    def grad(x):
+        value, g = model.gradient(model.to_params(x))
+        return g if math.isfinite(value) else np.full(x.size, np.nan)
+
+    d = u.size
+    out = np.zeros((d, d))
+    for i in range(d):
+        e = np.zeros(d)
+        e[i] = h
+        out[i] = (grad(u + e) - grad(u - e)) / (2 * h)
+    out = 0.5 * (out + out.T)
+    return np.where(np.isfinite(out), out, 0.0)
+
+
+def _proposal_cov(hess: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    """The Laplace covariance −H⁻¹ made positive definite (directions the likelihood leaves
+    flat get a variance of the prior box's width squared / 12)."""
+    w, v = np.linalg.eigh(-0.5 * (hess + hess.T))
+    widths = np.diff(bounds, axis=1).ravel()
+    floor = 12.0 / float(np.max(widths)) ** 2
+    w = np.maximum(w, floor)
+    return (v / w) @ v.T
+
+
+def best_fit(model: SmoothMaster, start: np.ndarray) -> tuple[np.ndarray, float]:
+    """The maximum of the likelihood from ``start`` (natural units): its point in the sampling
+    coordinates and its log-likelihood, an upper bound of ln Z under the normalised prior."""
+    u0 = model.to_u(start)
+    hyper = np.zeros(u0.size, bool)
+    hyper[-4:] = True  # smoothness and noise first, the shifts held at the start
+    u_map, value, _ = _newton(model, _optimum(model, _optimum(model, u0, hyper)))
+    return u_map, value
+
+
+def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
+                  fit: tuple | None = None) -> ShiftPosterior:
+    """The posterior of the model's parameters by importance sampling from a multivariate t
+    at the likelihood's maximum (Laplace covariance), adapted to the weighted draws up to
+    :data:`ROUNDS` times; emcee where the weights never certify.
+
+    Parameters
+    ----------
+    model : SmoothMaster
+    start : ndarray
+        A start for the optimisation (natural units; :func:`start_of`).
+    seed : int
+    fit : tuple, optional
+        :func:`best_fit` of the model, where it was already found.
+
+    Returns
+    -------
+    ShiftPosterior
+    """
+    from scipy.special import logsumexp
+    from scipy.stats import multivariate_t
+
+    from ..inference._arviz import psis
+
+    rng = np.random.default_rng(seed)
+    bounds = model.bounds
+    u_map, max_ll = best_fit(model, start) if fit is None else fit
+    mean, cov = u_map, _proposal_cov(_hessian(model, u_map), bounds)
+    log_prior = -model.log_prior_volume
+    messages = []
+    best = None
+    for _ in range(ROUNDS):
+        prop = multivariate_t(loc=mean, shape=cov, df=DF, seed=rng)
+        u = np.empty((0, mean.size))
+        log_w = np.empty(0)
+        # Draws from one proposal until the weights' ESS reaches ESS_MIN (at most
+        # MAX_DRAWS), where their tail (k̂) certifies them.
+        while u.shape[0] < MAX_DRAWS:
+            more = np.atleast_2d(prop.rvs(size=DRAWS))
+            inside = np.all((more > bounds[:, 0]) & (more < bounds[:, 1]), axis=1)
+            ll = np.full(DRAWS, -np.inf)
+            ll[inside] = model.log_likelihood(model.to_params(more[inside]))
+            u = np.vstack([u, more])
+            log_w = np.r_[log_w, ll + log_prior - prop.logpdf(more)]
+            finite = np.isfinite(log_w)
+            if finite.sum() < 0.1 * u.shape[0]:
+                break
+            smoothed, k_hat = psis(log_w[finite])
+            w = np.exp(smoothed - logsumexp(smoothed))
+            ess = float(1.0 / np.sum(w ** 2))
+            if k_hat >= K_HAT_MAX or ess >= ESS_MIN:
+                break
+        if finite.sum() < 0.1 * u.shape[0]:
+            break
+        n = u.shape[0]
+        raw = np.where(finite, log_w, -np.inf)
+        log_z = float(logsumexp(raw) - math.log(n))
+        rel = np.exp(raw - logsumexp(raw))
+        log_z_err = float(math.sqrt(max(n * np.sum(rel ** 2) - 1.0, 0.0) / n))
+        best = (u[finite], w, k_hat, ess, log_z, log_z_err)
+        if k_hat < K_HAT_MAX and ess >= ESS_MIN:
+            break
+        # Adapt: the proposal's moments from the weighted draws, widened a little.
+        x = u[finite]
+        mean = w @ x
+        cov = 1.2 * np.cov(x, rowvar=False, aweights=w) + 1e-10 * np.eye(x.shape[1])
+    if best is not None and best[2] < K_HAT_MAX and best[3] >= ESS_MIN:
+        x, w, k_hat, ess, log_z, log_z_err = best
+        pick = rng.choice(x.shape[0], size=DRAWS // 2, replace=True, p=w)
+        draws = model.to_params(x[pick])
+        evidence_ok = k_hat < K_HAT_EVIDENCE
+        return ShiftPosterior(model, draws, log_z if evidence_ok else math.nan,
+                              log_z_err if evidence_ok else math.nan, model.to_params(u_map),
+                              max_ll, "importance", k_hat, ess, True,
+                              () if evidence_ok else (
+                                  f"importance weights certify the posterior but not ln Z "
+                                  f"(Pareto k {k_hat:.2f})",))
+    messages.append("the importance weights did not certify the posterior (Pareto k "
+                    f"{'n/a' if best is None else f'{best[2]:.2f}'}); emcee drew it")
+    return _emcee(model, u_map, cov, max_ll, seed, tuple(messages),
+                  None if best is None or best[2] >= K_HAT_EVIDENCE else best[4:6])
+
+
+def _emcee(model: SmoothMaster, u_map, cov, max_ll: float, seed: int, messages: tuple,
+           evidence) -> ShiftPosterior:
+    """The posterior by emcee (vectorised), walkers started around the maximum."""
+    import emcee
+
+    from ..inference._arviz import ess_min, rhat_max
+
+    rng = np.random.default_rng(seed)
+    bounds = model.bounds
+    d = u_map.size
+    n_walkers = 2 * d + 2
+
+    def log_prob(u):
+        u = np.atleast_2d(u)
+        inside = np.all((u > bounds[:, 0]) & (u < bounds[:, 1]), axis=1)
+        out = np.full(u.shape[0], -np.inf)
+        if inside.any():
+            out[inside] = model.log_likelihood(model.to_params(u[inside]))
+        return out
+
+    span = bounds[:, 1] - bounds[:, 0]
+    p0 = rng.multivariate_normal(u_map, 0.1 * cov, size=n_walkers)
+    p0 = np.clip(p0, bounds[:, 0] + 1e-6 * span, bounds[:, 1] - 1e-6 * span)
+    p0 += 1e-8 * span * rng.standard_normal(p0.shape)  # no two walkers alike
+    sampler = emcee.EnsembleSampler(n_walkers, d, log_prob, vectorize=True,
+                                    moves=[(emcee.moves.DEMove(), 0.8),
+                                           (emcee.moves.StretchMove(), 0.2)])
+    sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
+    steps = EMCEE_STEPS
+    sampler.run_mcmc(p0, steps, progress=False)
+    chain = sampler.get_chain(discard=steps // 2, thin=5)  # (steps, walkers, d)
+    chains = np.swapaxes(chain, 0, 1)
+    rhat = rhat_max(chains)
+    ess = ess_min(chains)
+    ok = rhat < 1.01 and ess >= 400
+    msgs = messages + (() if ok else (f"emcee did not converge (R-hat {rhat:.3f}, ESS "
+                                      f"{ess:.0f})",))
+    log_z, log_z_err = evidence if evidence is not None else (math.nan, math.nan)
+    return ShiftPosterior(model, model.to_params(chain.reshape(-1, d)), log_z, log_z_err,
+                          model.to_params(u_map), max_ll, "emcee", math.nan, ess, ok, msgs)

@@ -238,7 +238,24 @@ class SmoothMaster:
 
     @property
     def log_prior_volume(self) -> float:
-        return float(np.sum(np.log(np.diff(self.bounds, axis=1))))
+        """ln of the prior support's volume in the sampling coordinates: the box, where free
+        shifts are ordered (the a isotherms colder than the reference in (0, reach), the b
+        warmer in (−reach, 0), each group in order: reach^a/a! · reach^b/b!)."""
+        box = float(np.sum(np.log(np.diff(self.bounds, axis=1))))
+        if self.law != "free":
+            return box
+        a = sum(1 for i in self.shifted if i < self.reference)
+        b = len(self.shifted) - a
+        return box - len(self.shifted) * math.log(2.0) - math.lgamma(a + 1) - math.lgamma(b + 1)
+
+    def ordered(self, theta) -> np.ndarray:
+        """Whether each set's shifts fall as the temperature rises (relaxation is slower the
+        colder: log10 a_T strictly decreasing), part of the prior's support; always true of
+        the laws (C1 > 0 and C2 above T_ref − T_min; E_a > 0)."""
+        theta = np.atleast_2d(np.asarray(theta, float))
+        if self.law != "free":
+            return np.ones(theta.shape[0], bool)
+        return np.all(np.diff(self.log_shifts(theta), axis=1) < 0, axis=1)
 
     def to_params(self, u) -> np.ndarray:
         u = np.asarray(u, float)
@@ -345,11 +362,11 @@ class SmoothMaster:
 
     def log_likelihood(self, theta) -> np.ndarray:
         """ln p(data | θ) with the master function integrated out, for parameter sets
-        ``theta`` (n_sets, n_params) in natural units; −inf where a set is not finite or
-        shifts a point beyond the knots."""
+        ``theta`` (n_sets, n_params) in natural units; −inf where a set is not finite, lies
+        outside the prior's support (:meth:`ordered`) or shifts a point beyond the knots."""
         theta = np.atleast_2d(np.asarray(theta, float))
         out = np.full(theta.shape[0], -np.inf)
-        rows = np.flatnonzero(np.all(np.isfinite(theta), axis=1))
+        rows = np.flatnonzero(np.all(np.isfinite(theta), axis=1) & self.ordered(theta))
         for chunk in np.array_split(rows, max(1, -(-rows.size // CHUNK))):
             if chunk.size:
                 out[chunk] = self._log_likelihood(theta[chunk])
@@ -576,7 +593,14 @@ def start_of(model: SmoothMaster, log_shifts) -> np.ndarray:
         basis = arrhenius(temps, t_ref, 1.0)
         horizontal = [float(basis @ seeds / (basis @ basis))]
     else:
-        horizontal = list(np.delete(seeds, model.reference))
+        # Ordered as the prior asks: each colder isotherm at least 0.01 decade above its
+        # warmer neighbour (an overlay of featureless isotherms may give any order).
+        ordered = seeds.copy()
+        for i in range(model.reference - 1, -1, -1):
+            ordered[i] = max(ordered[i], ordered[i + 1] + 0.01)
+        for i in range(model.reference + 1, ordered.size):
+            ordered[i] = min(ordered[i], ordered[i - 1] - 0.01)
+        horizontal = list(np.delete(ordered, model.reference))
     # Free vertical shifts start at the density correction, which they contain.
     density = np.log10((temps[model.reference] + KELVIN) / (temps + KELVIN))
     vertical = list(np.delete(density, model.reference)) if model.vertical == "free" else []
@@ -671,7 +695,16 @@ def _proposal_cov(hess: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     widths = np.diff(bounds, axis=1).ravel()
     floor = 12.0 / float(np.max(widths)) ** 2
     w = np.maximum(w, floor)
-    return (v / w) @ v.T
+    return _well_conditioned((v / w) @ v.T)
+
+
+def _well_conditioned(cov: np.ndarray) -> np.ndarray:
+    """``cov`` symmetric, its eigenvalues at least 1e-8 of the largest (a proposal's shape
+    that the multivariate t accepts)."""
+    w, v = np.linalg.eigh(0.5 * (cov + cov.T))
+    w = np.maximum(w, 1e-8 * max(float(w.max()), 1e-300))
+    out = (v * w) @ v.T
+    return 0.5 * (out + out.T)
 
 
 def best_fit(model: SmoothMaster, start: np.ndarray) -> tuple[np.ndarray, float]:
@@ -749,7 +782,7 @@ def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
         # Adapt: the proposal's moments from the weighted draws, widened a little.
         x = u[finite]
         mean = w @ x
-        cov = 1.2 * np.cov(x, rowvar=False, aweights=w) + 1e-10 * np.eye(x.shape[1])
+        cov = _well_conditioned(1.2 * np.cov(x, rowvar=False, aweights=w))
     if best is not None and best[2] < K_HAT_MAX and best[3] >= ESS_MIN:
         x, w, k_hat, ess, log_z, log_z_err = best
         pick = rng.choice(x.shape[0], size=DRAWS // 2, replace=True, p=w)

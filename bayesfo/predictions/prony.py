@@ -1,34 +1,42 @@
 """Prony series of a compared model for finite-element codes.
 
-G(t) = G∞ + Σ g_i exp(−t/τ_i) with the τ_i fixed, ``per_decade`` of them per decade from two
-decades below 1/ω_max to two decades above 1/ω_min, and G∞, g_i ≥ 0 fitted by non-negative least
-squares to the posterior median of G′(ω) and G″(ω) (relative residuals, 20 frequencies per
-decade over the data window widened by a decade each side). G∞ is 0 where the model relaxes
+G(t) = G∞ + Σ g_i exp(−t/τ_i) with the τ_i log-spaced from two decades below 1/ω_max to two
+decades above 1/ω_min, and G∞, g_i ≥ 0 fitted by non-negative least squares to the posterior
+median of G′(ω) and G″(ω) (relative residuals, 20 frequencies per decade over the data window
+widened by a decade each side). The number of τ_i is by default the fewest whose series' G(t)
+stays inside the model's own 94 % band at each of :data:`DENSE` log-spaced times over the data
+window (more would describe the model more closely than the data know it); a number, or a
+number per decade, may be given instead. G∞ is 0 where the model relaxes
 fully (a liquid: its long-time modulus, the limit of G(t) as t → ∞, is 0 for the median draw),
 and the τ_i then reach a decade further; else G∞ is fitted with the terms; ``liquid`` forces
 either. A fitted G∞ is the series' modulus beyond its longest relaxation time: a fractional
 model still relaxing there (a springpot relaxes over every decade) has a long-time modulus
 below it, which the files state beside it.
 
-How well the series stands for the model is stated: the largest relative error of its G′, G″
-and G(t) against the posterior medians over the data window, beside the half-width of the
-model's own 94 % band of G(t) there (a series whose error is well inside the band adds nothing
-the data could tell).
+How well the series stands for the model is stated, each error the largest over the data
+window on a dense grid and named for what it measures: |ΔG(t)|/G(t) at :data:`DENSE` times,
+|ΔG*|/|G*|, |ΔG′|/G′ and |ΔG″|/G″ at :data:`DENSE` frequencies; beside them the model's band
+of G(t) and how far the series departs within it.
 
 Formats: ``csv`` (``tau_s,g_i`` with ``#`` lines for G∞, G0, the unit and the errors), ``abaqus``
 (``*VISCOELASTIC, TIME=PRONY``: g_i/G0, k_i = 0, τ_i; G0 in a comment, for ``*ELASTIC,
-MODULI=INSTANTANEOUS``), ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` pairs of α_i = g_i/G0
-and τ_i) and ``lsdyna`` (``*MAT_GENERAL_VISCOELASTIC``, fixed 10-character fields: rows of G_i
-and the decay constant β_i = 1/τ_i, G∞ as a row with β = 0, at most :data:`LSDYNA_MAX_TERMS`
-rows; RO and BULK, which a shear measurement does not give, are left for the user).
+MODULI=INSTANTANEOUS``), ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` commands of three
+values, α_i = g_i/G0 and τ_i in turn, as ANSYS's TBFT writes them) and ``lsdyna``
+(``*MAT_GENERAL_VISCOELASTIC``, fixed 10-character fields: rows of G_i and the decay constant
+β_i = 1/τ_i, G∞ as a row with β = 0, at most :data:`LSDYNA_MAX_TERMS` rows; RO and BULK,
+which a shear or tensile measurement does not give, are left for the user). The ratios g_i/G0
+that Abaqus and ANSYS take sum to at most :data:`RATIO_SUM_MAX` (a liquid's, which sum to 1,
+are scaled by 1 − 1e-6): those codes refuse a sum of 1.
 
 A series fitted to a master curve is the material at the reference temperature, and its shift
 law goes with it (the law of larger support, posterior means): Abaqus ``*TRS`` (``WLF``:
 θ0, C1, C2; ``ARRHENIUS``: θ0, E0, R, θZ = −273.15 for temperatures in °C), ANSYS
 ``TB,SHIFT`` (``WLF``: T_r, C1, C2, whose log10 A = C1 (T − T_r)/(C2 + T − T_r) is the
 inverse of a_T; Arrhenius as the two-constant Tool–Narayanaswamy form ``TN``: T_r and
-E_a/R, in kelvin), and the csv's comment lines; the law's fit to the shifts and its
-temperature range are stated beside it.
+E_a/R, in kelvin), LS-DYNA's TREF, A, B (:meth:`Prony.lsdyna_shift`) and the csv's comment
+lines; the law's fit to the shifts and its temperature range are stated beside it. A law the
+evidence rejects (free shifts of larger ln Z under ``law="auto"``) is not written: the files
+say so and list the isotherms' own shifts.
 """
 
 from __future__ import annotations

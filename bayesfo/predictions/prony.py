@@ -623,9 +623,9 @@ def _shift_law(mc) -> tuple[dict | None, str, tuple]:
 
 
 def _has_unit(unit: str) -> bool:
-    """Whether ``unit`` names a unit: not empty, not the placeholder of data without one
-    (``[G]``: :func:`~bayesfo.structures.physical.stress_unit`)."""
-    return bool(unit) and "[" not in unit
+    """Whether ``unit`` names a unit: not empty, not the arbitrary unit of data without one
+    (``a.u.``: :func:`~bayesfo.structures.physical.stress_unit`, ``[G]`` of earlier versions)."""
+    return bool(unit) and "[" not in unit and "a.u." not in unit
 
 
 def _unit_suffix(unit: str) -> str:

@@ -158,6 +158,22 @@ class Prony:
         """Whether the series' G(t) stays inside the model's 94 % band over the window."""
         return bool(self.band_fraction <= 1.0)
 
+    def __repr__(self) -> str:
+        from ..data.symbols import modulus_symbol
+
+        e = modulus_symbol(self.symbol)
+        unit = _unit_suffix(self.unit)
+        band = ("inside" if self.inside_band else "outside") if not math.isnan(
+            self.band_fraction) else "not judged against"
+        return (f"<Prony series of {self.source}: {self.tau.size} terms, {e}0 = "
+                f"{self.g_0:.6g}{unit}, {e}_inf = {self.g_inf:.6g}{unit}; max |d{e}(t)|/{e}(t) "
+                f"{self.max_rel_error_relaxation:.2g}, {band} the model's band>")
+
+    def _repr_html_(self) -> str:
+        from ..output.notebook import prony_html
+
+        return prony_html(self)
+
     def relaxation(self, t) -> np.ndarray:
         t = np.asarray(t, float)
         return self.g_inf + np.sum(self.g * np.exp(-t[..., None] / self.tau), axis=-1)

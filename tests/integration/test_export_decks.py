@@ -97,7 +97,7 @@ def test_pyvisco_reads_the_ansys_deck_back(liquid, tmp_path):
 def test_auto_terms_are_the_fewest_inside_the_band(nrel):
     """The NREL master (26 decades): the default series has the fewest log-spaced terms whose
     E(t) stays inside the model's 94 % band at 2001 times over the window (28; two per decade
-    gave 60), and one term fewer leaves it."""
+    gave 59), and one term fewer leaves it."""
     result, _ = nrel
     prony = prony_series(result)
     assert prony.rule == "auto" and prony.tau.size <= 30
@@ -139,7 +139,7 @@ def test_stated_errors_are_the_maxima_on_the_dense_grid(nrel):
 
 
 def test_lsdyna_takes_the_automatic_terms_within_its_18_rows(nrel, tmp_path, run_cli):
-    """LS-DYNA's default on the NREL master was refused (61 rows > 18): the automatic number
+    """LS-DYNA's default on the NREL master was refused (60 rows > 18): the automatic number
     stops at the card's 18 rows, with the long-time modulus one of them, and says that the
     series then leaves the band. The tensile series is named as such."""
     _, out = nrel

@@ -13,10 +13,10 @@ def add_parser(subparsers):
     p = subparsers.add_parser(
         "export", help="a Prony series of the model (csv, Abaqus, ANSYS, LS-DYNA) from the "
                        "output directory of a comparison or a master curve",
-        description="Fit G(t) = G_inf + sum g_i exp(-t/tau_i) (tau_i fixed per decade, g_i >= "
-                    "0) to the posterior median G', G'' of a structure or an average, and "
-                    "write it with its largest relative error over the data window beside the "
-                    "width of the model's credible band.")
+        description="Fit G(t) = G_inf + sum g_i exp(-t/tau_i) (tau_i log-spaced, g_i >= 0) "
+                    "to the posterior median G', G'' of a structure or an average, with the "
+                    "fewest terms whose G(t) stays inside the model's 94 % band over the data "
+                    "window, and write it with its largest relative errors there.")
     p.add_argument("directory", metavar="DIR",
                    help="output directory of bayesfo compare, or of bayesfo mastercurve (the "
                         "series at the reference temperature, with the shift law)")
@@ -26,11 +26,14 @@ def add_parser(subparsers):
                         "18 terms)")
     p.add_argument("--out", required=True, metavar="FILE", help="the file to write")
     many = p.add_mutually_exclusive_group()
-    many.add_argument("--per-decade", type=int, default=2, metavar="K",
-                      help="relaxation times per decade (default 2)")
-    many.add_argument("--terms", type=int, default=None, metavar="N",
-                      help="the number of relaxation times instead (2-100, log-spaced over the "
-                           "same span; terms of zero weight are dropped)")
+    many.add_argument("--terms", type=_terms, default="auto", metavar="auto|N",
+                      help="the number of relaxation times (log-spaced from two decades below "
+                           "the data window to two above it; terms of zero weight are "
+                           "dropped): auto (default), the fewest whose G(t) stays inside the "
+                           "model's 94 %% band at 2001 times over the window (for lsdyna at "
+                           "most the card's 18 rows), or N from 2 to 100")
+    many.add_argument("--per-decade", type=int, default=None, metavar="K",
+                      help="K relaxation times per decade instead (1-10)")
     p.add_argument("--liquid", action=argparse.BooleanOptionalAction, default=None,
                    help="G_inf = 0: the material relaxes fully (--no-liquid: G_inf fitted with "
                         "the terms; default: 0 where the model's long-time modulus is 0, else "
@@ -45,19 +48,33 @@ def add_parser(subparsers):
     return p
 
 
+def _terms(text: str):
+    """``auto`` or an integer, for ``--terms``."""
+    import argparse
+
+    if text.strip().lower() == "auto":
+        return "auto"
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"give auto or a whole number, got {text!r}") from None
+
+
 def run(args) -> int:
     from pathlib import Path
 
     from .._io import atomic_write_text, write_error
     from ..comparison import load
     from ..errors import InputError
-    from ..predictions.prony import prony_series
+    from ..predictions.prony import LSDYNA_MAX_TERMS, prony_series
 
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     try:
+        terms = None if args.per_decade is not None else args.terms
         prony = prony_series(result, per_decade=args.per_decade, liquid=args.liquid,
                              structure=args.structure, average=args.average, seed=args.seed,
-                             terms=args.terms)
+                             terms=terms, max_terms=LSDYNA_MAX_TERMS if args.format == "lsdyna"
+                             and terms == "auto" else None)
     except InputError as exc:  # the API's words, in the command line's
         raise InputError(str(exc).replace("predict: ", "", 1).replace("export: ", "", 1)
                          .replace("terms per decade", "--per-decade")
@@ -92,10 +109,21 @@ def run(args) -> int:
             raise InputError(f"--figure '{args.figure}': cannot be written "
                              f"({write_error(args.figure, exc)})") from None
         print(f"wrote {args.figure}")
-    error = max(prony.max_rel_error_modulus, prony.max_rel_error_relaxation)
-    print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
-          f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
-          f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
+    from ..data.symbols import modulus_symbol
+    from ..predictions.prony import DENSE, _unit_suffix
+
+    e = modulus_symbol(prony.symbol)
+    how = (f" (the fewest whose {e}(t) stays inside the model's band)" if prony.rule == "auto" and prony.inside_band
+           else "")
+    print(f"{prony.tau.size} terms of {prony.source}{how}, {e}0 = {prony.g_0:.6g}, {e}_inf = "
+          f"{prony.g_inf:.6g}{_unit_suffix(prony.unit)}; wrote {args.out}")
+    print(f"largest relative errors over the data window ({DENSE} log-spaced times, "
+          f"frequencies): {e}(t) {prony.max_rel_error_relaxation:.2g}, |{e}*| "
+          f"{prony.max_rel_error_modulus:.2g}, {e}′ {prony.max_rel_error_storage:.2g}, {e}″ "
+          f"{prony.max_rel_error_loss:.2g}; the model's 94 % band of {e}(t): at least "
+          f"+-{prony.band_rel_halfwidth:.2g}, the series "
+          + ("inside it" if prony.inside_band else "outside it")
+          + f" (largest departure {prony.band_fraction:.2g} of the band's reach)")
     for line in prony.extrapolation_text():
         print(f"note: {line}")
     for line in prony.long_time_text():
@@ -104,6 +132,8 @@ def run(args) -> int:
                      " (--no-liquid fits G_inf with the terms)" if args.liquid is None else "")
         print(f"note: {line}")
     law = prony.shift_law
+    if law is None and prony.shift_note:
+        print(f"note: {prony.shift_note}")
     if law is not None:
         from ..tts.joint import LAW_MISS
 
@@ -114,9 +144,15 @@ def run(args) -> int:
             print(f"note: the shift law misses the master curve's shifts beyond their "
                   f"uncertainty (chi2/dof {law['chi2_per_dof']:.3g}): the finite-element model "
                   "will be off at some temperatures; see the master curve's notes")
-    if error > prony.band_rel_halfwidth:
-        more = (f"--terms {min(100, 2 * args.terms)}" if args.terms is not None
-                else f"--per-decade {min(10, 2 * args.per_decade)}")
-        print(f"note: the series departs from the model by more than the model's uncertainty; "
-              f"more terms ({more}) may help")
+    if not prony.inside_band:
+        if prony.rule == "auto" and prony.max_terms is not None:
+            more = (f"the card's {prony.max_terms} rows are too few: the format csv, abaqus "
+                    "or ansys takes as many as it needs")
+        elif args.per_decade is not None:
+            more = f"more terms (--per-decade {min(10, 2 * args.per_decade)}) may help"
+        elif isinstance(args.terms, int):
+            more = f"more terms (--terms {min(100, 2 * args.terms)} or auto) may help"
+        else:
+            more = "no number of terms up to 100 keeps it inside"
+        print(f"note: the series leaves the model's 94 % band of {e}(t): {more}")
     return 0

@@ -157,12 +157,12 @@ def run(args) -> int:
     summary = _finite({"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)})
     master = mc.master_data()
     law = mc.shift_law()
-    comments = [f"master curve at {mc.reference_temperature:g} C of {len(mc.temperatures)} "
-                f"isotherms ({min(mc.temperatures):g} to {max(mc.temperatures):g} C), shifted "
+    comments = [f"master curve at {mc.reference_temperature:g} °C of {len(mc.temperatures)} "
+                f"isotherms ({min(mc.temperatures):g} to {max(mc.temperatures):g} °C), shifted "
                 f"by the posterior mean log10 a_T"
                 + ("" if mc.vertical == "none" else f" and log10 b_T ({mc.vertical})")
                 + f" of bayesfo mastercurve ({mc.structure})",
-                f"temperature: {mc.reference_temperature:g} C",
+                f"temperature: {mc.reference_temperature:g} °C",
                 f"shift law: {law['name']} "
                 + ", ".join(f"{k} = {v['mean']:.6g} {v['unit']}".rstrip()
                             for k, v in law["parameters"].items())]

@@ -425,6 +425,11 @@ class Comparison:
                 f"({self.data.n_frequencies} frequencies, {self.data.kind}){best}"
                 + (f"; {failed} failed" if failed else "") + ">")
 
+    def _repr_html_(self) -> str:
+        from ..output.notebook import comparison_html
+
+        return comparison_html(self)
+
     def summary(self) -> str:
         """The ranking as ``bayesfo compare`` prints it
         (:func:`~bayesfo.comparison.table.ranking_lines`): per structure ln Z ± error (L: from

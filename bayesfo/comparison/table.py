@@ -169,12 +169,19 @@ def number(value, spec: str = ".2f", missing: str = "-") -> str:
 
     Examples
     --------
+    A value that rounds to zero is written without a sign ("0.000", not "-0.000").
+
     >>> number(-12.3456), number(float("nan")), number(None, missing="–")
     ('-12.35', '-', '–')
+    >>> number(-1e-17, ".3f"), number(-0.0004, ".3f"), number(-0.0, "g")
+    ('0.000', '0.000', '0')
     """
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return missing
-    return format(value, spec)
+    text = format(value, spec)
+    if text.startswith("-") and not any(c in "123456789" for c in text.split("e")[0]):
+        return text[1:]
+    return text
 
 
 def order_means(row: dict) -> str:

@@ -376,7 +376,7 @@ class FrequencyResponse:
     def to_csv_text(self, comments=()) -> str:
         """The response as CSV text of the contract (numbers written exactly), with ``# name:``,
         ``# kind:``, ``# units:`` and, for a symbol other than the default G, ``# symbol:``
-        lines, and then ``comments`` (e.g. ``"temperature: 20 C"``), each as a ``#`` line."""
+        lines, and then ``comments`` (e.g. ``"temperature: 20 °C"``), each as a ``#`` line."""
         lines = []
         if self.name:
             lines.append(f"# name: {self.name}")

@@ -164,7 +164,7 @@ def contract_text(data: FrequencyResponse, temperature: float | None = None) -> 
     ``# note:`` lines (:meth:`FrequencyResponse.to_csv_text`)."""
     comments = []
     if temperature is not None:
-        comments.append(f"temperature: {temperature!r} C")
+        comments.append(f"temperature: {temperature!r} °C")
     if data.source:
         comments.append(f"source: {data.source}")
     comments.extend(f"note: {note}" for note in data.notes)

@@ -86,9 +86,18 @@ def in_symbol(text: str, symbol: str) -> str:
 def parameter_label(name: str, symbol: str) -> str:
     """A parameter's name as shown for data measured as ``symbol``: a modulus named by its
     shear letter (``G_e``, ``G_m``, ``G_k``) takes the tensile letter (``E_e``) for tensile
-    data; every other name, and every name for shear data, stays."""
+    data; the Maxwell modulus the thesis calls ``E`` takes the data's modulus letter (``G``
+    for shear data); every other name stays.
+
+    Examples
+    --------
+    >>> parameter_label("G_e", "E"), parameter_label("E", "G"), parameter_label("E", "E")
+    ('E_e', 'G', 'E')
+    """
     if mode(symbol) == "tensile" and re.fullmatch(r"G_[A-Za-z0-9_]+", name):
         return "E" + name[1:]
+    if name == "E":
+        return modulus_symbol(symbol)
     return name
 
 

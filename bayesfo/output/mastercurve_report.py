@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 from .._io import atomic_write_text
+from ..comparison.table import number
 from .report import CSS, _e, _figures_section, _num
 
 #: Captions of the master curve's figures.
@@ -119,9 +120,11 @@ def _shifts_table(mc) -> str:
     rows = []
     for f in mc.shift_factors():
         a, b = f["log10_aT"], f["log10_bT"]
-        rows.append(f"<tr><td>{f['temperature']:g}</td><td>{a['mean']:.3f}</td>"
-                    f"<td>{a['sd']:.3f}</td><td>[{a['hdi_low']:.3f}, {a['hdi_high']:.3f}]</td>"
-                    + (f"<td>{b['mean']:.3f}</td><td>{b['sd']:.3f}</td>" if vertical else "")
+        n = {k: number(v, ".3f") for k, v in a.items()}  # no "-0.000" at the reference
+        m = {k: number(v, ".3f") for k, v in b.items()}
+        rows.append(f"<tr><td>{f['temperature']:g}</td><td>{n['mean']}</td>"
+                    f"<td>{n['sd']}</td><td>[{n['hdi_low']}, {n['hdi_high']}]</td>"
+                    + (f"<td>{m['mean']}</td><td>{m['sd']}</td>" if vertical else "")
                     + "</tr>")
     return "<table>" + head + "".join(rows) + "</table>"
 

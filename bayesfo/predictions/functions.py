@@ -111,6 +111,22 @@ class Prediction:
     window: tuple[float, float] | None = None
     temperature: float | None = None
 
+    def __repr__(self) -> str:
+        from ..structures.physical import in_brackets
+
+        who = self.structure if self.weights is None else f"{self.average} average"
+        x = np.asarray(self.x, float)
+        span = f" ({x.min():.4g} to {x.max():.4g} {self.x_unit})" if x.size else ""
+        return (f"<Prediction of {self.symbol or QUANTITIES[self.quantity][1]}"
+                f"{in_brackets(self.unit)} from {who} at {x.size} points{span}"
+                + (f", {int(np.sum(self.extrapolated))} extrapolated"
+                   if np.any(self.extrapolated) else "") + ">")
+
+    def _repr_html_(self) -> str:
+        from ..output.notebook import prediction_html
+
+        return prediction_html(self)
+
     def to_dict(self) -> dict:
         """The JSON form (``bayesfo predict --json``): plain lists, NaN as None."""
         def plain(a):

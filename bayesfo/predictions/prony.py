@@ -1,34 +1,42 @@
 """Prony series of a compared model for finite-element codes.
 
-G(t) = G∞ + Σ g_i exp(−t/τ_i) with the τ_i fixed, ``per_decade`` of them per decade from two
-decades below 1/ω_max to two decades above 1/ω_min, and G∞, g_i ≥ 0 fitted by non-negative least
-squares to the posterior median of G′(ω) and G″(ω) (relative residuals, 20 frequencies per
-decade over the data window widened by a decade each side). G∞ is 0 where the model relaxes
+G(t) = G∞ + Σ g_i exp(−t/τ_i) with the τ_i log-spaced from two decades below 1/ω_max to two
+decades above 1/ω_min, and G∞, g_i ≥ 0 fitted by non-negative least squares to the posterior
+median of G′(ω) and G″(ω) (relative residuals, 20 frequencies per decade over the data window
+widened by a decade each side). The number of τ_i is by default the fewest whose series' G(t)
+stays inside the model's own 94 % band at each of :data:`DENSE` log-spaced times over the data
+window (more would describe the model more closely than the data know it); a number, or a
+number per decade, may be given instead. G∞ is 0 where the model relaxes
 fully (a liquid: its long-time modulus, the limit of G(t) as t → ∞, is 0 for the median draw),
 and the τ_i then reach a decade further; else G∞ is fitted with the terms; ``liquid`` forces
 either. A fitted G∞ is the series' modulus beyond its longest relaxation time: a fractional
 model still relaxing there (a springpot relaxes over every decade) has a long-time modulus
 below it, which the files state beside it.
 
-How well the series stands for the model is stated: the largest relative error of its G′, G″
-and G(t) against the posterior medians over the data window, beside the half-width of the
-model's own 94 % band of G(t) there (a series whose error is well inside the band adds nothing
-the data could tell).
+How well the series stands for the model is stated, each error the largest over the data
+window on a dense grid and named for what it measures: |ΔG(t)|/G(t) at :data:`DENSE` times,
+|ΔG*|/|G*|, |ΔG′|/G′ and |ΔG″|/G″ at :data:`DENSE` frequencies; beside them the model's band
+of G(t) and how far the series departs within it.
 
-Formats: ``csv`` (``tau_s,g_i`` with ``#`` lines for G∞, G0, the unit and the errors), ``abaqus``
-(``*VISCOELASTIC, TIME=PRONY``: g_i/G0, k_i = 0, τ_i; G0 in a comment, for ``*ELASTIC,
-MODULI=INSTANTANEOUS``), ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` pairs of α_i = g_i/G0
-and τ_i) and ``lsdyna`` (``*MAT_GENERAL_VISCOELASTIC``, fixed 10-character fields: rows of G_i
-and the decay constant β_i = 1/τ_i, G∞ as a row with β = 0, at most :data:`LSDYNA_MAX_TERMS`
-rows; RO and BULK, which a shear measurement does not give, are left for the user).
+Formats (written by :mod:`.decks`): ``csv`` (``tau_s,g_i`` with ``#`` lines for G∞, G0,
+the unit and the errors), ``abaqus`` (``*VISCOELASTIC, TIME=PRONY``: g_i/G0, k_i = 0, τ_i; G0 in a comment, for ``*ELASTIC,
+MODULI=INSTANTANEOUS``), ``ansys`` (``TB,PRONY,,,N,SHEAR`` and ``TBDATA`` commands of three
+values, α_i = g_i/G0 and τ_i in turn, as ANSYS's TBFT writes them) and ``lsdyna``
+(``*MAT_GENERAL_VISCOELASTIC``, fixed 10-character fields: rows of G_i and the decay constant
+β_i = 1/τ_i, G∞ as a row with β = 0, at most :data:`LSDYNA_MAX_TERMS` rows; RO and BULK,
+which a shear or tensile measurement does not give, are left for the user). The ratios g_i/G0
+that Abaqus and ANSYS take sum to at most :data:`RATIO_SUM_MAX` (a liquid's, which sum to 1,
+are scaled by 1 − 1e-6): those codes refuse a sum of 1.
 
 A series fitted to a master curve is the material at the reference temperature, and its shift
 law goes with it (the law of larger support, posterior means): Abaqus ``*TRS`` (``WLF``:
 θ0, C1, C2; ``ARRHENIUS``: θ0, E0, R, θZ = −273.15 for temperatures in °C), ANSYS
 ``TB,SHIFT`` (``WLF``: T_r, C1, C2, whose log10 A = C1 (T − T_r)/(C2 + T − T_r) is the
 inverse of a_T; Arrhenius as the two-constant Tool–Narayanaswamy form ``TN``: T_r and
-E_a/R, in kelvin), and the csv's comment lines; the law's fit to the shifts and its
-temperature range are stated beside it.
+E_a/R, in kelvin), LS-DYNA's TREF, A, B (:meth:`Prony.lsdyna_shift`) and the csv's comment
+lines; the law's fit to the shifts and its temperature range are stated beside it. A law the
+evidence rejects (free shifts of larger ln Z under ``law="auto"``) is not written: the files
+say so and list the isotherms' own shifts.
 """
 
 from __future__ import annotations
@@ -56,6 +64,15 @@ LIQUID_MARGIN = 1
 EXTRAPOLATED = 1.5
 
 
+#: A modulus ratio sum Abaqus and ANSYS take: Σ g_i/G0 < 1 (a relaxed modulus above zero);
+#: the ratios written sum to at most this.
+RATIO_SUM_MAX = 1 - 1e-6
+#: Log-spaced times (and frequencies) over the data window the series is judged on.
+DENSE = 2001
+#: Significant digits of the moduli, ratios and times written.
+DIGITS = 10
+
+
 @dataclass(frozen=True)
 class Prony:
     """A Prony series and how well it stands for the model.
@@ -72,15 +89,17 @@ class Prony:
     window : (float, float)
         The times [s] the data cover, 1/ω_max to 1/ω_min.
     max_rel_error_modulus, max_rel_error_relaxation : float
-        Largest relative error of the series' G* (|ΔG*|/|G*|), and of its G(t) (relative to
-        G(t), or to 0.1 % of G0 where G(t) has relaxed below that), against the posterior
-        medians over the window.
+        Largest relative error of the series' G* (|ΔG*|/|G*| at :data:`DENSE` log-spaced
+        frequencies over the window), and of its G(t) (relative to G(t), or to 0.1 % of G0
+        where G(t) has relaxed below that, at :data:`DENSE` log-spaced times), against the
+        posterior medians.
     band_rel_halfwidth : float
         The smallest relative half-width of the model's 94 % band of G(t) over the window.
     shift_law : dict or None
         For a master curve: ``{"name": "wlf" | "arrhenius", "reference_temperature",
         "parameters": {NAME: value}, "temperatures": (min, max), "chi2_per_dof"}`` (values
-        in °C and J/mol, posterior means), written with the series.
+        in °C and J/mol, posterior means), written with the series; None where the evidence
+        rejects every law (see ``shift_note``).
     symbol : str
         The letter of the measured quantity (``"G"`` shear, ``"E"`` tensile; see
         :mod:`bayesfo.data.symbols`), which the files name.
@@ -90,6 +109,22 @@ class Prony:
     model_g_inf : float
         The model's own long-time modulus, lim G(t) as t → ∞ (the median over the draws; 0 for
         a liquid; NaN where unknown), beside the series' ``g_inf``.
+    max_rel_error_storage, max_rel_error_loss : float
+        Largest |ΔG′|/G′ and |ΔG″|/G″ at the :data:`DENSE` frequencies, each part on its own
+        (G″ is small where G′ dominates, so its relative error can be far larger than G*'s).
+    band_fraction : float
+        The series' largest departure from the model's median G(t) over the window, as a
+        fraction of the band's reach on that side: at most 1 where the series stays inside
+        the model's 94 % band at every one of the :data:`DENSE` times.
+    rule : str
+        How the number of terms was chosen: ``"auto"`` (the fewest inside the band),
+        ``"N terms"`` or ``"K per decade"``.
+    max_terms : int or None
+        The most terms ``"auto"`` could take (LS-DYNA's 18), None for no limit.
+    shift_note : str
+        For a master curve whose evidence rejects every shift law: why none is written.
+    shift_table : tuple of (float, float)
+        Then the isotherms' own shifts, (temperature [°C], log10 a_T) at posterior means.
     """
 
     tau: np.ndarray
@@ -105,11 +140,39 @@ class Prony:
     symbol: str = "G"
     measured_max: float = math.nan
     model_g_inf: float = math.nan
+    max_rel_error_storage: float = math.nan
+    max_rel_error_loss: float = math.nan
+    band_fraction: float = math.nan
+    rule: str = ""
+    max_terms: int | None = None
+    shift_note: str = ""
+    shift_table: tuple = ()
 
     @property
     def g_0(self) -> float:
         """The instantaneous modulus G∞ + Σ g_i."""
         return float(self.g_inf + np.sum(self.g))
+
+    @property
+    def inside_band(self) -> bool:
+        """Whether the series' G(t) stays inside the model's 94 % band over the window."""
+        return bool(self.band_fraction <= 1.0)
+
+    def __repr__(self) -> str:
+        from ..data.symbols import modulus_symbol
+
+        e = modulus_symbol(self.symbol)
+        unit = _unit_suffix(self.unit)
+        band = ("inside" if self.inside_band else "outside") if not math.isnan(
+            self.band_fraction) else "not judged against"
+        return (f"<Prony series of {self.source}: {self.tau.size} terms, {e}0 = "
+                f"{self.g_0:.6g}{unit}, {e}_inf = {self.g_inf:.6g}{unit}; max |d{e}(t)|/{e}(t) "
+                f"{self.max_rel_error_relaxation:.2g}, {band} the model's band>")
+
+    def _repr_html_(self) -> str:
+        from ..output.notebook import prony_html
+
+        return prony_html(self)
 
     def relaxation(self, t) -> np.ndarray:
         t = np.asarray(t, float)
@@ -119,107 +182,73 @@ class Prony:
         s = 1j * np.asarray(omega, float)[..., None] * self.tau
         return self.g_inf + np.sum(self.g * s / (1 + s), axis=-1)
 
-    def text(self, fmt: str) -> str:
-        """The series in ``fmt`` (one of :data:`FORMATS`)."""
-        if fmt not in FORMATS:
-            raise InputError(f"export: format must be one of {', '.join(FORMATS)}, got {fmt!r}")
-        from ..data.symbols import mode as mode_of
+    def ratios(self) -> np.ndarray:
+        """g_i/G0 as Abaqus and ANSYS take them, written to :data:`DIGITS` digits: every
+        one > 0 and their sum at most :data:`RATIO_SUM_MAX` (a liquid's ratios, which sum to
+        1, are scaled down by 1e-6: those codes refuse Σ g_i/G0 ≥ 1)."""
+        r = self.g / self.g_0
+        total = float(np.sum(r))
+        if total > RATIO_SUM_MAX:
+            r = r * ((RATIO_SUM_MAX - 1e-9) / total)
+        written = np.array([float(f"{v:.{DIGITS}g}") for v in r])
+        while float(np.sum(written)) > RATIO_SUM_MAX:  # rounding up, at most a step or two
+            written = np.array([float(f"{v:.{DIGITS}g}") for v in written * (1 - 1e-9)])
+        return written
+
+    def _ratio_text(self) -> list[str]:
+        """What the ratios' sum stands for, where it had to be kept below 1."""
+        if float(np.sum(self.g / self.g_0)) <= RATIO_SUM_MAX:
+            return []
+        return [f"the ratios g_i/g_0 are scaled by (1 - 1e-6) so that they sum to less than "
+                f"1, as the code requires: its long-time modulus is then 1e-6 g_0 "
+                f"({1e-6 * self.g_0:.3g}{_unit_suffix(self.unit)}), where the series has "
+                f"{self.g_inf:.6g}"]
+
+    def error_text(self) -> list[str]:
+        """The stated errors, each named for what it measures, and the band."""
         from ..data.symbols import modulus_symbol
 
-        e, mode = modulus_symbol(self.symbol), mode_of(self.symbol)
-        head = [f"Prony series of {self.source} (bayesfo), {mode} modulus {e} in "
-                f"{self.unit or 'the data unit'}, as measured",
-                f"fitted over t = {self.window[0]:.4g} to {self.window[1]:.4g} s (the data window)",
-                *self._reach_text(),
-                f"g_inf = {self.g_inf:.10g}", f"g_0 = {self.g_0:.10g}",
-                *self.long_time_text(),
-                f"max_rel_error = {max(self.max_rel_error_modulus, self.max_rel_error_relaxation):.3g}"
-                f" ({e}', {e}'': {self.max_rel_error_modulus:.3g}; {e}(t): "
-                f"{self.max_rel_error_relaxation:.3g}); the model's 94 % band of {e}(t) is at "
-                f"least +-{self.band_rel_halfwidth:.3g} (relative) there"]
-        head += self.extrapolation_text()
-        if mode == "tensile" and fmt in ("abaqus", "ansys"):
-            head.append("a tensile series: its ratios g_i/g_0 stand for the shear ratios the "
-                        "code takes under a constant Poisson's ratio")
-        law = self.shift_law
-        if law is not None:
-            head.append(self._law_text())
-        if fmt == "csv":
-            lines = [f"# {h}" for h in head] + ["tau_s,g_i"]
-            lines += [f"{t:.10g},{g:.10g}" for t, g in zip(self.tau, self.g, strict=True)]
-        elif fmt == "abaqus":
-            lines = [f"** {h}" for h in head]
-            # *ELASTIC takes Young's modulus and Poisson's ratio: a shear series' G0 is
-            # E0 = 2 (1 + nu) G0 there; a tensile series' own G0 is E0.
-            lines.append(f"** instantaneous modulus {e}0 = {self.g_0:.10g}: give "
-                         + ("it" if mode == "tensile" else f"E0 = 2 (1 + nu) {e}0")
-                         + " with Poisson's ratio nu in *ELASTIC, MODULI=INSTANTANEOUS")
-            lines.append("*VISCOELASTIC, TIME=PRONY")
-            lines += [f"{g / self.g_0:.10g}, 0., {t:.10g}"
-                      for t, g in zip(self.tau, self.g, strict=True)]
-            if law is not None:
-                p, t_ref = law["parameters"], law["reference_temperature"]
-                if law["name"] == "wlf":
-                    lines += ["*TRS, DEFINITION=WLF", f"{t_ref:.10g}, {p['C1']:.10g}, "
-                                                      f"{p['C2']:.10g}"]
-                else:
-                    lines += ["*TRS, DEFINITION=ARRHENIUS",
-                              f"{t_ref:.10g}, {p['Ea']:.10g}, {GAS_CONSTANT:.10g}, {-KELVIN:.10g}"]
-        elif fmt == "lsdyna":
-            lines = self._lsdyna(head)
-        else:  # ansys
-            lines = [f"! {h}" for h in head]
-            lines.append(f"! instantaneous modulus G0 = {self.g_0:.10g}")
-            lines.append(f"TB,PRONY,1,,{self.tau.size},SHEAR")
-            pairs = [v for t, g in zip(self.tau, self.g, strict=True)
-                     for v in (g / self.g_0, t)]
-            for start in range(0, len(pairs), 6):  # TBDATA takes six values per command
-                chunk = ",".join(f"{v:.10g}" for v in pairs[start:start + 6])
-                lines.append(f"TBDATA,{start + 1},{chunk}")
-            if law is not None:
-                p, t_ref = law["parameters"], law["reference_temperature"]
-                if law["name"] == "wlf":
-                    lines += ["TB,SHIFT,1,,3,WLF",
-                              f"TBDATA,1,{t_ref:.10g},{p['C1']:.10g},{p['C2']:.10g}"]
-                else:
-                    lines += ["! Arrhenius as Tool-Narayanaswamy: ln A = (Ea/R) (1/T_r - 1/T), "
-                              "T in kelvin", "TB,SHIFT,1,,2,TN",
-                              f"TBDATA,1,{t_ref + KELVIN:.10g},{p['Ea'] / GAS_CONSTANT:.10g}"]
-        return "\n".join(lines) + "\n"
-
-    def _lsdyna(self, head: list[str]) -> list[str]:
-        """*MAT_GENERAL_VISCOELASTIC in LS-DYNA's fixed 10-character fields."""
-        rows = [(g, 1.0 / t) for t, g in zip(self.tau, self.g, strict=True)]
-        if self.g_inf > 0:
-            rows.append((self.g_inf, 0.0))
-        if len(rows) > LSDYNA_MAX_TERMS:
-            raise InputError(f"export: LS-DYNA's *MAT_GENERAL_VISCOELASTIC takes at most "
-                             f"{LSDYNA_MAX_TERMS} terms (G_inf counts as one), this series has "
-                             f"{len(rows)}; ask for fewer (terms {LSDYNA_MAX_TERMS - 1} or 1 per "
-                             "decade)")
-
-        def field(v: float) -> str:  # 4 significant digits: a blank keeps the fields apart
-            return f"{v:10.3E}" if v != 0 else f"{0.0:10.1f}"
-
-        lines = [f"$ {h}" for h in head]
-        lines += ["$ GI: shear moduli in the data's unit (a tensile E series: divide each by "
-                  "2(1+nu)); BETAI = 1/tau_i [1/s]; the row with BETAI = 0 is G_inf",
-                  "$ RO (density) and BULK (bulk modulus) are not measured in shear: give them "
-                  "in the units of your model"]
-        if self.shift_law is not None:
-            lines.append("$ TREF, A, B (the shift function) are left 0: enter the shift law "
-                         "above in the convention of your LS-DYNA version")
-        lines += ["*KEYWORD", "*MAT_GENERAL_VISCOELASTIC",
-                  "$      MID        RO      BULK       PCF        EF      TREF         A"
-                  "         B",
-                  f"{1:>10d}" + " " * 20 + field(0.0) * 5,
-                  "$     LCID        NT    BSTART     TRAMP     LCIDK       NTK   BSTARTK"
-                  "    TRAMPK",
-                  f"{0:>10d}{0:>10d}" + field(0.0) * 2 + f"{0:>10d}{0:>10d}" + field(0.0) * 2,
-                  "$       GI     BETAI        KI    BETAKI"]
-        lines += [field(g) + field(b) + field(0.0) * 2 for g, b in rows]
-        lines.append("*END")
+        e = modulus_symbol(self.symbol)
+        error = max(self.max_rel_error_modulus, self.max_rel_error_relaxation)
+        lines = [f"max_rel_error = {error:.3g}: the larger of max |d{e}(t)|/{e}(t) and "
+                 f"max |d{e}*|/|{e}*| below, over the data window",
+                 f"max |d{e}(t)|/{e}(t) = {self.max_rel_error_relaxation:.3g} at {DENSE} "
+                 f"log-spaced times (relative to {e}(t), or to 0.1 % of {e}0 where {e}(t) has "
+                 "relaxed below that)",
+                 f"max |d{e}*|/|{e}*| = {self.max_rel_error_modulus:.3g}, max |d{e}'|/{e}' = "
+                 f"{self.max_rel_error_storage:.3g}, max |d{e}''|/{e}'' = "
+                 f"{self.max_rel_error_loss:.3g}, each at {DENSE} log-spaced frequencies"]
+        where = ("stays inside it at every time" if self.inside_band
+                 else "leaves it")
+        lines.append(f"the model's 94 % band of {e}(t) is at least +-"
+                     f"{self.band_rel_halfwidth:.3g} (relative) over the window; the series "
+                     f"{where} (largest departure {self.band_fraction:.3g} of the band's reach)")
         return lines
+
+    def terms_text(self) -> list[str]:
+        """How the number of terms was chosen."""
+        n = self.tau.size
+        if self.rule != "auto":
+            return [f"{n} terms ({self.rule})"] if self.rule else []
+        if self.inside_band:
+            return [f"{n} terms: the fewest log-spaced relaxation times whose series stays "
+                    "inside the model's 94 % band"]
+        return [f"{n} terms: the most the card takes ({self.max_terms}, g_inf counted), and "
+                "the series still leaves the model's 94 % band"]
+
+    def text(self, fmt: str) -> str:
+        """The series in ``fmt`` (one of :data:`FORMATS`; :func:`~.decks.deck_text`)."""
+        from .decks import deck_text
+
+        return deck_text(self, fmt)
+
+    def lsdyna_shift(self) -> tuple[float, float, float] | None:
+        """TREF [K], A and B of *MAT_GENERAL_VISCOELASTIC for the shift law, None without one
+        (:func:`~.decks.lsdyna_shift`: A = −C1 ln 10, B = C2 for WLF; A = E_a/R, B = 0 for
+        Arrhenius)."""
+        from .decks import lsdyna_shift
+
+        return lsdyna_shift(self)
 
     def _reach_text(self) -> list[str]:
         """Where the relaxation times lie against the data window: terms beyond it stand for
@@ -251,7 +280,7 @@ class Prony:
         model, longest = self.model_g_inf, float(np.max(self.tau)) if self.tau.size else math.nan
         if math.isnan(model):
             return []
-        unit = f" {self.unit}" if self.unit else ""
+        unit = _unit_suffix(self.unit)
         if self.g_inf == 0.0:
             return (["g_inf = 0: the model relaxes fully (a liquid)"] if model == 0.0 else
                     [f"g_inf = 0 as asked, where the model's long-time modulus is {model:.6g}"
@@ -268,26 +297,27 @@ class Prony:
         lo, hi = law["temperatures"]
         if law["name"] == "wlf":
             form = (f"WLF log10 a_T = -C1 (T - T_ref)/(C2 + T - T_ref), T_ref = "
-                    f"{law['reference_temperature']:.10g} C, C1 = {p['C1']:.10g}, "
-                    f"C2 = {p['C2']:.10g} C")
+                    f"{law['reference_temperature']:.10g} °C, C1 = {p['C1']:.10g}, "
+                    f"C2 = {p['C2']:.10g} °C")
         else:
             form = (f"Arrhenius log10 a_T = Ea/(R ln 10) (1/T - 1/T_ref) in kelvin, T_ref = "
-                    f"{law['reference_temperature']:.10g} C, Ea = {p['Ea']:.10g} J/mol")
-        return (f"shift law: {form}; fitted to the shifts of isotherms at {lo:g} to {hi:g} C "
+                    f"{law['reference_temperature']:.10g} °C, Ea = {p['Ea']:.10g} J/mol")
+        return (f"shift law: {form}; fitted to the shifts of isotherms at {lo:g} to {hi:g} °C "
                 f"(chi2/dof {law['chi2_per_dof']:.3g})")
 
 
-def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
+def prony_series(result, *, per_decade: int | None = None, liquid: bool | None = None,
                  structure: str | None = None, average: str | None = None,
-                 seed: int = 0, terms: int | None = None) -> Prony:
+                 seed: int = 0, terms: int | str | None = None,
+                 max_terms: int | None = None) -> Prony:
     """A Prony series fitted to a comparison's structure (default the best ranked) or average.
 
     Parameters
     ----------
     result : Comparison or MasterCurve
         A master curve gives the series at its reference temperature, with its shift law.
-    per_decade : int
-        Relaxation times per decade (1 to 10).
+    per_decade : int, optional
+        Relaxation times per decade (1 to 10) instead of the fewest that suffice.
     liquid : bool, optional
         True: G∞ = 0 (a liquid relaxes completely); False: G∞ fitted with the terms; None
         (default): 0 where the model's long-time modulus is 0 for the median draw
@@ -298,27 +328,41 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
         An average over the structures instead, as in :func:`bayesfo.predict`.
     seed : int
         Seeds the draws used.
-    terms : int, optional
-        The number of relaxation times (2 to 100, log-spaced over the same span) instead of
-        ``per_decade``; terms whose weight comes out zero are dropped, so the series may have
-        fewer.
+    terms : int or "auto", optional
+        ``"auto"`` (the default unless ``per_decade`` is given): the fewest relaxation times,
+        log-spaced over the span, whose series' G(t) stays inside the model's 94 % band at
+        every one of :data:`DENSE` log-spaced times over the data window. An integer (2 to
+        100): that many relaxation times over the same span. Either way terms whose weight
+        comes out zero are dropped, so the series may have fewer.
+    max_terms : int, optional
+        With ``terms="auto"``: at most this many terms, G∞ counted as one where it is
+        fitted (LS-DYNA's card takes 18); where none of those stays inside the band, the one
+        that departs least from it.
 
     Returns
     -------
     Prony
     """
-    from scipy.optimize import nnls
-
     from .functions import predict
     from .long_time import long_time_modulus
 
-    if isinstance(per_decade, bool) or not isinstance(per_decade, int) or not 1 <= per_decade <= 10:
+    if per_decade is not None and (isinstance(per_decade, bool) or not isinstance(per_decade, int)
+                                   or not 1 <= per_decade <= 10):
         raise InputError(f"export: terms per decade must be an integer from 1 to 10, got "
                          f"{per_decade!r}")
-    if terms is not None and (isinstance(terms, bool) or not isinstance(terms, int)
-                              or not 2 <= terms <= 100):
-        raise InputError(f"export: the number of terms must be an integer from 2 to 100, got "
-                         f"{terms!r}")
+    if terms is None:
+        terms = "auto" if per_decade is None else None
+    elif per_decade is not None:
+        raise InputError("export: give the number of terms or terms per decade, not both")
+    if terms is not None and terms != "auto" and (isinstance(terms, bool)
+                                                  or not isinstance(terms, int)
+                                                  or not 2 <= terms <= 100):
+        raise InputError(f"export: the number of terms must be 'auto' or an integer from 2 to "
+                         f"100, got {terms!r}")
+    if max_terms is not None and (isinstance(max_terms, bool) or not isinstance(max_terms, int)
+                                  or max_terms < 2):
+        raise InputError(f"export: max_terms must be an integer of at least 2, got "
+                         f"{max_terms!r}")
     master = hasattr(result, "shift_draws")
     window_omega = result.reduced_omega() if master else result.data.omega
     w_lo, w_hi = float(np.min(window_omega)), float(np.max(window_omega))
@@ -333,14 +377,81 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
         liquid = model_g_inf == 0.0
     if not np.all(np.isfinite(g)):
         raise InputError("export: the model's modulus is not finite over the window")
+    window = (1.0 / w_hi, 1.0 / w_lo)
+    # The dense grids the series is judged on: its G(t) against the model's band at DENSE
+    # times, its G′ and G″ against the medians at DENSE frequencies, both over the window.
+    t = np.logspace(math.log10(window[0]), math.log10(window[1]), DENSE)
+    g_t = predict(result, "relaxation_modulus", t, **kw)
+    w = np.logspace(math.log10(w_lo), math.log10(w_hi), DENSE)
+    g_w = predict(result, "storage", w, **kw).median + 1j * predict(result, "loss", w, **kw).median
     # The terms reach TAU_MARGIN decades past the window: a power-law spectrum (a springpot)
     # relaxes over every decade, and terms only over the window leave its edges short.
     # Without G∞, a term further out takes the relaxation beyond the longest time that G∞
     # would have stood for.
     lo_tau = 1 / (w_hi * 10**TAU_MARGIN)
     hi_tau = 10**(TAU_MARGIN + (LIQUID_MARGIN if liquid else 0)) / w_lo
-    n = terms if terms is not None else int(round(math.log10(hi_tau / lo_tau) * per_decade)) + 1
-    tau = np.logspace(math.log10(lo_tau), math.log10(hi_tau), n)
+
+    def fit(n: int):
+        tau = np.logspace(math.log10(lo_tau), math.log10(hi_tau), n)
+        g_inf, weights = _nnls(g, omega, tau, liquid)
+        keep = weights > 0
+        tau, weights = tau[keep], weights[keep]
+        series = g_inf + np.sum(weights * np.exp(-t[:, None] / tau), axis=1)
+        return tau, weights, g_inf, _band_fraction(series, g_t)
+
+    if terms == "auto":
+        cap = max_terms if max_terms is not None else 100
+        best = None
+        for n in range(2, 101):
+            found = fit(n)
+            if found[0].size + (0 if liquid else 1) > cap:
+                break
+            if best is None or found[3] < best[3]:
+                best = found
+            if found[3] <= 1.0:
+                best = found
+                break
+        tau, weights, g_inf, _ = best
+        rule = "auto"
+    else:
+        n = terms if terms is not None else \
+            int(round(math.log10(hi_tau / lo_tau) * per_decade)) + 1
+        tau, weights, g_inf, _ = fit(n)
+        rule = f"{terms} terms" if terms is not None else f"{per_decade} per decade"
+    fitted = Prony(tau=tau, g=weights, g_inf=g_inf, unit=storage.unit,
+                   source=(f"the master curve of {result.structure} at "
+                           f"{result.reference_temperature:g} °C" if master
+                           else storage.structure or f"{storage.average} average"),
+                   window=window,
+                   max_rel_error_modulus=math.nan, max_rel_error_relaxation=math.nan,
+                   band_rel_halfwidth=math.nan)
+    series_w = fitted.modulus(w)
+    err_g = float(np.max(np.abs(series_w - g_w) / np.abs(g_w)))
+    err_storage = float(np.max(np.abs(series_w.real - g_w.real) / np.abs(g_w.real)))
+    err_loss = float(np.max(np.abs(series_w.imag - g_w.imag) / np.abs(g_w.imag)))
+    # Relative to G(t), or to 0.1 % of G0 where G(t) has relaxed below it (a liquid's tail).
+    scale = np.maximum(np.abs(g_t.median), 1e-3 * fitted.g_0)
+    series_t = fitted.relaxation(t)
+    err_t = float(np.max(np.abs(series_t - g_t.median) / scale))
+    half = float(np.min((g_t.hdi_high - g_t.hdi_low) / 2 / np.abs(g_t.median)))
+    from dataclasses import replace
+
+    data = result.master_data() if master else result.data
+    measured = np.abs(data.response if data.kind == "modulus" else 1.0 / data.response)
+    law, law_note, table = _shift_law(result) if master else (None, "", ())
+    return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
+                   band_rel_halfwidth=half, shift_law=law,
+                   symbol=data.symbol, measured_max=float(np.max(measured)),
+                   model_g_inf=model_g_inf, max_rel_error_storage=err_storage,
+                   max_rel_error_loss=err_loss, band_fraction=_band_fraction(series_t, g_t),
+                   rule=rule, max_terms=max_terms, shift_note=law_note, shift_table=table)
+
+
+def _nnls(g: np.ndarray, omega: np.ndarray, tau: np.ndarray, liquid: bool):
+    """G∞ (0 for a liquid) and the g_i ≥ 0 of the relaxation times ``tau`` by non-negative
+    least squares on the relative residuals of G′ and G″ at ``omega``."""
+    from scipy.optimize import nnls
+
     s = 1j * omega[:, None] * tau
     basis = s / (1 + s)
     if not liquid:
@@ -349,38 +460,52 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
     a = np.vstack([(basis.real * weight[:, None]), (basis.imag * weight[:, None])])
     b = np.r_[g.real * weight, g.imag * weight]
     x, _ = nnls(a, b, maxiter=50 * a.shape[1])
-    g_inf, terms = (0.0, x) if liquid else (float(x[0]), x[1:])
-    keep = terms > 0
-    window = (1.0 / w_hi, 1.0 / w_lo)
-    fitted = Prony(tau=tau[keep], g=terms[keep], g_inf=g_inf, unit=storage.unit,
-                   source=(f"the master curve of {result.structure} at "
-                           f"{result.reference_temperature:g} C" if master
-                           else storage.structure or f"{storage.average} average"),
-                   window=window,
-                   max_rel_error_modulus=math.nan, max_rel_error_relaxation=math.nan,
-                   band_rel_halfwidth=math.nan)
-    inside = (omega >= w_lo) & (omega <= w_hi)
-    err_g = float(np.max(np.abs(fitted.modulus(omega[inside]) - g[inside]) / np.abs(g[inside])))
-    t = np.logspace(math.log10(window[0]), math.log10(window[1]), 50)
-    g_t = predict(result, "relaxation_modulus", t, **kw)
-    # Relative to G(t), or to 0.1 % of G0 where G(t) has relaxed below it (a liquid's tail).
-    scale = np.maximum(np.abs(g_t.median), 1e-3 * fitted.g_0)
-    err_t = float(np.max(np.abs(fitted.relaxation(t) - g_t.median) / scale))
-    half = float(np.min((g_t.hdi_high - g_t.hdi_low) / 2 / np.abs(g_t.median)))
-    from dataclasses import replace
-
-    data = result.master_data() if master else result.data
-    measured = np.abs(data.response if data.kind == "modulus" else 1.0 / data.response)
-    return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
-                   band_rel_halfwidth=half, shift_law=_shift_law(result) if master else None,
-                   symbol=data.symbol, measured_max=float(np.max(measured)),
-                   model_g_inf=model_g_inf)
+    return (0.0, x) if liquid else (float(x[0]), x[1:])
 
 
-def _shift_law(mc) -> dict:
-    """The master curve's preferred shift law, as :class:`Prony` carries it."""
+def _band_fraction(series: np.ndarray, band) -> float:
+    """The series' largest departure from the band's median as a fraction of the band's
+    reach on that side (the HDI's end): at most 1 where the series stays inside the band."""
+    above = series - band.median
+    reach = np.where(above >= 0, band.hdi_high - band.median, band.median - band.hdi_low)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        frac = np.where(above == 0, 0.0, np.abs(above) / reach)
+    return float(np.max(np.nan_to_num(frac, nan=np.inf, posinf=np.inf)))
+
+
+def _shift_law(mc) -> tuple[dict | None, str, tuple]:
+    """The master curve's preferred shift law as :class:`Prony` carries it, or None where the
+    evidence rejects every law (free shifts of larger ln Z): then a note and the isotherms'
+    own shifts, ``((T [°C], log10 a_T), ...)`` at their posterior means."""
+    evidence = getattr(mc, "law_evidence", {}) or {}
+    if mc.law == "free" and evidence and "free" in evidence and max(
+            evidence, key=lambda k: evidence[k].get("probability") or 0.0) == "free":
+        others = [k for k in evidence if k != "free"]
+        z_free = evidence["free"].get("log_evidence")
+        gaps = []
+        for k in others:
+            z = evidence[k].get("log_evidence")
+            z = z if z is not None else evidence[k].get("log_evidence_upper")
+            if z is not None and z_free is not None:
+                gaps.append(f"{'WLF' if k == 'wlf' else 'Arrhenius'} {z_free - z:.0f} nats below")
+        note = ("no shift law is written: the evidence prefers free shifts to every law ("
+                + ", ".join(gaps) + "); the isotherms' own shifts follow as a table, to enter "
+                "as tabular shifts or to interpolate between the measured temperatures")
+        table = tuple((float(t), float(a)) for t, a in zip(mc.temperatures, mc.log_shift_mean,
+                                                          strict=True))
+        return None, note, table
     law = mc.shift_law()
-    return {"name": law["name"], "reference_temperature": float(law["reference_temperature"]),
-            "parameters": {k: float(v["mean"]) for k, v in law["parameters"].items()},
-            "temperatures": (float(min(mc.temperatures)), float(max(mc.temperatures))),
-            "chi2_per_dof": float(mc.laws[law["name"]]["chi2_per_dof"])}
+    return ({"name": law["name"], "reference_temperature": float(law["reference_temperature"]),
+             "parameters": {k: float(v["mean"]) for k, v in law["parameters"].items()},
+             "temperatures": (float(min(mc.temperatures)), float(max(mc.temperatures))),
+             "chi2_per_dof": float(mc.laws[law["name"]]["chi2_per_dof"])}, "", ())
+
+
+def _has_unit(unit: str) -> bool:
+    """Whether ``unit`` names a unit: not empty, not the arbitrary unit of data without one
+    (``a.u.``: :func:`~bayesfo.structures.physical.stress_unit`, ``[G]`` of earlier versions)."""
+    return bool(unit) and "[" not in unit and "a.u." not in unit
+
+
+def _unit_suffix(unit: str) -> str:
+    return f" {unit}" if _has_unit(unit) else ""

@@ -24,7 +24,7 @@ report and the terminal show the moduli in the tensile letter, E_e for G_e
 
 Units come from the data: for modulus data in Pa the stress unit is Pa; for compliance data in
 1/Pa it is again Pa; for other units the inverse of the data's unit (``1/(µm/N)``); without
-units, ``[G]`` (modulus data) or ``1/[J]`` (compliance data, generic data). All functions take
+units, ``a.u.`` (modulus data without a unit: an arbitrary unit) or ``1/a.u.`` (compliance data, generic data). All functions take
 the *unscaled* coefficients, as the posterior draws are reported (:meth:`Structure.to_physical`).
 
 Examples
@@ -39,6 +39,7 @@ Examples
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -228,29 +229,37 @@ def display_name(name: str, symbol: str = "G") -> str:
 
 # ---------------------------------------------------------------------------- units
 def in_brackets(unit: str) -> str:
-    """`` [unit]`` after a quantity's name, nothing without a unit; the placeholder of data
-    without a unit (``[G]``, ``[J]``: :func:`stress_unit`) is not bracketed twice, alone or in
-    a compound unit (``[G s^q]``, read as the unit of G times s^q).
+    """`` [unit]`` after a quantity's name, nothing without a unit. Data without a unit have
+    the arbitrary unit ``a.u.`` (:func:`stress_unit`); the placeholder earlier versions stored
+    for it (``[G]``, ``[J]``) is read as that, never shown as a unit of its own.
 
     Examples
     --------
-    >>> in_brackets("Pa"), in_brackets("[G]"), in_brackets("[G] s^q"), in_brackets("")
-    (' [Pa]', ' [G]', ' [G s^q]', '')
-    >>> in_brackets("1/[J]")
-    ' [1/J]'
+    >>> in_brackets("Pa"), in_brackets("a.u."), in_brackets("[G]"), in_brackets("[G] s^q")
+    (' [Pa]', ' [a.u.]', ' [a.u.]', ' [a.u. s^q]')
+    >>> in_brackets("1/[J]"), in_brackets("")
+    (' [1/a.u.]', '')
     """
     if not unit:
         return ""
-    return f" [{unit.replace('[', '').replace(']', '')}]"
+    return f" [{_PLACEHOLDER.sub('a.u.', unit)}]"
+
+
+#: The placeholder unit of data without one that earlier versions stored (in the data's letter).
+_PLACEHOLDER = re.compile(r"\[[GJED]\]")
+
+
+#: The unit of data that give none: an arbitrary unit.
+ARBITRARY = "a.u."
 
 
 def stress_unit(kind: str, unit: str = "") -> str:
     """The stress unit of the physical parameters for data of ``kind`` in ``unit``."""
     u = (unit or "").strip()
     if kind == "modulus":
-        return u or "[G]"
+        return u or ARBITRARY
     if not u:
-        return "1/[J]"
+        return f"1/{ARBITRARY}"
     if u.startswith("1/"):
         inner = u[2:].strip()
         return inner[1:-1] if inner.startswith("(") and inner.endswith(")") else inner
@@ -280,8 +289,8 @@ def format_unit(stress: float, time: str, stress_symbol: str) -> str:
     --------
     >>> format_unit(-1, "0", "1/(m/N)"), format_unit(1, "0", "1/(m/N)")
     ('m/N', '1/(m/N)')
-    >>> format_unit(-1, "q", "1/[J]"), format_unit(1, "q", "Pa")
-    ('[J] s^q', 'Pa s^q')
+    >>> format_unit(-1, "q", "1/a.u."), format_unit(1, "q", "Pa")
+    ('a.u. s^q', 'Pa s^q')
     """
     if stress and stress_symbol.startswith("1/"):
         inner = stress_symbol[2:].strip()

@@ -233,6 +233,17 @@ class MasterCurve:
             b = (1 - f) * vertical[:, lo] + f * vertical[:, hi]
         return a, b
 
+    def __repr__(self) -> str:
+        temps = self.temperatures
+        return (f"<MasterCurve of {self.structure} at {self.reference_temperature:g} °C from "
+                f"{len(temps)} isotherms ({min(temps):g} to {max(temps):g} °C); shifts: "
+                + ("free" if self.law == "free" else self.law) + ">")
+
+    def _repr_html_(self) -> str:
+        from ..output.notebook import mastercurve_html
+
+        return mastercurve_html(self)
+
     def to_dict(self) -> dict:
         return {"structure": self.structure, "reference_temperature": self.reference_temperature,
                 "temperatures": list(self.temperatures),

@@ -102,7 +102,7 @@ def test_a_number_of_terms_instead_of_terms_per_decade(written, tmp_path, run_cl
     np.testing.assert_allclose(tau, many.tau, rtol=1e-9)
     status, _, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "q.csv",
                              "--terms", "1")
-    assert status == 2 and "--terms must be an integer from 2 to 100, got 1" in err
+    assert status == 2 and "--terms must be 'auto' or an integer from 2 to 100, got 1" in err
     status, _, err = run_cli("export", out, "--format", "csv", "--out", tmp_path / "q.csv",
                              "--terms", "5", "--per-decade", "3")
     assert status == 2 and "not allowed with argument" in err
@@ -119,10 +119,11 @@ def test_the_long_time_modulus_follows_the_model(written, tmp_path, run_cli):
     where it does not (the Voigt, whose long-time modulus is 1/b0); either can be forced, and
     the files and the command say which and what the model's own long-time modulus is."""
     result, out = written
-    liquid = prony_series(result, structure="maxwell-int")
+    liquid = prony_series(result, structure="maxwell-int", per_decade=2)
     assert liquid.g_inf == 0.0 and liquid.model_g_inf == 0.0
     assert "g_inf = 0: the model relaxes fully (a liquid)" in liquid.text("csv")
-    # Its two terms lie inside the data window: nothing is said of extrapolation.
+    # Its two terms (two per decade) lie inside the data window: nothing is said of
+    # extrapolation.
     assert liquid.tau.max() < liquid.window[1] and "extrapolation" not in liquid.text("csv")
     # A springpot relaxes fully, but slowly: fitted, G_inf stands for its relaxation beyond
     # the longest relaxation time.

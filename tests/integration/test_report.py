@@ -135,10 +135,10 @@ def test_ranking_table_numbers_match_the_comparison(comparison):
                "bic": 10, "rmse": 11, "rhat_max": 13}
     # WAIC is not a column (it is in ranking.csv): PSIS-LOO with its Pareto k stands for both.
     assert "elpd WAIC" not in render_report(comparison)
-    # The RMSE is in the data's unit (a compliance in 1/Pa here; the placeholder without one).
+    # The RMSE is in the data's unit (a compliance in 1/Pa here; no unit without one).
     assert "<th>RMSE [1/Pa]</th>" in render_report(comparison)
     bare = replace(comparison, data=replace(comparison.data, units=""))
-    assert "<th>RMSE [J]</th>" in render_report(bare)
+    assert "<th>RMSE [a.u.]</th>" in render_report(bare) and "[J]" not in render_report(bare)
     for rank, row in enumerate(table, start=1):
         cells = parser.rows[f"row-{row['structure']}"]
         assert cells[0][0] == str(rank) and cells[1][0] == row["structure"]

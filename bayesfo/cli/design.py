@@ -59,6 +59,9 @@ def run(args) -> int:
         if not figure.parent.is_dir():
             raise InputError(f"--figure {args.figure}: directory '{figure.parent}' does not "
                              "exist")
+        if figure.is_dir():
+            raise InputError(f"--figure {args.figure}: is a directory; give a file name in "
+                             "it (e.g. design.png)")
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     if hasattr(result, "shift_draws"):
         raise InputError(f"'{args.directory}' holds a master curve: design chooses frequencies "
@@ -75,10 +78,17 @@ def run(args) -> int:
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
     if figure is not None:
+        from .._io import write_error
         from ..plotting.design import plot_design
         from ..plotting.output import save_figure
 
-        save_figure(plot_design(result, plan, seed=args.seed).figure, figure, close=True)
+        try:
+            save_figure(plot_design(result, plan, seed=args.seed).figure, figure, close=True,
+                        named=True)
+        except OSError as exc:
+            raise InputError(f"--figure '{args.figure}': cannot be written "
+                             f"({write_error(figure, exc)}); give a file in a writable "
+                             "folder") from None
     if args.json:
         print(json.dumps(plan.to_dict(), indent=1))
         return 0

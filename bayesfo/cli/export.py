@@ -24,7 +24,9 @@ def add_parser(subparsers):
                    help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY), ansys "
                         "(TB,PRONY with TBDATA) or lsdyna (*MAT_GENERAL_VISCOELASTIC, at most "
                         "18 terms)")
-    p.add_argument("--out", required=True, metavar="FILE", help="the file to write")
+    p.add_argument("--out", required=True, metavar="FILE",
+                   help="the file to write ('-': standard output, the messages then go to "
+                        "standard error)")
     many = p.add_mutually_exclusive_group()
     many.add_argument("--per-decade", type=int, default=2, metavar="K",
                       help="relaxation times per decade (default 2)")
@@ -46,6 +48,8 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
+    import functools
+    import sys
     from pathlib import Path
 
     from .._io import atomic_write_text, write_error
@@ -71,12 +75,17 @@ def run(args) -> int:
     except InputError as exc:
         raise InputError(str(exc).replace("export: ", "", 1).replace(
             "terms 17 or 1 per decade", "--terms 17 or --per-decade 1")) from None
-    try:
-        atomic_write_text(args.out, text)
-    except OSError as exc:
-        raise InputError(f"--out '{args.out}': cannot be written "
-                         f"({write_error(args.out, exc)})") \
-            from None
+    # With --out - the series goes to standard output, and what is said of it to stderr.
+    say = functools.partial(print, file=sys.stderr if args.out == "-" else sys.stdout)
+    if args.out == "-":
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    else:
+        try:
+            atomic_write_text(args.out, text, named=True)
+        except OSError as exc:
+            raise InputError(f"--out '{args.out}': cannot be written "
+                             f"({write_error(args.out, exc)})") from None
     if args.figure is not None:
         from ._libraries import load_libraries
 
@@ -87,36 +96,38 @@ def run(args) -> int:
         drawn = plot_prony(result, prony, structure=args.structure, average=args.average,
                            seed=args.seed)
         try:
-            save_figure(drawn.figure, args.figure, close=True)
+            save_figure(drawn.figure, args.figure, close=True, named=True)
         except OSError as exc:
+            written = "" if args.out == "-" else f"; the series was written to '{args.out}'"
             raise InputError(f"--figure '{args.figure}': cannot be written "
-                             f"({write_error(args.figure, exc)})") from None
-        print(f"wrote {args.figure}")
+                             f"({write_error(args.figure, exc)}){written}") from None
+        say(f"wrote {args.figure}")
     error = max(prony.max_rel_error_modulus, prony.max_rel_error_relaxation)
-    print(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
-          f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
-          f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {args.out}")
+    where = "standard output" if args.out == "-" else args.out
+    say(f"{prony.tau.size} terms of {prony.source}, G0 = {prony.g_0:.6g}, G_inf = "
+        f"{prony.g_inf:.6g} {prony.unit}; largest relative error over the data window "
+        f"{error:.2g} (the model's 94 % band: +-{prony.band_rel_halfwidth:.2g}); wrote {where}")
     for line in prony.extrapolation_text():
-        print(f"note: {line}")
+        say(f"note: {line}")
     for line in prony.long_time_text():
         if prony.model_g_inf == 0.0:
             line += (" (--liquid sets G_inf = 0)" if prony.g_inf > 0 else
                      " (--no-liquid fits G_inf with the terms)" if args.liquid is None else "")
-        print(f"note: {line}")
+        say(f"note: {line}")
     law = prony.shift_law
     if law is not None:
         from ..tts.joint import LAW_MISS
 
-        print(f"with the {'WLF' if law['name'] == 'wlf' else 'Arrhenius'} shift law at "
-              f"T_ref = {law['reference_temperature']:g} °C (" + ", ".join(
-                  f"{k} = {v:.6g}" for k, v in law["parameters"].items()) + ")")
+        say(f"with the {'WLF' if law['name'] == 'wlf' else 'Arrhenius'} shift law at "
+            f"T_ref = {law['reference_temperature']:g} °C (" + ", ".join(
+                f"{k} = {v:.6g}" for k, v in law["parameters"].items()) + ")")
         if law["chi2_per_dof"] > LAW_MISS:
-            print(f"note: the shift law misses the master curve's shifts beyond their "
-                  f"uncertainty (chi2/dof {law['chi2_per_dof']:.3g}): the finite-element model "
-                  "will be off at some temperatures; see the master curve's notes")
+            say(f"note: the shift law misses the master curve's shifts beyond their "
+                f"uncertainty (chi2/dof {law['chi2_per_dof']:.3g}): the finite-element model "
+                "will be off at some temperatures; see the master curve's notes")
     if error > prony.band_rel_halfwidth:
         more = (f"--terms {min(100, 2 * args.terms)}" if args.terms is not None
                 else f"--per-decade {min(10, 2 * args.per_decade)}")
-        print(f"note: the series departs from the model by more than the model's uncertainty; "
-              f"more terms ({more}) may help")
+        say(f"note: the series departs from the model by more than the model's uncertainty; "
+            f"more terms ({more}) may help")
     return 0

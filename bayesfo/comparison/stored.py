@@ -33,7 +33,7 @@ from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.adequacy import Adequacy
 from ..inference.evidence import Evidence
-from ..inference.results import ParameterSummary
+from ..inference.results import ParameterSummary, draws_digest
 from ..structures import Scaling
 from .criteria_types import Criteria
 from .results import Comparison, StructureResult
@@ -134,8 +134,12 @@ def _load(d: Path, models) -> Comparison:
 
     path = d / "summary.json"
     if not path.is_file():
-        raise InputError(f"'{path}': missing, so '{d}' holds no complete output of bayesfo "
-                         "compare")
+        raise InputError(f"'{path}': " + ("not a regular file" if path.exists() else "missing")
+                         + f", so '{d}' holds no complete output of bayesfo compare")
+    size = path.stat().st_size
+    if size > MAX_SUMMARY_BYTES:
+        raise InputError(f"'{path}': {size} bytes, more than the {MAX_SUMMARY_BYTES} a "
+                         "summary.json of bayesfo can have; is it the right directory?")
     try:
         summary = json.loads(path.read_text(encoding="utf-8"))
     except UnicodeDecodeError as exc:
@@ -167,16 +171,52 @@ def _num(value) -> float:
     return math.nan if value is None else float(value)
 
 
-def _read_netcdf(path: Path, name: str):
-    from ..inference._arviz import group_names, open_tree
+#: Largest number of values of one variable of a NetCDF that :func:`load` reads (draws ×
+#: frequencies: 4 000 draws of 200 isotherms × 50 points are 4e7); a file that declares more is
+#: refused before anything is read.
+MAX_NETCDF_VALUES = 50_000_000
+#: Largest summary.json that :func:`load` reads [bytes] (a master curve of 200 isotherms writes
+#: a few megabytes).
+MAX_SUMMARY_BYTES = 64 * 1024 * 1024
 
-    if not path.is_file():
-        raise InputError(f"'{path}': missing (summary.json lists structure '{name}' with a "
-                         "posterior)")
+
+def _read_netcdf(path: Path, name: str, s: dict | None = None, n_frequencies=None):
+    """The DataTree of ``path``: with ``s`` (the structure's block of summary.json), only the
+    groups and variables bayesfo writes, each checked against the numbers of draws and
+    frequencies that summary.json gives before it is read; a file whose datasets lie in other
+    files (HDF5 external or virtual storage) is refused."""
+    import stat
+
+    from ..inference._arviz import external_storage, group_names, open_tree
+
+    try:
+        info = path.stat()
+    except OSError:
+        info = None
+    if info is None or not stat.S_ISREG(info.st_mode):
+        raise InputError(f"'{path}': " + ("missing" if info is None else "not a regular file")
+                         + f" (summary.json lists structure '{name}' with a posterior); run the "
+                         "command that wrote the directory again")
+    keep = sizes = None
+    if s is not None:
+        params = list(s["parameters"])
+        keep = {"posterior": params + ["model_real", "model_imag"], "log_likelihood": ["G"],
+                "observed_data": ["G_real", "G_imag"],
+                "posterior_predictive": ["G_real", "G_imag"], "sample_stats": ["lp"]}
+        sizes = {"chain": None, "draw": None, "omega": int(n_frequencies),
+                 "draws": int(s["n_draws"])}
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            idata = open_tree(path)
+            outside = external_storage(path)
+            if outside is not None:
+                raise InputError(f"'{path}': its dataset '{outside}' is stored in other files "
+                                 "(HDF5 external or virtual storage), which bayesfo never "
+                                 "writes; it is not read. Run the command that wrote the "
+                                 "directory again")
+            idata = open_tree(path, keep, sizes, MAX_NETCDF_VALUES)
+    except InputError:
+        raise
     except Exception as exc:  # netCDF4 and xarray raise many kinds on a damaged file
         raise InputError(f"'{path}': cannot be read as NetCDF ({type(exc).__name__}: "
                          f"{exc})") from None
@@ -240,7 +280,8 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
     files = {}
     for s in entries:
         if "error" not in s:
-            files[s["name"]] = _read_netcdf(d / f"{s['name']}.nc", s["name"])
+            files[s["name"]] = _read_netcdf(d / f"{s['name']}.nc", s["name"], s,
+                                            summary["data"]["n_frequencies"])
     if not files:
         raise InputError(f"'{d / 'summary.json'}': no structure has a posterior")
     first = next(iter(files))
@@ -269,6 +310,13 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
         idata = files[name]
         if not np.array_equal(np.asarray(idata.observed_data["omega"].values), data.omega):
             raise InputError(f"'{path}': its frequencies differ from those of '{first}.nc'")
+        if not (np.array_equal(np.asarray(idata.observed_data["G_real"].values),
+                               data.response.real)
+                and np.array_equal(np.asarray(idata.observed_data["G_imag"].values),
+                                   data.response.imag)):
+            raise InputError(f"'{path}': its data differ from those of '{first}.nc' (the files "
+                             "of two runs); run the command that wrote "
+                             f"'{d}' again, or copy the whole directory")
         post = _posterior(s, idata, data, path)
         results.append(StructureResult(structure, _fit(s, data), post,
                                        _criteria(s, idata)))
@@ -292,7 +340,8 @@ def _mastercurve(summary: dict, d: Path, library):
     name = summary["structure"]
     _check_name(name, d)
     path = d / f"{name}.nc"
-    idata = _read_netcdf(path, name)
+    idata = _read_netcdf(path, name, summary["posterior"],
+                         sum(int(m["n_frequencies"]) for m in summary["isotherms"]))
     try:
         master = (Spectrum(tuple(float(t) for t in summary["spectrum"]["tau_s"]))
                   if name == SPECTRUM else get_structure(name, library))
@@ -354,6 +403,11 @@ def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> Posterior
     if samples.shape[0] != s["n_draws"]:
         raise InputError(f"'{path}': {samples.shape[0]} draws, but summary.json says "
                          f"{s['n_draws']}")
+    recorded = s.get("draws_sha256")  # runs written before it was recorded have none
+    if recorded is not None and recorded != draws_digest(samples):
+        raise InputError(f"'{path}': its draws are not those that '{path.parent / 'summary.json'}' "
+                         "describes (the file of another run, copied in?); run the command "
+                         f"that wrote '{path.parent}' again, or copy the whole directory")
     pointwise = np.asarray(idata.log_likelihood["G"].values, dtype=float)
     loglik = pointwise.reshape(-1, data.n_frequencies).sum(axis=1)
     fields = [f.name for f in dataclasses.fields(ParameterSummary)]

@@ -122,3 +122,144 @@ def test_design_figure_that_cannot_be_written_is_one_line(cmp1, tmp_path, run_cl
         status, _, err = run_cli("design", cmp1, "--figure", "/sys/design.png")
         assert status == 2 and err.count("\n") == 1
         assert "--figure '/sys/design.png': cannot be written" in err
+
+
+# ---------------------------------------------------------------- 2: readers never move files
+def test_a_reader_never_completes_a_swap(cmp1, tmp_path, run_cli):
+    d = _copy(cmp1, tmp_path / "run")
+    mine = d / "mine.nc"  # a file of the user's, which no manifest lists
+    mine.write_bytes(b"mine")
+    staging = d / ".bayesfo-staging-0123456789ab"
+    (staging / "new").mkdir(parents=True)
+    (d / ".bayesfo-swap.json").write_text(json.dumps(
+        {"format": 1, "staging": staging.name, "old": ["mine.nc", "summary.json"],
+         "new": []}))
+    before = sorted(p.name for p in d.iterdir())
+    status, _, err = run_cli("predict", d, "--quantity", "storage", "--omega", "1")
+    assert status == 2 and err.count("\n") == 1
+    assert "half-done move" in err and "run the command that wrote it again" in err
+    assert mine.read_bytes() == b"mine" and (d / "summary.json").is_file()
+    assert sorted(p.name for p in d.iterdir()) == before  # nothing deleted, renamed or made
+    with pytest.raises(InputError, match="half-done move"):
+        bf.load(d)
+
+
+# ---------------------------------------------------------------- 3: one run's files only
+def test_a_posterior_of_another_run_is_refused(cmp1, cmp2, tmp_path, run_cli):
+    d = tmp_path / "mixed"
+    d.mkdir()
+    for f in cmp1.iterdir():  # "cp dir/* new/": the manifest stays behind
+        if not f.name.startswith("."):
+            shutil.copy(f, d)
+    status, _, err = run_cli("predict", d, "--quantity", "storage", "--omega", "1",
+                             "--average", "bma")
+    assert status == 0, err
+    shutil.copy(cmp2 / "zener.nc", d)  # the 10 °C posterior beside the 20 °C one
+    status, _, err = run_cli("predict", d, "--quantity", "storage", "--omega", "1",
+                             "--average", "bma")
+    assert status == 2 and err.count("\n") == 1 and "zener.nc" in err
+    shutil.copy(cmp2 / "voigt.nc", d)  # both posteriors of the other run, its summary not
+    status, _, err = run_cli("export", d, "--format", "csv", "--out", tmp_path / "s.csv")
+    assert status == 2 and err.count("\n") == 1
+    assert "its draws are not those that" in err and "summary.json" in err
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_the_summary_records_a_digest_of_each_posterior(cmp1):
+    summary = json.loads((cmp1 / "summary.json").read_text())
+    loaded = bf.load(cmp1)
+    for s, r in zip(summary["structures"], loaded.results, strict=True):
+        assert len(s["draws_sha256"]) == 64
+        assert r.to_dict()["draws_sha256"] == s["draws_sha256"]
+
+
+# ---------------------------------------------------------------- 4, 17: what a NetCDF holds
+def _without_manifest(src: Path, dst: Path) -> Path:
+    dst.mkdir()
+    for f in src.iterdir():
+        if not f.name.startswith("."):
+            shutil.copy(f, dst)
+    return dst
+
+
+def test_only_the_variables_bayesfo_writes_are_read(cmp1, tmp_path):
+    h5py = pytest.importorskip("h5py")
+    d = _without_manifest(cmp1, tmp_path / "run")
+    with h5py.File(d / "zener.nc", "a") as f:
+        f["posterior"].create_dataset("extra", data=[[1.0] * 500] * 4)
+    loaded = bf.load(d)
+    tree = loaded.results[[r.name for r in loaded.results].index("zener")].posterior.idata
+    assert "extra" not in tree.posterior and "a1" in tree.posterior
+
+
+def test_external_hdf5_storage_is_refused(cmp1, tmp_path):
+    h5py = pytest.importorskip("h5py")
+    secret = tmp_path / "secret.txt"
+    secret.write_bytes(b"s3cr3t!!" * 4)
+    d = _without_manifest(cmp1, tmp_path / "run")
+    with h5py.File(d / "zener.nc", "a") as f:
+        f["posterior"].create_dataset("leak", shape=(4,), dtype="f8",
+                                      external=[(str(secret), 0, 32)])
+    with pytest.raises(InputError, match="'posterior/leak' is stored in other files") as exc:
+        bf.load(d)
+    assert "s3cr3t" not in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_variable_larger_than_declared_is_refused_before_it_is_read(tmp_path):
+    netCDF4 = pytest.importorskip("netCDF4")
+    from bayesfo.inference._arviz import open_tree
+
+    path = tmp_path / "big.nc"
+    with netCDF4.Dataset(path, "w") as nc:
+        g = nc.createGroup("posterior")
+        g.createDimension("chain", 4)
+        g.createDimension("draw", 125_000_000)  # 5e8 values declared, none written
+        g.createVariable("a1", "f8", ("chain", "draw"), zlib=True, chunksizes=(1, 1_000_000))
+    assert path.stat().st_size < 1_000_000
+    with pytest.raises(ValueError, match="'posterior/a1' has 125000000 values along 'draw'"):
+        open_tree(path, {"posterior": ["a1"]}, {"chain": None, "draw": 500, "omega": 17,
+                                                "draws": 2000})
+    with pytest.raises(ValueError, match="500000000 values, more than the 1000"):
+        open_tree(path, {"posterior": ["a1"]}, None, 1000)
+
+
+# ---------------------------------------------------------------- 13, 14, 18, 21: records
+def _cli(*argv, timeout=60):
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[2]), MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "bayesfo.cli", *map(str, argv)],
+                          capture_output=True, text=True, timeout=timeout, env=env)
+
+
+@pytest.mark.parametrize("record", [".bayesfo-run.json", ".bayesfo-swap.json"])
+@pytest.mark.parametrize("kind", ["fifo", "zero"])
+def test_a_record_that_is_not_a_file_is_refused_not_read(cmp1, tmp_path, record, kind):
+    d = _copy(cmp1, tmp_path / "run")
+    (d / record).unlink(missing_ok=True)
+    if kind == "fifo":
+        os.mkfifo(d / record)
+    else:
+        (d / record).symlink_to("/dev/zero")
+    done = _cli("predict", d, "--quantity", "storage", "--omega", "1", timeout=30)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.count("\n") == 1 and record in done.stderr
+    assert os.path.lexists(d / record)  # left as it was
+
+
+def test_a_damaged_manifest_is_said_not_ignored(cmp1, tmp_path, run_cli):
+    d = _copy(cmp1, tmp_path / "run")
+    (d / ".bayesfo-run.json").write_text("{not json")
+    (d / "ranking.csv").write_text("changed")
+    status, _, err = run_cli("predict", d, "--quantity", "storage", "--omega", "1")
+    assert status == 2 and err.count("\n") == 1
+    assert ".bayesfo-run.json' (the record of the run" in err and "damaged" in err
+
+
+def test_a_summary_too_large_is_refused_before_it_is_read(cmp1, tmp_path):
+    d = _without_manifest(cmp1, tmp_path / "run")
+    with open(d / "summary.json", "r+b") as f:
+        f.truncate(65 * 1024 * 1024)  # sparse: no disk space taken
+    with pytest.raises(InputError, match=r"summary.json': 68157440 bytes, more than the"):
+        bf.load(d)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import InputError
 
 
@@ -77,6 +79,10 @@ def run(args) -> int:
     except InputError as exc:  # the API's words, in the command line's
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
+    except np.linalg.LinAlgError as exc:
+        raise InputError(f"the design's linear algebra failed ({exc}): the predictions over "
+                         "the window are degenerate; give a narrower --window or other "
+                         "--structures") from None
     if figure is not None:
         from .._io import write_error
         from ..plotting.design import plot_design
@@ -138,6 +144,9 @@ def _parameter(result, args, window, structures) -> int:
     except InputError as exc:
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
+    except np.linalg.LinAlgError as exc:
+        raise InputError(f"the design's linear algebra failed ({exc}): the predictions over "
+                         "the window are degenerate; give a narrower --window") from None
     if args.json:
         print(json.dumps(plan.to_dict(), indent=1))
         return 0

@@ -122,6 +122,7 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         raise InputError(f"law must be one of auto, {', '.join(LAWS)}, got {law!r}")
     names = _master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
+    _warn_negative_loss(iso)
     first = "free" if law == "auto" else law
     auto_laws = law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN
     from ..parallel import executor
@@ -176,6 +177,10 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
     notes = list(chosen.notes) + law_notes
     if vgp["valid"] is not True:
         notes.append(describe(vgp))
+    if vgp["valid"] is None and parts["consistent"] is None:
+        notes.append("superposition untested (tts_valid null): no neighbouring isotherms share "
+                     "values of |G*|, G′, G″ or tan δ, so the shifts come from the master "
+                     "function alone, not from overlapping data")
     if parts["consistent"] is False:
         notes.append(describe_parts(parts) + (
             "" if vertical == "none" else " (the model's vertical shifts account for the "
@@ -189,6 +194,25 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
                      f"over {ISOTHERM_MISFIT:g} times the median isotherm's")
     return replace(chosen, ranking=ranking, tts_checks=checks, notes=tuple(notes),
                    law_evidence=law_evidence)
+
+
+def _warn_negative_loss(iso) -> None:
+    """Warn of isotherms with points of negative loss, as ``compare`` and ``inspect`` do: no
+    passive master function fits them."""
+    import warnings
+
+    from ..errors import DataWarning
+
+    for data, t in zip(iso.data, iso.temperatures, strict=True):
+        bad = data.omega[data.dissipation_violations()]
+        if bad.size:
+            shown = ", ".join(f"{w:.4g}" for w in bad[:6]) + (
+                f" and {bad.size - 6} more" if bad.size > 6 else "")
+            loss = "Im J > 0" if data.kind == "compliance" else "Im G < 0"
+            warnings.warn(f"the isotherm at {t:g} °C ({data.label}): {bad.size} of "
+                          f"{data.n_frequencies} points have negative loss ({loss}), impossible "
+                          f"for a passive {data.kind}, at omega = {shown} rad/s; no passive "
+                          "master function can fit them", DataWarning, stacklevel=3)
 
 
 def _master_names(structures) -> list:

@@ -263,3 +263,23 @@ def test_a_summary_too_large_is_refused_before_it_is_read(cmp1, tmp_path):
         f.truncate(65 * 1024 * 1024)  # sparse: no disk space taken
     with pytest.raises(InputError, match=r"summary.json': 68157440 bytes, more than the"):
         bf.load(d)
+
+
+# ---------------------------------------------------------------- 8, 10: design's window
+def test_design_proposes_no_frequency_far_beyond_the_data(cmp1, run_cli):
+    omega = bf.load(cmp1).data.omega
+    for window in ("1e-6,1e6", "1e-300,1e300"):
+        status, out, err = run_cli("design", cmp1, "--window", window, "--json")
+        assert status == 0, err
+        plan = json.loads(out)
+        low, high = plan["window"]
+        assert low >= omega.min() / 1e3 * (1 - 1e-8) and high <= omega.max() * 1e3 * (1 + 1e-8)
+        assert all(low <= p["omega"] <= high for p in plan["proposed"])
+        assert any("is cut to" in n for n in plan["notes"])
+    status, out, err = run_cli("design", cmp1, "--cost", "low-frequency", "--window",
+                               "1e-30,1e30")
+    assert status == 0, err
+    assert "3 decades beyond the measured frequencies at most" in out
+    status, _, err = run_cli("design", cmp1, "--window", "1e10,1e30")
+    assert status == 2 and err.count("\n") == 1
+    assert err.startswith("bayesfo: error: --window (1e+10, 1e+30) lies wholly more than 3 decades")

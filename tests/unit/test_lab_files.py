@@ -848,10 +848,10 @@ def test_a_temperature_without_unit_that_reads_as_kelvin_is_warned_of(tmp_path):
 
     path = tmp_path / "k.csv"
     path.write_text("# temperature: 293.15\nomega,storage,loss\n1,1,1\n2,2,2\n3,3,3\n")
-    for read in (lambda: read_isotherms(path)[0].temperature, lambda: temperature_of_file(path)):
+    for reader in (lambda: read_isotherms(path)[0].temperature, lambda: temperature_of_file(path)):
         with pytest.warns(DataWarning, match=r"'# temperature: 293.15' has no unit and is read "
                                              r"as 293.15 °C, yet it looks like kelvin \(20 °C\)"):
-            assert read() == 293.15
+            assert reader() == 293.15
     for text in ("20", "150", "293.15 K", "20.15"):
         path.write_text(f"# temperature: {text}\nomega,storage,loss\n1,1,1\n2,2,2\n3,3,3\n")
         with _warnings.catch_warnings():

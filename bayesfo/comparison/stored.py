@@ -275,8 +275,21 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
     from ..structures import get_structure
 
     entries = summary["structures"]
+    where = d / "summary.json"
     for s in entries:
         _check_name(s.get("name"), d)
+    names = [s["name"] for s in entries]
+    if len(set(names)) != len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise _tampered(where, f"structure '{twice}' is listed twice")
+    for s in entries:
+        if "error" in s:
+            continue
+        _check_noise(s, where)
+        p = s.get("posterior_probability")
+        if p is not None and not _is_probability(p):
+            raise _tampered(where, f"the posterior probability of '{s['name']}' is {p!r}, not "
+                                   "a number from 0 to 1")
     files = {}
     for s in entries:
         if "error" not in s:
@@ -329,7 +342,7 @@ def _mastercurve(summary: dict, d: Path, library):
     (what it stores: :mod:`bayesfo.tts.stored`)."""
     from ..structures import get_structure
     from ..tts import MasterCurve
-    from ..tts.model import ShiftedStructure
+    from ..tts.model import SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
     from ..tts.spectrum import NAME as SPECTRUM
     from ..tts.spectrum import Spectrum
 
@@ -337,6 +350,7 @@ def _mastercurve(summary: dict, d: Path, library):
     if "posterior" not in summary or "isotherms" not in summary:
         raise InputError(f"'{where}': a master curve written by an earlier version of bayesfo, "
                          "without its posterior; run bayesfo mastercurve again")
+    _check_master_summary(summary, where)
     name = summary["structure"]
     _check_name(name, d)
     path = d / f"{name}.nc"
@@ -379,16 +393,64 @@ def _mastercurve(summary: dict, d: Path, library):
         raise InputError(f"'{path}': its parameters are not those of the master curve of "
                          f"{name} over the isotherms summary.json lists")
     theta = post.samples[:, :shifted.n_params]
+    shifts = shifted.log_shifts(theta)
+    if not np.all(np.abs(shifts) <= SHIFT_RANGE + SHIFT_MARGIN):
+        raise InputError(f"'{path}': shift draws of log10 a_T that are not finite or beyond "
+                         f"±{SHIFT_RANGE + SHIFT_MARGIN:g} decades, which no run writes; run "
+                         f"bayesfo mastercurve again into '{d}'")
     return MasterCurve(
         structure=name, temperatures=temperatures,
         reference_temperature=float(summary["reference_temperature"]),
-        shift_draws=shifted.log_shifts(theta), master_draws=theta[:, :master.n_params],
+        shift_draws=shifts, master_draws=theta[:, :master.n_params],
         posterior=post, log_evidence=_num(summary["log_evidence"]),
         log_evidence_err=_num(summary["log_evidence_err"]), laws=summary["laws"], data=joint,
         isotherms=isotherms, notes=tuple(summary["notes"]), ranking=tuple(summary["structures"]),
         tts_checks=summary["tts_checks"], vertical=vertical,
         vertical_draws=None if vertical == "none" else shifted.log_vertical(theta),
         master=master, law=law, law_evidence=summary.get("law_evidence") or {})
+
+
+def _tampered(where: Path, what: str):
+    return InputError(f"'{where}': {what}, which bayesfo never writes (edited?); run the "
+                      f"command that wrote '{where.parent}' again")
+
+
+def _check_master_summary(summary: dict, where: Path) -> None:
+    """The blocks of a master curve's summary.json that load passes on unread, checked now
+    (a tampered file failed later, in predict or export, with AttributeError or ValueError)."""
+    from ..tts.joint import VERTICAL
+    from ..tts.model import LAWS
+
+    laws = summary.get("laws")
+    if not isinstance(laws, dict) or not all(
+            isinstance(v, dict) and isinstance(v.get("parameters"), dict)
+            and _is_probability(v.get("probability")) for v in laws.values()):
+        raise _tampered(where, "'laws' is not a table of shift laws with their parameters and "
+                               "probabilities")
+    checks = summary.get("tts_checks")
+    if not isinstance(checks, dict) or not all(isinstance(v, dict) for v in checks.values()):
+        raise _tampered(where, "'tts_checks' is not a table of checks")
+    if summary.get("vertical", "none") not in VERTICAL:
+        raise _tampered(where, f"'vertical' is {summary.get('vertical')!r}, not one of "
+                               f"{', '.join(VERTICAL)}")
+    if summary.get("law", "free") not in LAWS or (
+            summary.get("law", "free") != "free" and summary["law"] not in laws):
+        raise _tampered(where, f"'law' is {summary.get('law')!r}, not one of {', '.join(LAWS)} "
+                               "with its entry in 'laws'")
+    _check_noise(summary["posterior"], where)
+
+
+def _is_probability(value) -> bool:
+    return (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and 0.0 <= value <= 1.0)
+
+
+def _check_noise(s: dict, where: Path) -> None:
+    from ..inference.likelihood import NOISE_MODELS
+
+    if s.get("noise") not in NOISE_MODELS:
+        raise _tampered(where, f"the noise model of '{s.get('name')}' is {s.get('noise')!r}, "
+                               f"not one of {', '.join(NOISE_MODELS)}")
 
 
 def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> PosteriorResult:
@@ -403,6 +465,9 @@ def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> Posterior
     if samples.shape[0] != s["n_draws"]:
         raise InputError(f"'{path}': {samples.shape[0]} draws, but summary.json says "
                          f"{s['n_draws']}")
+    if not np.all(np.isfinite(samples)):
+        raise InputError(f"'{path}': draws that are not finite numbers, which no run writes; "
+                         f"run the command that wrote '{path.parent}' again")
     recorded = s.get("draws_sha256")  # runs written before it was recorded have none
     if recorded is not None and recorded != draws_digest(samples):
         raise InputError(f"'{path}': its draws are not those that '{path.parent / 'summary.json'}' "

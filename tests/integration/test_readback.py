@@ -283,3 +283,73 @@ def test_design_proposes_no_frequency_far_beyond_the_data(cmp1, run_cli):
     status, _, err = run_cli("design", cmp1, "--window", "1e10,1e30")
     assert status == 2 and err.count("\n") == 1
     assert err.startswith("bayesfo: error: --window (1e+10, 1e+30) lies wholly more than 3 decades")
+
+
+# ---------------------------------------------------------------- 11, 20: tampered summaries
+@pytest.fixture(scope="module")
+def master(tmp_path_factory):
+    """The master curve of zener over the adhesive at 10 and 20 °C (about 10 s)."""
+    from bayesfo.cli import main
+
+    out = tmp_path_factory.mktemp("master")
+    status = main(["mastercurve", str(DATA / "Tp010C.csv"), str(DATA / "Tp020C.csv"),
+                   "--structures", "zener", "--no-figures", "--workers", "1", "--out", str(out)])
+    assert status == 0
+    return out
+
+
+def _tamper(src: Path, dst: Path, change) -> Path:
+    d = _without_manifest(src, dst)
+    summary = json.loads((d / "summary.json").read_text())
+    change(summary)
+    (d / "summary.json").write_text(json.dumps(summary))
+    return d
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s.update(laws=None), "'laws' is not a table of shift laws"),
+    (lambda s: s.update(laws="wlf"), "'laws' is not a table of shift laws"),
+    (lambda s: s["laws"]["wlf"].update(probability=float("nan")),
+     "'laws' is not a table of shift laws"),
+    (lambda s: s.update(tts_checks=None), "'tts_checks' is not a table of checks"),
+    (lambda s: s.update(vertical="bogus"), "'vertical' is 'bogus', not one of none"),
+    (lambda s: s["posterior"].update(noise="bogus"), "the noise model of 'zener' is 'bogus'"),
+])
+def test_a_tampered_master_summary_is_refused_at_load(master, tmp_path, run_cli, change,
+                                                      message):
+    d = _tamper(master, tmp_path / "run", change)
+    with pytest.raises(InputError, match=message):
+        bf.load(d)
+    status, _, err = run_cli("export", d, "--format", "csv", "--out", tmp_path / "s.csv")
+    assert status == 2 and err.count("\n") == 1 and "edited?" in err
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_shift_draws_beyond_any_run_are_refused(master, tmp_path):
+    h5py = pytest.importorskip("h5py")
+    d = _without_manifest(master, tmp_path / "run")
+    summary = json.loads((d / "summary.json").read_text())
+    summary["posterior"].pop("draws_sha256")  # as a run of an earlier version wrote it
+    (d / "summary.json").write_text(json.dumps(summary))
+    name = next(k for k in summary["posterior"]["parameters"] if k.startswith("log10_aT"))
+    with h5py.File(d / "zener.nc", "a") as f:
+        f["posterior"][name][0, 0] = 1e300
+    with pytest.raises(InputError, match="shift draws of log10 a_T that are not finite or "
+                                         "beyond"):
+        bf.load(d)
+    with h5py.File(d / "zener.nc", "a") as f:
+        f["posterior"][name][0, 0] = float("nan")
+    with pytest.raises(InputError, match="draws that are not finite numbers"):
+        bf.load(d)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s["structures"][0].update(posterior_probability=float("nan")),
+     "posterior probability of '.*' is nan, not a number from 0 to 1"),
+    (lambda s: s["structures"][1].update(noise="bogus"), "noise model of '.*' is 'bogus'"),
+    (lambda s: s["structures"].append(s["structures"][0]), "is listed twice"),
+])
+def test_a_tampered_comparison_summary_is_refused_at_load(cmp1, tmp_path, change, message):
+    d = _tamper(cmp1, tmp_path / "run", change)
+    with pytest.raises(InputError, match=message):
+        bf.load(d)

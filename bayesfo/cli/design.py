@@ -5,8 +5,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
-
 from ..errors import InputError
 
 
@@ -44,6 +42,8 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
+    import numpy as np
+
     from ..comparison import load
     from ..options import parse_floats
     from ..planning import design
@@ -130,6 +130,8 @@ def _print(plan, figure) -> None:
 
 def _parameter(result, args, window, structures) -> int:
     """``--parameter``: the frequencies that best determine one parameter."""
+    import numpy as np
+
     from ..planning import design_parameter
 
     if structures is not None and len(structures) != 1:

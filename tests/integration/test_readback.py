@@ -353,3 +353,37 @@ def test_a_tampered_comparison_summary_is_refused_at_load(cmp1, tmp_path, change
     d = _tamper(cmp1, tmp_path / "run", change)
     with pytest.raises(InputError, match=message):
         bf.load(d)
+
+
+# ---------------------------------------------------------------- 12: Ctrl-C while loading
+def test_import_bayesfo_loads_neither_numpy_nor_scipy():
+    import subprocess
+    import sys
+
+    code = ("import sys, bayesfo; "
+            "sys.exit(sum(m in sys.modules for m in ('numpy', 'scipy', 'importlib.metadata')))")
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[2]))
+    assert subprocess.run([sys.executable, "-c", code], env=env, timeout=60).returncode == 0
+
+
+@pytest.mark.parametrize("delay", [0.25, 0.45, 0.7, 1.0])
+def test_ctrl_c_while_export_loads_its_libraries_is_one_line(cmp1, tmp_path, delay):
+    """The libraries load in the first second or so: a Ctrl-C then gave 30 to 50 lines of
+    traceback (it came while ``import bayesfo`` loaded scipy, before the command line's own
+    handling). Before ~0.1 s the interpreter itself is starting (its own traceback)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[2]), MPLBACKEND="Agg")
+    p = subprocess.Popen([sys.executable, "-m", "bayesfo.cli", "export", str(cmp1), "--format",
+                          "csv", "--out", str(tmp_path / "s.csv")], cwd=tmp_path, env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    time.sleep(delay)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert "Traceback" not in err and err.count("\n") <= 1, err
+    if p.returncode not in (0,):  # 0: it had finished before the signal came
+        assert err == "bayesfo: interrupted (no output is left half-written)\n"

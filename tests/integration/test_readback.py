@@ -387,3 +387,25 @@ def test_ctrl_c_while_export_loads_its_libraries_is_one_line(cmp1, tmp_path, del
     assert "Traceback" not in err and err.count("\n") <= 1, err
     if p.returncode not in (0,):  # 0: it had finished before the signal came
         assert err == "bayesfo: interrupted (no output is left half-written)\n"
+
+
+def test_a_writer_never_opens_a_record_that_is_not_a_file(tmp_path):
+    """A FIFO as the manifest and as the journal: mastercurve --out (any run into the
+    directory) hung on reading them."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    out.mkdir()
+    os.mkfifo(out / ".bayesfo-run.json")
+    os.mkfifo(out / ".bayesfo-swap.json")
+    code = ("import sys, warnings; from bayesfo.outdir import staged_run\n"
+            "warnings.simplefilter('ignore')\n"
+            "with staged_run(sys.argv[1]) as stage:\n"
+            "    (stage / 'summary.json').write_text('{}')\n")
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[2]))
+    done = subprocess.run([sys.executable, "-c", code, str(out)], env=env, timeout=30,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert (out / "summary.json").read_text() == "{}"
+    assert json.loads((out / ".bayesfo-run.json").read_text())["entries"] == ["summary.json"]

@@ -409,3 +409,33 @@ def test_a_writer_never_opens_a_record_that_is_not_a_file(tmp_path):
     assert done.returncode == 0, done.stderr
     assert (out / "summary.json").read_text() == "{}"
     assert json.loads((out / ".bayesfo-run.json").read_text())["entries"] == ["summary.json"]
+
+
+# ---------------------------------------------------------------- 15: predict's memory
+def test_predict_takes_the_times_in_chunks(cmp1, monkeypatch):
+    """``--time 1e-6:1e6:100000`` held (250 draws, 100 000 times, 20 nodes) complex at once,
+    22 GB; the times are now taken in chunks, the same band in memory that does not grow with
+    their number (500 draws here, for speed)."""
+    import tracemalloc
+
+    import numpy as np
+
+    from bayesfo.predictions import functions
+
+    monkeypatch.setattr(functions, "MAX_DRAWS", 500)
+    result = bf.load(cmp1)
+    x = np.logspace(-6, 6, 1200)
+    tracemalloc.start()
+    try:
+        chunked = bf.predict(result, "relaxation_modulus", x, structure="zener")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100e6, peak / 1e6  # one piece: about 400 MB
+    monkeypatch.setattr(functions, "_X_CHUNK", 10**9)
+    whole = bf.predict(result, "relaxation_modulus", x[:200], structure="zener")
+    np.testing.assert_array_equal(chunked.median[:200], whole.median)
+    np.testing.assert_array_equal(chunked.hdi_low[:200], whole.hdi_low)
+    np.testing.assert_array_equal(chunked.values[:, :200], whole.values)
+    monkeypatch.setattr(functions, "MAX_KEPT_VALUES", 1000)
+    assert bf.predict(result, "storage", x, structure="zener").values is None

@@ -246,6 +246,9 @@ def _data(summary: dict, idata, path: Path) -> tuple[FrequencyResponse, Frequenc
                   source=meta.get("path") or "", symbol=meta.get("symbol") or "G")
     data = FrequencyResponse(omega, response, attrs.get("sigma"), notes=tuple(meta["notes"]),
                              **common)
+    if isinstance(meta["n_frequencies"], bool) or not isinstance(meta["n_frequencies"], int):
+        raise _tampered(path.parent / "summary.json", f"'n_frequencies' is "
+                        f"{meta['n_frequencies']!r}, not a whole number")
     if data.n_frequencies != meta["n_frequencies"]:
         raise InputError(f"'{path}': {data.n_frequencies} frequencies, but summary.json says "
                          f"{meta['n_frequencies']}")
@@ -384,6 +387,9 @@ def _mastercurve(summary: dict, d: Path, library):
     joint = FrequencyResponse(omega, response, sigma, name=meta["name"],
                               notes=tuple(meta["notes"]), distinct_frequencies=False, **common)
     temperatures = tuple(float(m["temperature"]) for m in iso)
+    if float(summary["reference_temperature"]) not in temperatures:
+        raise _tampered(where, f"the reference temperature {summary['reference_temperature']!r} "
+                               "is not among the isotherms' temperatures")
     vertical, law = summary.get("vertical", "none"), summary.get("law", "free")
     shifted = ShiftedStructure(master, temperatures,
                                temperatures.index(float(summary["reference_temperature"])),

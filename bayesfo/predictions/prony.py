@@ -90,6 +90,8 @@ class Prony:
     model_g_inf : float
         The model's own long-time modulus, lim G(t) as t → ∞ (the median over the draws; 0 for
         a liquid; NaN where unknown), beside the series' ``g_inf``.
+    g_inf_fixed : bool
+        Whether ``g_inf`` was held at 0 (a liquid, or ``liquid=True``) rather than fitted.
     """
 
     tau: np.ndarray
@@ -105,6 +107,7 @@ class Prony:
     symbol: str = "G"
     measured_max: float = math.nan
     model_g_inf: float = math.nan
+    g_inf_fixed: bool = False
 
     @property
     def g_0(self) -> float:
@@ -253,9 +256,14 @@ class Prony:
             return []
         unit = f" {self.unit}" if self.unit else ""
         if self.g_inf == 0.0:
-            return (["g_inf = 0: the model relaxes fully (a liquid)"] if model == 0.0 else
-                    [f"g_inf = 0 as asked, where the model's long-time modulus is {model:.6g}"
-                     f"{unit}"])
+            if model == 0.0:
+                return ["g_inf = 0: the model relaxes fully (a liquid)"]
+            if self.g_inf_fixed:
+                return [f"g_inf = 0 as asked, where the model's long-time modulus is "
+                        f"{model:.6g}{unit}"]
+            return [f"g_inf was fitted as 0 (the terms carry the relaxation up to the longest "
+                    f"relaxation time, {longest:.4g} s), where the model's long-time modulus "
+                    f"is {model:.6g}{unit}"]
         what = ("relaxes fully (a liquid)" if model == 0.0
                 else "does not settle (its G(t) grows without bound)" if math.isinf(model)
                 else f"has the long-time modulus {model:.6g}{unit}")
@@ -374,7 +382,7 @@ def prony_series(result, *, per_decade: int = 2, liquid: bool | None = None,
     return replace(fitted, max_rel_error_modulus=err_g, max_rel_error_relaxation=err_t,
                    band_rel_halfwidth=half, shift_law=_shift_law(result) if master else None,
                    symbol=data.symbol, measured_max=float(np.max(measured)),
-                   model_g_inf=model_g_inf)
+                   model_g_inf=model_g_inf, g_inf_fixed=bool(liquid))
 
 
 def _shift_law(mc) -> dict:

@@ -314,6 +314,8 @@ def _tamper(src: Path, dst: Path, change) -> Path:
     (lambda s: s.update(tts_checks=None), "'tts_checks' is not a table of checks"),
     (lambda s: s.update(vertical="bogus"), "'vertical' is 'bogus', not one of none"),
     (lambda s: s["posterior"].update(noise="bogus"), "the noise model of 'zener' is 'bogus'"),
+    (lambda s: s.update(reference_temperature=15.0),
+     "the reference temperature 15.0 is not among the isotherms' temperatures"),
 ])
 def test_a_tampered_master_summary_is_refused_at_load(master, tmp_path, run_cli, change,
                                                       message):
@@ -348,6 +350,7 @@ def test_shift_draws_beyond_any_run_are_refused(master, tmp_path):
      "posterior probability of '.*' is nan, not a number from 0 to 1"),
     (lambda s: s["structures"][1].update(noise="bogus"), "noise model of '.*' is 'bogus'"),
     (lambda s: s["structures"].append(s["structures"][0]), "is listed twice"),
+    (lambda s: s["data"].update(n_frequencies="17"), "'n_frequencies' is '17', not a whole"),
 ])
 def test_a_tampered_comparison_summary_is_refused_at_load(cmp1, tmp_path, change, message):
     d = _tamper(cmp1, tmp_path / "run", change)
@@ -439,3 +442,24 @@ def test_predict_takes_the_times_in_chunks(cmp1, monkeypatch):
     np.testing.assert_array_equal(chunked.values[:, :200], whole.values)
     monkeypatch.setattr(functions, "MAX_KEPT_VALUES", 1000)
     assert bf.predict(result, "storage", x, structure="zener").values is None
+
+
+# ---------------------------------------------------------------- 19-21: messages
+def test_g_inf_fitted_as_zero_is_not_said_to_be_asked_for(cmp1, tmp_path, run_cli):
+    status, out, err = run_cli("export", cmp1, "--format", "csv", "--terms", "2", "--out",
+                               tmp_path / "s.csv")
+    assert status == 0, err
+    assert "as asked" not in out and "g_inf was fitted as 0" in out
+    status, out, err = run_cli("export", cmp1, "--format", "csv", "--terms", "2", "--liquid",
+                               "--out", tmp_path / "s.csv")
+    assert status == 0, err
+    assert "note: g_inf = 0 as asked, where the model's long-time modulus is" in out
+
+
+def test_a_figure_that_cannot_be_written_says_the_series_was(cmp1, tmp_path, run_cli):
+    (tmp_path / "afile").write_text("")
+    status, _, err = run_cli("export", cmp1, "--format", "csv", "--out", tmp_path / "s.csv",
+                             "--figure", tmp_path / "afile" / "x.png")
+    assert status == 2 and err.count("\n") == 1
+    assert f"the series was written to '{tmp_path / 's.csv'}'" in err
+    assert (tmp_path / "s.csv").read_text().startswith("# Prony series")

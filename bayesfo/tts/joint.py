@@ -123,6 +123,7 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     names = _master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
     _warn_negative_loss(iso)
+    _warn_temperature_gap(iso)
     first = "free" if law == "auto" else law
     auto_laws = law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN
     from ..parallel import executor
@@ -213,6 +214,24 @@ def _warn_negative_loss(iso) -> None:
                           f"{data.n_frequencies} points have negative loss ({loss}), impossible "
                           f"for a passive {data.kind}, at omega = {shown} rad/s; no passive "
                           "master function can fit them", DataWarning, stacklevel=3)
+
+
+#: Neighbouring isotherms further apart than this [°C] are warned of: a temperature in kelvin
+#: read as °C (293.15 beside 10 °C) gave a master curve with WLF C1 0.80.
+TEMPERATURE_GAP = 200.0
+
+
+def _warn_temperature_gap(iso) -> None:
+    import warnings
+
+    from ..errors import DataWarning
+
+    temps = sorted(float(t) for t in iso.temperatures)
+    for low, high in zip(temps, temps[1:]):
+        if high - low > TEMPERATURE_GAP:
+            warnings.warn(f"the isotherms at {low:g} and {high:g} °C are {high - low:g} °C "
+                          "apart, with none between: is a temperature in kelvin read as °C? "
+                          "(write '293.15 K', not '293.15')", DataWarning, stacklevel=3)
 
 
 def _master_names(structures) -> list:

@@ -214,3 +214,27 @@ def test_mastercurve_warns_of_negative_loss_as_compare_does(monkeypatch):
     with pytest.warns(DataWarning, match=r"the isotherm at -40 °C .*: 1 of 17 points have "
                                          r"negative loss \(Im G < 0\)"), pytest.raises(Stop):
         mastercurve(isotherms, "zener")
+
+
+def test_mastercurve_warns_of_isotherms_hundreds_of_degrees_apart(monkeypatch):
+    """293.15 (kelvin meant, °C read) beside 10 °C: a master curve with WLF C1 0.80."""
+    from pathlib import Path
+
+    import bayesfo as bf
+    import bayesfo.parallel
+    from bayesfo.errors import DataWarning
+    from bayesfo.tts import mastercurve
+
+    class Stop(Exception):
+        pass
+
+    def stop(*args, **kwargs):
+        raise Stop
+
+    monkeypatch.setattr(bayesfo.parallel, "executor", stop)
+    folder = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+    isotherms = [(bf.read(folder / "Tp010C.csv"), 10.0), (bf.read(folder / "Tp020C.csv"),
+                                                          293.15)]
+    with pytest.warns(DataWarning, match=r"the isotherms at 10 and 293.15 °C are 283.15 °C "
+                                         r"apart"), pytest.raises(Stop):
+        mastercurve(isotherms, "zener")

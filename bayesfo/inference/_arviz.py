@@ -193,8 +193,11 @@ def external_storage(path: Path) -> str | None:
             return True
         return None
 
-    with h5py.File(path, "r") as f:
-        f.visititems(visit)
+    try:
+        with h5py.File(path, "r") as f:
+            f.visititems(visit)
+    except Exception:  # h5py cannot read it (its HDF5 differs from netCDF-C's): not checked
+        return None
     return found[0] if found else None
 
 

@@ -365,12 +365,17 @@ def _acquire(path: Path, fcntl) -> int:
     """A descriptor of the lock file ``path``, flock-ed, that ``path`` still names."""
     while True:
         try:  # O_NOFOLLOW: a link named like the lock never makes a file outside the directory
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
+                         | getattr(os, "O_NONBLOCK", 0), 0o644)
         except OSError as exc:
             if exc.errno == errno.ELOOP:
                 raise OutputError(f"'{path}' is a symbolic link, not bayesfo's lock file; "
                                   "remove it") from None
             raise
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # a FIFO or device named like the lock
+            os.close(fd)
+            raise OutputError(f"'{path}' is not a regular file, so not bayesfo's lock file; "
+                              "remove it")
         try:
             fcntl.flock(fd, fcntl.LOCK_EX)
             try:

@@ -463,3 +463,11 @@ def test_a_figure_that_cannot_be_written_says_the_series_was(cmp1, tmp_path, run
     assert status == 2 and err.count("\n") == 1
     assert f"the series was written to '{tmp_path / 's.csv'}'" in err
     assert (tmp_path / "s.csv").read_text().startswith("# Prony series")
+
+
+def test_a_reader_leaves_a_fifo_named_like_the_lock_in_place(cmp1, tmp_path, run_cli):
+    d = _copy(cmp1, tmp_path / "run")
+    os.mkfifo(d / ".bayesfo-lock")
+    status, _, err = run_cli("predict", d, "--quantity", "storage", "--omega", "1")
+    assert status == 0, err
+    assert (d / ".bayesfo-lock").is_fifo()  # was removed as if it were the reader's own lock

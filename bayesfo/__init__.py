@@ -27,35 +27,45 @@ Example
 True
 """
 
-from importlib.metadata import PackageNotFoundError
-from importlib.metadata import version as _version
 
-try:
-    __version__ = _version("bayesfo")
-except PackageNotFoundError:  # run from a source tree that is not installed
-    __version__ = "0+unknown"
+def _package_version() -> str:
+    """The installed version (importlib.metadata takes a tenth of a second to load: it is
+    loaded when ``bayesfo.__version__`` is first asked for)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as _version
 
-from .data import FrequencyResponse, read, read_csv  # noqa: E402
+    try:
+        return _version("bayesfo")
+    except PackageNotFoundError:  # run from a source tree that is not installed
+        return "0+unknown"
+
 from .errors import BayesfoError, InputError, NonlinearityWarning, OutputError, StructureError  # noqa: E402
-from .structures import get_structure, list_structures, resolve_structures  # noqa: E402
 
-#: Names of the flat API that load the inference stack (arviz, emcee) on first use, so that
-#: ``import bayesfo`` and ``bayesfo --help`` stay fast.
+#: Names of the flat API loaded on first use, so that ``import bayesfo`` imports neither numpy
+#: nor scipy: ``bayesfo --help`` stays fast, and a Ctrl-C while the command line's libraries
+#: load reaches :func:`bayesfo.cli.main`, which says "interrupted" in one line (it gave a
+#: traceback of 30 to 50 lines while ``import bayesfo`` loaded scipy).
 _LAZY = {"compare": "comparison", "write_outputs": "output", "load": "comparison",
          "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison",
          "predict": "predictions", "Prediction": "predictions",
-         "mastercurve": "tts", "MasterCurve": "tts", "design": "planning", "Design": "planning"}
+         "mastercurve": "tts", "MasterCurve": "tts", "design": "planning", "Design": "planning",
+         "FrequencyResponse": "data", "read": "data", "read_csv": "data",
+         "get_structure": "structures", "list_structures": "structures",
+         "resolve_structures": "structures"}
 
 
 #: Subpackages reachable as attributes without an import of their own (``bf.plotting``), loaded
 #: on first use: matplotlib is imported only by a program that draws.
 _LAZY_MODULES = ("plotting", "inference", "identify", "batch", "predictions", "tts", "output",
-                 "timeseries", "planning")
+                 "timeseries", "planning", "data", "structures")
 
 
 def __getattr__(name):
     import importlib
 
+    if name == "__version__":
+        globals()["__version__"] = version = _package_version()
+        return version
     if name in _LAZY:
         return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     if name in _LAZY_MODULES:

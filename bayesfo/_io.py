@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import errno
 import math
 import os
 import re
@@ -11,13 +12,23 @@ import tempfile
 from pathlib import Path
 
 
-def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8") -> Path:
+def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8", *,
+                      named: bool = False) -> Path:
     """Write ``text`` to ``path`` through a temporary file in the same directory and a rename.
 
     The rename is atomic on POSIX and Windows file systems, so an interrupted run leaves either
     the previous file or the complete new one, never a truncated file.
+
+    With ``named`` (a file the user named: ``--out FILE``), a symbolic link is written through
+    (the file it names is replaced, the link stays) and a device or FIFO is written into, never
+    replaced (:func:`write_target`). Without it (a file inside an output directory), what is
+    at ``path`` is replaced, a link included: nothing outside the directory is written.
     """
-    path = Path(path)
+    given = Path(path)
+    path = write_target(given) if named else given
+    if named and is_special(path):  # /dev/null, a FIFO: written into, never renamed over
+        write_into(path, text.encode(encoding))
+        return given
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -32,7 +43,56 @@ def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8
         except FileNotFoundError:
             pass
         raise
-    return path
+    return given
+
+
+def write_target(path: str | os.PathLike) -> Path:
+    """Where a file named by the user is written without replacing what ``path`` names.
+
+    A symbolic link is followed to the file it names (the link stays a link: the file it
+    points to is replaced); a link that leads nowhere is refused, since writing through it would
+    create a file elsewhere than where the user looked. An existing device, FIFO or socket is
+    returned as it is, to be written into (:func:`is_special`, :func:`write_into`), never
+    renamed over.
+
+    Raises
+    ------
+    OSError
+        For a symbolic link that points to nothing (with a ``strerror`` that says so).
+    """
+    path = Path(path)
+    if not path.is_symlink():
+        return path
+    try:
+        os.stat(path)
+    except OSError:
+        raise OSError(errno.ENOENT, f"a symbolic link to '{os.readlink(path)}', which does not "
+                      "exist; give the path of a file") from None
+    # /dev/fd/N and /proc/self/fd/N (a shell's process substitution) lead to a pipe that has no
+    # path: written into through the link itself.
+    return path if is_special(path) else Path(os.path.realpath(path))
+
+
+def is_special(path: str | os.PathLike) -> bool:
+    """Whether ``path`` names (after links) an existing node that is neither a regular file
+    nor a directory: a device such as ``/dev/null``, a FIFO or a socket."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
+def write_into(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` into the existing device, FIFO or socket ``path`` (opened for writing
+    without creating or truncating anything: the node stays what it was)."""
+    fd = os.open(path, os.O_WRONLY | getattr(os, "O_BINARY", 0))
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+    finally:
+        os.close(fd)
 
 
 #: What to do with a directory where a data file was expected.

@@ -37,6 +37,7 @@ import os
 import re
 import secrets
 import shutil
+import stat
 import time
 from pathlib import Path, PurePosixPath
 
@@ -75,9 +76,28 @@ def is_output_path(name) -> bool:
             and is_output_name(path.parts[0]))
 
 
+#: Largest journal or manifest read [bytes]: a manifest names a run's top-level entries and
+#: their digests (a few kilobytes); anything larger is not one.
+MAX_RECORD_BYTES = 16 * 1024 * 1024
+
+
 def _read_json(path: Path):
+    """The JSON of a journal or manifest, or None where it is missing, unreadable, not JSON,
+    nested too deeply, or not a regular file of at most :data:`MAX_RECORD_BYTES` (a FIFO would
+    block the reader, a link to ``/dev/zero`` never end: neither is opened for reading)."""
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        info = os.lstat(path)
+        if not stat.S_ISREG(info.st_mode) or info.st_size > MAX_RECORD_BYTES:
+            return None
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0)
+                     | getattr(os, "O_NOFOLLOW", 0))
+        with open(fd, "rb") as f:
+            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                return None
+            raw = f.read(MAX_RECORD_BYTES + 1)
+        if len(raw) > MAX_RECORD_BYTES:
+            return None
+        return json.loads(raw.decode("utf-8"))
     except (OSError, ValueError, RecursionError):  # unreadable, not JSON, nested too deeply
         return None
 
@@ -93,23 +113,39 @@ def _digest(path: Path) -> str:
 
 @contextlib.contextmanager
 def one_run(out_dir, checked=lambda name: True):
-    """Read the files of ``out_dir`` as the output of one run: a swap that a killed run left
-    half-done is completed first, a run swapping its outputs in is waited for (its lock is held
-    while the block reads), and every file for which ``checked(name)`` holds and whose digest
-    the run recorded must still have it.
+    """Read the files of ``out_dir`` as the output of one run: a run swapping its outputs in
+    is waited for (its lock is held while the block reads), and every file for which
+    ``checked(name)`` holds and whose digest the run recorded must still have it.
+
+    A reader never deletes or renames anything: a swap that a killed run left half-done is
+    refused (the next run of the command that wrote the directory completes it), and so is a
+    manifest that cannot be read (it would switch the digest checks off).
 
     Raises
     ------
     InputError
-        A file that another run wrote, or that was changed since (copied in, truncated).
+        A file that another run wrote, or that was changed since (copied in, truncated); a
+        swap left half-done; a damaged manifest.
     """
     out_dir = Path(out_dir)
     with contextlib.ExitStack() as stack:
         try:
-            recover(out_dir)
             stack.enter_context(_locked(out_dir))
         except OSError:  # a directory that cannot be written: read what it holds, unlocked
             pass
+        if os.path.lexists(out_dir / JOURNAL):
+            raise InputError(f"'{out_dir}' holds a half-done move of a run's outputs "
+                             f"('{JOURNAL}': that run was interrupted), so its files may be of "
+                             "two runs; run the command that wrote it again into the directory "
+                             "(it completes the move first)")
+        if os.path.lexists(out_dir / MANIFEST):
+            record = _read_json(out_dir / MANIFEST)
+            if not (isinstance(record, dict) and isinstance(record.get("sha256", {}), dict)):
+                raise InputError(f"'{out_dir / MANIFEST}' (the record of the run that wrote "
+                                 f"'{out_dir}') is damaged or not a regular file, so its files "
+                                 "cannot be checked; run the command that wrote it again into "
+                                 "the directory, or remove the record to read the files "
+                                 "unchecked")
         path = changed_file(out_dir, checked)
         if path is not None:
             raise InputError(f"'{path}' is not the file that the run which wrote "
@@ -329,12 +365,17 @@ def _acquire(path: Path, fcntl) -> int:
     """A descriptor of the lock file ``path``, flock-ed, that ``path`` still names."""
     while True:
         try:  # O_NOFOLLOW: a link named like the lock never makes a file outside the directory
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
+                         | getattr(os, "O_NONBLOCK", 0), 0o644)
         except OSError as exc:
             if exc.errno == errno.ELOOP:
                 raise OutputError(f"'{path}' is a symbolic link, not bayesfo's lock file; "
                                   "remove it") from None
             raise
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # a FIFO or device named like the lock
+            os.close(fd)
+            raise OutputError(f"'{path}' is not a regular file, so not bayesfo's lock file; "
+                              "remove it")
         try:
             fcntl.flock(fd, fcntl.LOCK_EX)
             try:

@@ -16,9 +16,6 @@ import re
 import sys
 import warnings
 
-import numpy as np
-
-from .. import __version__
 from .._signals import cause
 from ..errors import InputError, OutputError
 
@@ -37,6 +34,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .. import __version__
+
     parser = _Parser(
         prog="bayesfo",
         description="Uncertainty-aware model choice for fractional-order transfer functions.",
@@ -155,16 +154,20 @@ def main(argv=None) -> int:
     # the user chose one (a desktop session would otherwise load a GUI toolkit, whose state a
     # process forked to draw figures must not share; bayesfo.plotting.output.can_fork).
     os.environ.setdefault("MPLBACKEND", "agg")
-    parser = build_parser()
     previous = None
     thaw = not gc.get_freeze_count()  # a caller's own frozen objects stay frozen
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
+        # Inside the try: a Ctrl-C while the commands' modules load is one line, not a
+        # traceback.
+        parser = build_parser()
         args = parser.parse_args(_negative_values(sys.argv[1:] if argv is None else argv))
         if args.command is None:
             parser.print_help()
             return 2
+        import numpy as np
+
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.showwarning = _one_line_warning
             _held.clear()

@@ -42,6 +42,8 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
+    import numpy as np
+
     from ..comparison import load
     from ..options import parse_floats
     from ..planning import design
@@ -59,6 +61,9 @@ def run(args) -> int:
         if not figure.parent.is_dir():
             raise InputError(f"--figure {args.figure}: directory '{figure.parent}' does not "
                              "exist")
+        if figure.is_dir():
+            raise InputError(f"--figure {args.figure}: is a directory; give a file name in "
+                             "it (e.g. design.png)")
     result = load(args.directory, models=getattr(args, "models", ()) or ())
     if hasattr(result, "shift_draws"):
         raise InputError(f"'{args.directory}' holds a master curve: design chooses frequencies "
@@ -74,11 +79,22 @@ def run(args) -> int:
     except InputError as exc:  # the API's words, in the command line's
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
+    except np.linalg.LinAlgError as exc:
+        raise InputError(f"the design's linear algebra failed ({exc}): the predictions over "
+                         "the window are degenerate; give a narrower --window or other "
+                         "--structures") from None
     if figure is not None:
+        from .._io import write_error
         from ..plotting.design import plot_design
         from ..plotting.output import save_figure
 
-        save_figure(plot_design(result, plan, seed=args.seed).figure, figure, close=True)
+        try:
+            save_figure(plot_design(result, plan, seed=args.seed).figure, figure, close=True,
+                        named=True)
+        except OSError as exc:
+            raise InputError(f"--figure '{args.figure}': cannot be written "
+                             f"({write_error(figure, exc)}); give a file in a writable "
+                             "folder") from None
     if args.json:
         print(json.dumps(plan.to_dict(), indent=1))
         return 0
@@ -114,6 +130,8 @@ def _print(plan, figure) -> None:
 
 def _parameter(result, args, window, structures) -> int:
     """``--parameter``: the frequencies that best determine one parameter."""
+    import numpy as np
+
     from ..planning import design_parameter
 
     if structures is not None and len(structures) != 1:
@@ -128,6 +146,9 @@ def _parameter(result, args, window, structures) -> int:
     except InputError as exc:
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
+    except np.linalg.LinAlgError as exc:
+        raise InputError(f"the design's linear algebra failed ({exc}): the predictions over "
+                         "the window are degenerate; give a narrower --window") from None
     if args.json:
         print(json.dumps(plan.to_dict(), indent=1))
         return 0

@@ -24,7 +24,9 @@ def add_parser(subparsers):
                    help="csv (tau_s,g_i), abaqus (*VISCOELASTIC, TIME=PRONY), ansys "
                         "(TB,PRONY with TBDATA) or lsdyna (*MAT_GENERAL_VISCOELASTIC, at most "
                         "18 terms)")
-    p.add_argument("--out", required=True, metavar="FILE", help="the file to write")
+    p.add_argument("--out", required=True, metavar="FILE",
+                   help="the file to write ('-': standard output, the messages then go to "
+                        "standard error)")
     many = p.add_mutually_exclusive_group()
     many.add_argument("--terms", type=_terms, default="auto", metavar="auto|N",
                       help="the number of relaxation times (log-spaced from two decades below "
@@ -61,6 +63,8 @@ def _terms(text: str):
 
 
 def run(args) -> int:
+    import functools
+    import sys
     from pathlib import Path
 
     from .._io import atomic_write_text, write_error
@@ -88,12 +92,17 @@ def run(args) -> int:
     except InputError as exc:
         raise InputError(str(exc).replace("export: ", "", 1).replace(
             "terms 17 or 1 per decade", "--terms 17 or --per-decade 1")) from None
-    try:
-        atomic_write_text(args.out, text)
-    except OSError as exc:
-        raise InputError(f"--out '{args.out}': cannot be written "
-                         f"({write_error(args.out, exc)})") \
-            from None
+    # With --out - the series goes to standard output, and what is said of it to stderr.
+    say = functools.partial(print, file=sys.stderr if args.out == "-" else sys.stdout)
+    if args.out == "-":
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    else:
+        try:
+            atomic_write_text(args.out, text, named=True)
+        except OSError as exc:
+            raise InputError(f"--out '{args.out}': cannot be written "
+                             f"({write_error(args.out, exc)})") from None
     if args.figure is not None:
         from ._libraries import load_libraries
 
@@ -104,46 +113,48 @@ def run(args) -> int:
         drawn = plot_prony(result, prony, structure=args.structure, average=args.average,
                            seed=args.seed)
         try:
-            save_figure(drawn.figure, args.figure, close=True)
+            save_figure(drawn.figure, args.figure, close=True, named=True)
         except OSError as exc:
+            written = "" if args.out == "-" else f"; the series was written to '{args.out}'"
             raise InputError(f"--figure '{args.figure}': cannot be written "
-                             f"({write_error(args.figure, exc)})") from None
-        print(f"wrote {args.figure}")
+                             f"({write_error(args.figure, exc)}){written}") from None
+        say(f"wrote {args.figure}")
     from ..data.symbols import modulus_symbol
     from ..predictions.prony import DENSE, _unit_suffix
 
     e = modulus_symbol(prony.symbol)
-    how = (f" (the fewest whose {e}(t) stays inside the model's band)" if prony.rule == "auto" and prony.inside_band
-           else "")
-    print(f"{prony.tau.size} terms of {prony.source}{how}, {e}0 = {prony.g_0:.6g}, {e}_inf = "
-          f"{prony.g_inf:.6g}{_unit_suffix(prony.unit)}; wrote {args.out}")
-    print(f"largest relative errors over the data window ({DENSE} log-spaced times, "
-          f"frequencies): {e}(t) {prony.max_rel_error_relaxation:.2g}, |{e}*| "
-          f"{prony.max_rel_error_modulus:.2g}, {e}′ {prony.max_rel_error_storage:.2g}, {e}″ "
-          f"{prony.max_rel_error_loss:.2g}; the model's 94 % band of {e}(t): at least "
-          f"+-{prony.band_rel_halfwidth:.2g}, the series "
-          + ("inside it" if prony.inside_band else "outside it")
-          + f" (largest departure {prony.band_fraction:.2g} of the band's reach)")
+    how = (f" (the fewest whose {e}(t) stays inside the model's band)"
+           if prony.rule == "auto" and prony.inside_band else "")
+    where = "standard output" if args.out == "-" else args.out
+    say(f"{prony.tau.size} terms of {prony.source}{how}, {e}0 = {prony.g_0:.6g}, {e}_inf = "
+        f"{prony.g_inf:.6g}{_unit_suffix(prony.unit)}; wrote {where}")
+    say(f"largest relative errors over the data window ({DENSE} log-spaced times, "
+        f"frequencies): {e}(t) {prony.max_rel_error_relaxation:.2g}, |{e}*| "
+        f"{prony.max_rel_error_modulus:.2g}, {e}′ {prony.max_rel_error_storage:.2g}, {e}″ "
+        f"{prony.max_rel_error_loss:.2g}; the model's 94 % band of {e}(t): at least "
+        f"+-{prony.band_rel_halfwidth:.2g}, the series "
+        + ("inside it" if prony.inside_band else "outside it")
+        + f" (largest departure {prony.band_fraction:.2g} of the band's reach)")
     for line in prony.extrapolation_text():
-        print(f"note: {line}")
+        say(f"note: {line}")
     for line in prony.long_time_text():
         if prony.model_g_inf == 0.0:
             line += (" (--liquid sets G_inf = 0)" if prony.g_inf > 0 else
                      " (--no-liquid fits G_inf with the terms)" if args.liquid is None else "")
-        print(f"note: {line}")
+        say(f"note: {line}")
     law = prony.shift_law
     if law is None and prony.shift_note:
-        print(f"note: {prony.shift_note}")
+        say(f"note: {prony.shift_note}")
     if law is not None:
         from ..tts.joint import LAW_MISS
 
-        print(f"with the {'WLF' if law['name'] == 'wlf' else 'Arrhenius'} shift law at "
-              f"T_ref = {law['reference_temperature']:g} °C (" + ", ".join(
-                  f"{k} = {v:.6g}" for k, v in law["parameters"].items()) + ")")
+        say(f"with the {'WLF' if law['name'] == 'wlf' else 'Arrhenius'} shift law at "
+            f"T_ref = {law['reference_temperature']:g} °C (" + ", ".join(
+                f"{k} = {v:.6g}" for k, v in law["parameters"].items()) + ")")
         if law["chi2_per_dof"] > LAW_MISS:
-            print(f"note: the shift law misses the master curve's shifts beyond their "
-                  f"uncertainty (chi2/dof {law['chi2_per_dof']:.3g}): the finite-element model "
-                  "will be off at some temperatures; see the master curve's notes")
+            say(f"note: the shift law misses the master curve's shifts beyond their "
+                f"uncertainty (chi2/dof {law['chi2_per_dof']:.3g}): the finite-element model "
+                "will be off at some temperatures; see the master curve's notes")
     if not prony.inside_band:
         if prony.rule == "auto" and prony.max_terms is not None:
             more = (f"the card's {prony.max_terms} rows are too few: the format csv, abaqus "
@@ -154,5 +165,5 @@ def run(args) -> int:
             more = f"more terms (--terms {min(100, 2 * args.terms)} or auto) may help"
         else:
             more = "no number of terms up to 100 keeps it inside"
-        print(f"note: the series leaves the model's 94 % band of {e}(t): {more}")
+        say(f"note: the series leaves the model's 94 % band of {e}(t): {more}")
     return 0

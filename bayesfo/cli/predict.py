@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 
 from ..errors import InputError
@@ -37,7 +38,8 @@ def add_parser(subparsers):
                           "(bma) or stacking weights (stacking)")
     out = p.add_mutually_exclusive_group()
     out.add_argument("--json", action="store_true", help="print the prediction as JSON")
-    out.add_argument("--out", metavar="FILE.csv", help="write the prediction as CSV")
+    out.add_argument("--out", metavar="FILE.csv",
+                     help="write the prediction as CSV ('-': to standard output)")
     p.add_argument("--temperature", type=float, default=None, metavar="T",
                    help="[°C] of a master curve: the function at T (within the isotherms' "
                         "temperatures) instead of the reference temperature, each draw with its "
@@ -97,6 +99,9 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(p.to_dict(), indent=1))
         return 0
+    if args.out == "-":
+        sys.stdout.write(_csv_text(p))
+        return 0
     if args.out:
         _write_csv(p, args.out)
         print(f"wrote {args.out}")
@@ -113,7 +118,7 @@ def _figure(p, path) -> None:
 
     load_libraries((Path(path).suffix.lower().lstrip("."),))
     try:
-        save_figure(plot_prediction(p).figure, path, close=True)
+        save_figure(plot_prediction(p).figure, path, close=True, named=True)
     except OSError as exc:
         raise InputError(f"--figure '{path}': cannot be written ({write_error(path, exc)})") \
             from None
@@ -138,7 +143,7 @@ def _write_csv(p, path) -> None:
     from .._io import atomic_write_text, write_error
 
     try:
-        atomic_write_text(path, _csv_text(p))
+        atomic_write_text(path, _csv_text(p), named=True)
     except OSError as exc:
         raise InputError(f"--out '{path}': cannot be written ({write_error(path, exc)})") \
             from None

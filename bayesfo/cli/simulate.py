@@ -35,7 +35,7 @@ def run(args) -> int:
             from ..plotting import plot_rmse_surface, save_figure
 
             mesh = plot_rmse_surface(surface)
-            save_figure(mesh.axes.figure, args.figure)
+            save_figure(mesh.axes.figure, args.figure, named=True)
         if args.json:
             print(json.dumps(surface))
         else:

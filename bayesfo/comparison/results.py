@@ -14,7 +14,7 @@ from ..data import FrequencyResponse
 from ..errors import StructureError
 from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
-from ..inference.results import HDI_PROB
+from ..inference.results import HDI_PROB, draws_digest
 from ..structures import Structure
 from .criteria_types import Criteria
 from .parameters import (  # noqa: F401  (re-exported: the names results offered before)
@@ -296,6 +296,8 @@ class StructureResult:
             ess_tail_min=post.ess_tail_min, converged=post.converged, tau_max=float(np.max(post.tau)),
             n_steps=post.n_steps, n_draws=int(post.samples.shape[0]), messages=list(post.messages),
             sampler=getattr(post, "sampler", "emcee"),
+            # Ties the structure's NetCDF to this summary (load refuses another run's draws).
+            draws_sha256=draws_digest(post.samples),
             # The certificate of an importance-sampled posterior: Pareto k of its weights, their
             # ESS and the optima the proposal covered.
             importance=None if self.criteria.importance is None else {

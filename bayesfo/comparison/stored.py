@@ -33,7 +33,7 @@ from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.adequacy import Adequacy
 from ..inference.evidence import Evidence
-from ..inference.results import ParameterSummary
+from ..inference.results import ParameterSummary, draws_digest
 from ..structures import Scaling
 from .criteria_types import Criteria
 from .results import Comparison, StructureResult
@@ -134,8 +134,12 @@ def _load(d: Path, models) -> Comparison:
 
     path = d / "summary.json"
     if not path.is_file():
-        raise InputError(f"'{path}': missing, so '{d}' holds no complete output of bayesfo "
-                         "compare")
+        raise InputError(f"'{path}': " + ("not a regular file" if path.exists() else "missing")
+                         + f", so '{d}' holds no complete output of bayesfo compare")
+    size = path.stat().st_size
+    if size > MAX_SUMMARY_BYTES:
+        raise InputError(f"'{path}': {size} bytes, more than the {MAX_SUMMARY_BYTES} a "
+                         "summary.json of bayesfo can have; is it the right directory?")
     try:
         summary = json.loads(path.read_text(encoding="utf-8"))
     except UnicodeDecodeError as exc:
@@ -167,16 +171,52 @@ def _num(value) -> float:
     return math.nan if value is None else float(value)
 
 
-def _read_netcdf(path: Path, name: str):
-    from ..inference._arviz import group_names, open_tree
+#: Largest number of values of one variable of a NetCDF that :func:`load` reads (draws ×
+#: frequencies: 4 000 draws of 200 isotherms × 50 points are 4e7); a file that declares more is
+#: refused before anything is read.
+MAX_NETCDF_VALUES = 50_000_000
+#: Largest summary.json that :func:`load` reads [bytes] (a master curve of 200 isotherms writes
+#: a few megabytes).
+MAX_SUMMARY_BYTES = 64 * 1024 * 1024
 
-    if not path.is_file():
-        raise InputError(f"'{path}': missing (summary.json lists structure '{name}' with a "
-                         "posterior)")
+
+def _read_netcdf(path: Path, name: str, s: dict | None = None, n_frequencies=None):
+    """The DataTree of ``path``: with ``s`` (the structure's block of summary.json), only the
+    groups and variables bayesfo writes, each checked against the numbers of draws and
+    frequencies that summary.json gives before it is read; a file whose datasets lie in other
+    files (HDF5 external or virtual storage) is refused."""
+    import stat
+
+    from ..inference._arviz import external_storage, group_names, open_tree
+
+    try:
+        info = path.stat()
+    except OSError:
+        info = None
+    if info is None or not stat.S_ISREG(info.st_mode):
+        raise InputError(f"'{path}': " + ("missing" if info is None else "not a regular file")
+                         + f" (summary.json lists structure '{name}' with a posterior); run the "
+                         "command that wrote the directory again")
+    keep = sizes = None
+    if s is not None:
+        params = list(s["parameters"])
+        keep = {"posterior": params + ["model_real", "model_imag"], "log_likelihood": ["G"],
+                "observed_data": ["G_real", "G_imag"],
+                "posterior_predictive": ["G_real", "G_imag"], "sample_stats": ["lp"]}
+        sizes = {"chain": None, "draw": None, "omega": int(n_frequencies),
+                 "draws": int(s["n_draws"])}
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            idata = open_tree(path)
+            outside = external_storage(path)
+            if outside is not None:
+                raise InputError(f"'{path}': its dataset '{outside}' is stored in other files "
+                                 "(HDF5 external or virtual storage), which bayesfo never "
+                                 "writes; it is not read. Run the command that wrote the "
+                                 "directory again")
+            idata = open_tree(path, keep, sizes, MAX_NETCDF_VALUES)
+    except InputError:
+        raise
     except Exception as exc:  # netCDF4 and xarray raise many kinds on a damaged file
         raise InputError(f"'{path}': cannot be read as NetCDF ({type(exc).__name__}: "
                          f"{exc})") from None
@@ -206,6 +246,9 @@ def _data(summary: dict, idata, path: Path) -> tuple[FrequencyResponse, Frequenc
                   source=meta.get("path") or "", symbol=meta.get("symbol") or "G")
     data = FrequencyResponse(omega, response, attrs.get("sigma"), notes=tuple(meta["notes"]),
                              **common)
+    if isinstance(meta["n_frequencies"], bool) or not isinstance(meta["n_frequencies"], int):
+        raise _tampered(path.parent / "summary.json", f"'n_frequencies' is "
+                        f"{meta['n_frequencies']!r}, not a whole number")
     if data.n_frequencies != meta["n_frequencies"]:
         raise InputError(f"'{path}': {data.n_frequencies} frequencies, but summary.json says "
                          f"{meta['n_frequencies']}")
@@ -235,12 +278,26 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
     from ..structures import get_structure
 
     entries = summary["structures"]
+    where = d / "summary.json"
     for s in entries:
         _check_name(s.get("name"), d)
+    names = [s["name"] for s in entries]
+    if len(set(names)) != len(names):
+        twice = next(n for n in names if names.count(n) > 1)
+        raise _tampered(where, f"structure '{twice}' is listed twice")
+    for s in entries:
+        if "error" in s:
+            continue
+        _check_noise(s, where)
+        p = s.get("posterior_probability")
+        if p is not None and not _is_probability(p):
+            raise _tampered(where, f"the posterior probability of '{s['name']}' is {p!r}, not "
+                                   "a number from 0 to 1")
     files = {}
     for s in entries:
         if "error" not in s:
-            files[s["name"]] = _read_netcdf(d / f"{s['name']}.nc", s["name"])
+            files[s["name"]] = _read_netcdf(d / f"{s['name']}.nc", s["name"], s,
+                                            summary["data"]["n_frequencies"])
     if not files:
         raise InputError(f"'{d / 'summary.json'}': no structure has a posterior")
     first = next(iter(files))
@@ -269,6 +326,13 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
         idata = files[name]
         if not np.array_equal(np.asarray(idata.observed_data["omega"].values), data.omega):
             raise InputError(f"'{path}': its frequencies differ from those of '{first}.nc'")
+        if not (np.array_equal(np.asarray(idata.observed_data["G_real"].values),
+                               data.response.real)
+                and np.array_equal(np.asarray(idata.observed_data["G_imag"].values),
+                                   data.response.imag)):
+            raise InputError(f"'{path}': its data differ from those of '{first}.nc' (the files "
+                             "of two runs); run the command that wrote "
+                             f"'{d}' again, or copy the whole directory")
         post = _posterior(s, idata, data, path)
         results.append(StructureResult(structure, _fit(s, data), post,
                                        _criteria(s, idata)))
@@ -281,7 +345,7 @@ def _mastercurve(summary: dict, d: Path, library):
     (what it stores: :mod:`bayesfo.tts.stored`)."""
     from ..structures import get_structure
     from ..tts import MasterCurve
-    from ..tts.model import ShiftedStructure
+    from ..tts.model import SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
     from ..tts.spectrum import NAME as SPECTRUM
     from ..tts.spectrum import Spectrum
 
@@ -289,10 +353,12 @@ def _mastercurve(summary: dict, d: Path, library):
     if "posterior" not in summary or "isotherms" not in summary:
         raise InputError(f"'{where}': a master curve written by an earlier version of bayesfo, "
                          "without its posterior; run bayesfo mastercurve again")
+    _check_master_summary(summary, where)
     name = summary["structure"]
     _check_name(name, d)
     path = d / f"{name}.nc"
-    idata = _read_netcdf(path, name)
+    idata = _read_netcdf(path, name, summary["posterior"],
+                         sum(int(m["n_frequencies"]) for m in summary["isotherms"]))
     try:
         master = (Spectrum(tuple(float(t) for t in summary["spectrum"]["tau_s"]))
                   if name == SPECTRUM else get_structure(name, library))
@@ -321,6 +387,9 @@ def _mastercurve(summary: dict, d: Path, library):
     joint = FrequencyResponse(omega, response, sigma, name=meta["name"],
                               notes=tuple(meta["notes"]), distinct_frequencies=False, **common)
     temperatures = tuple(float(m["temperature"]) for m in iso)
+    if float(summary["reference_temperature"]) not in temperatures:
+        raise _tampered(where, f"the reference temperature {summary['reference_temperature']!r} "
+                               "is not among the isotherms' temperatures")
     vertical, law = summary.get("vertical", "none"), summary.get("law", "free")
     shifted = ShiftedStructure(master, temperatures,
                                temperatures.index(float(summary["reference_temperature"])),
@@ -330,10 +399,15 @@ def _mastercurve(summary: dict, d: Path, library):
         raise InputError(f"'{path}': its parameters are not those of the master curve of "
                          f"{name} over the isotherms summary.json lists")
     theta = post.samples[:, :shifted.n_params]
+    shifts = shifted.log_shifts(theta)
+    if not np.all(np.abs(shifts) <= SHIFT_RANGE + SHIFT_MARGIN):
+        raise InputError(f"'{path}': shift draws of log10 a_T that are not finite or beyond "
+                         f"±{SHIFT_RANGE + SHIFT_MARGIN:g} decades, which no run writes; run "
+                         f"bayesfo mastercurve again into '{d}'")
     return MasterCurve(
         structure=name, temperatures=temperatures,
         reference_temperature=float(summary["reference_temperature"]),
-        shift_draws=shifted.log_shifts(theta), master_draws=theta[:, :master.n_params],
+        shift_draws=shifts, master_draws=theta[:, :master.n_params],
         posterior=post, log_evidence=_num(summary["log_evidence"]),
         log_evidence_err=_num(summary["log_evidence_err"]), laws=summary["laws"], data=joint,
         isotherms=isotherms, notes=tuple(summary["notes"]), ranking=tuple(summary["structures"]),
@@ -343,6 +417,49 @@ def _mastercurve(summary: dict, d: Path, library):
         shifts_from=summary.get("shifts_from") or "joint",
         vertical_evidence=summary.get("vertical_evidence") or {},
         shift_evidence=summary.get("shift_evidence") or {})
+
+
+def _tampered(where: Path, what: str):
+    return InputError(f"'{where}': {what}, which bayesfo never writes (edited?); run the "
+                      f"command that wrote '{where.parent}' again")
+
+
+def _check_master_summary(summary: dict, where: Path) -> None:
+    """The blocks of a master curve's summary.json that load passes on unread, checked now
+    (a tampered file failed later, in predict or export, with AttributeError or ValueError)."""
+    from ..tts.joint import VERTICAL
+    from ..tts.model import LAWS
+
+    laws = summary.get("laws")
+    if not isinstance(laws, dict) or not all(
+            isinstance(v, dict) and isinstance(v.get("parameters"), dict)
+            and _is_probability(v.get("probability")) for v in laws.values()):
+        raise _tampered(where, "'laws' is not a table of shift laws with their parameters and "
+                               "probabilities")
+    checks = summary.get("tts_checks")
+    if not isinstance(checks, dict) or not all(isinstance(v, dict) for v in checks.values()):
+        raise _tampered(where, "'tts_checks' is not a table of checks")
+    if summary.get("vertical", "none") not in VERTICAL:
+        raise _tampered(where, f"'vertical' is {summary.get('vertical')!r}, not one of "
+                               f"{', '.join(VERTICAL)}")
+    if summary.get("law", "free") not in LAWS or (
+            summary.get("law", "free") != "free" and summary["law"] not in laws):
+        raise _tampered(where, f"'law' is {summary.get('law')!r}, not one of {', '.join(LAWS)} "
+                               "with its entry in 'laws'")
+    _check_noise(summary["posterior"], where)
+
+
+def _is_probability(value) -> bool:
+    return (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and 0.0 <= value <= 1.0)
+
+
+def _check_noise(s: dict, where: Path) -> None:
+    from ..inference.likelihood import NOISE_MODELS
+
+    if s.get("noise") not in NOISE_MODELS:
+        raise _tampered(where, f"the noise model of '{s.get('name')}' is {s.get('noise')!r}, "
+                               f"not one of {', '.join(NOISE_MODELS)}")
 
 
 def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> PosteriorResult:
@@ -357,6 +474,14 @@ def _posterior(s: dict, idata, data: FrequencyResponse, path: Path) -> Posterior
     if samples.shape[0] != s["n_draws"]:
         raise InputError(f"'{path}': {samples.shape[0]} draws, but summary.json says "
                          f"{s['n_draws']}")
+    if not np.all(np.isfinite(samples)):
+        raise InputError(f"'{path}': draws that are not finite numbers, which no run writes; "
+                         f"run the command that wrote '{path.parent}' again")
+    recorded = s.get("draws_sha256")  # runs written before it was recorded have none
+    if recorded is not None and recorded != draws_digest(samples):
+        raise InputError(f"'{path}': its draws are not those that '{path.parent / 'summary.json'}' "
+                         "describes (the file of another run, copied in?); run the command "
+                         f"that wrote '{path.parent}' again, or copy the whole directory")
     pointwise = np.asarray(idata.log_likelihood["G"].values, dtype=float)
     loglik = pointwise.reshape(-1, data.n_frequencies).sum(axis=1)
     fields = [f.name for f in dataclasses.fields(ParameterSummary)]

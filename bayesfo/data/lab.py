@@ -409,7 +409,7 @@ def _contract(path, kind, units, name, lines) -> Isotherm:
         elif stripped and header_line is None:
             header_line = lineno
             header = [c.strip().lower() for c in csv_cells(line, f"file '{path}'", lineno)]
-    temperature = _plain_temperature(meta.get("temperature"))
+    temperature = _plain_temperature(meta.get("temperature"), f"file '{path}'")
     reason = (data.notes[0] if data.notes and data.notes[0].startswith("kind modulus")
               else f"kind {data.kind} as asked" if kind is not None
               else f"kind {data.kind} from the file's '# kind:' line" if "kind" in meta
@@ -422,9 +422,17 @@ def _contract(path, kind, units, name, lines) -> Isotherm:
     return Isotherm(data, temperature, "", reading)
 
 
-def _plain_temperature(text: str | None) -> float | None:
+def _plain_temperature(text: str | None, where: str = "") -> float | None:
     if not text:
         return None
+    from .temperature import looks_like_kelvin
+
+    if looks_like_kelvin(text):
+        value = float(text.replace("C", "").strip())
+        warnings.warn(f"{where + ': ' if where else ''}'# temperature: {text}' has no unit and "
+                      f"is read as {value:g} °C, yet it looks like kelvin "
+                      f"({value - 273.15:g} °C); write '{text} K' or '{text} C'", DataWarning,
+                      stacklevel=3)
     found = temperature_in_text(text)
     if found is not None:
         return found
@@ -527,7 +535,8 @@ def _complete_skips(iso: Isotherm, skipped: list[str]) -> Isotherm:
 def _file_temperature(iso: Isotherm, meta: dict, params: dict) -> Isotherm:
     if iso.temperature is not None:
         return iso
-    t, source = _plain_temperature(meta.get("temperature")), "the '# temperature:' line"
+    t = _plain_temperature(meta.get("temperature"), f"file '{iso.data.source}'")
+    source = "the '# temperature:' line"
     if t is None:
         return iso
     reading = replace(iso.reading, temperature=t, temperature_source=source)

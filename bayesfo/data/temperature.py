@@ -46,6 +46,18 @@ def parse_temperature(text: str) -> float | None:
     return value
 
 
+def looks_like_kelvin(text: str) -> bool:
+    """Whether a temperature written without a unit reads as kelvin: 173.15 or more (−100 °C
+    in kelvin) and a whole number of degrees (or a half) above 273.15, as 293.15 or 423.15 are
+    (a number of degrees Celsius ending in .15 is rare)."""
+    m = _TEMPERATURE_VALUE.match(text)
+    if not m or m.group(2):
+        return False
+    value = float(m.group(1).replace("\u2212", "-"))
+    return value >= 173.15 and abs(2 * (value - 273.15) - round(2 * (value - 273.15))) < 1e-6 \
+        and abs(value - round(value)) > 1e-6
+
+
 def temperature_from_stem(stem: str) -> float | None:
     """A temperature in °C from a file stem such as ``T020C``, ``Tp020C``, ``Tm010C`` (−10 °C).
 
@@ -92,6 +104,15 @@ def temperature_of_file(path) -> float | None:
             if meta[key] is None:
                 raise InputError(f"file '{path}', line {lineno}: '# temperature:' expects a "
                                  f"temperature such as 20, 20 C or 293.15 K, got {value.strip()!r}")
+            if looks_like_kelvin(value):
+                import warnings
+
+                from ..errors import DataWarning
+
+                warnings.warn(f"file '{path}', line {lineno}: '# temperature: {value.strip()}' "
+                              f"has no unit and is read as {meta[key]:g} °C, yet it looks like "
+                              f"kelvin ({meta[key] - 273.15:g} °C); write '{value.strip()} K' "
+                              f"or '{value.strip()} C'", DataWarning, stacklevel=2)
         elif sep and key == "name":
             meta.setdefault(key, value.strip())
     if meta.get("temperature") is not None:

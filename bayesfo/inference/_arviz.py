@@ -130,13 +130,75 @@ def group_names(tree) -> tuple[str, ...]:
     return tuple(tree.children)
 
 
-def open_tree(path: Path):
+def open_tree(path: Path, keep: dict | None = None, sizes: dict | None = None,
+              max_elements: int | None = None):
     """A DataTree read from a NetCDF file (arviz 1.x or 0.x), loaded into memory and the file
-    closed."""
+    closed.
+
+    With ``keep`` (``{group: names}``), only those groups and variables are read (what else
+    the file holds is never loaded); with ``sizes`` (``{dimension: length or None}``, and
+    ``"draws"``: chains × draws), a kept variable along another dimension or of another length
+    is refused before it is read, and so is one of more than ``max_elements`` values.
+
+    Raises
+    ------
+    ValueError
+        A variable whose dimensions or size are not those expected (the message names it).
+    """
     import xarray as xr
 
     with xr.open_datatree(path, engine=ENGINE) as tree:
-        return tree.load()
+        if keep is None:
+            return tree.load()
+        groups = {}
+        for group, names in keep.items():
+            if group not in tree.children:
+                continue
+            ds = tree[group].to_dataset()
+            ds = ds[[n for n in names if n in ds.data_vars]]
+            for name, var in ds.variables.items():
+                where = f"variable '{group}/{name}'"
+                for dim, length in var.sizes.items():
+                    if sizes is not None and dim not in sizes:
+                        raise ValueError(f"{where} has a dimension '{dim}' that bayesfo does "
+                                         "not write")
+                    if sizes is not None and sizes[dim] is not None and sizes[dim] != length:
+                        raise ValueError(f"{where} has {length} values along '{dim}', where "
+                                         f"summary.json says {sizes[dim]}")
+                draws = var.sizes.get("chain", 1) * var.sizes.get("draw", 1)
+                if (sizes is not None and sizes.get("draws") is not None
+                        and {"chain", "draw"} <= set(var.dims) and draws != sizes["draws"]):
+                    raise ValueError(f"{where} holds {draws} draws, where summary.json says "
+                                     f"{sizes['draws']}")
+                if max_elements is not None and var.size > max_elements:
+                    raise ValueError(f"{where} has {var.size} values, more than the "
+                                     f"{max_elements} bayesfo reads")
+            groups[group] = ds.load()
+        return xr.DataTree.from_dict(groups)
+
+
+def external_storage(path: Path) -> str | None:
+    """The first dataset of an HDF5 file whose values lie outside it (external or virtual
+    storage: reading it would read another file), or None; None also where h5py is not
+    installed (then only the variables bayesfo names are read, see :func:`open_tree`)."""
+    try:
+        import h5py
+    except ImportError:
+        return None
+    found = []
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset) and (obj.external or obj.is_virtual):
+            found.append(name)
+            return True
+        return None
+
+    try:
+        with h5py.File(path, "r") as f:
+            f.visititems(visit)
+    except Exception:  # h5py cannot read it (its HDF5 differs from netCDF-C's): not checked
+        return None
+    return found[0] if found else None
 
 
 def write_tree(tree, path) -> None:

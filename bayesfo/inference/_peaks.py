@@ -1,6 +1,6 @@
 """The log posterior's peaks as importance sampling and its ridge probe use them: the maximum
 near a point within the prior box (:func:`_polish`, :func:`_polished`), the gradient and
-Hessian by central differences in one vectorised call (:func:`_hessian`), the Laplace
+Hessian by central differences in vectorised calls (:func:`_hessian`), the Laplace
 approximation at a peak (:func:`_laplace`, with :func:`_inward` where the peak is on the edge
 of the support), and the density of the Student-t mixtures built at the peaks
 (:func:`_mixture_log_pdf`)."""
@@ -15,19 +15,29 @@ from scipy.special import gammaln, logsumexp
 DF = 5.0  # Student-t degrees of freedom: heavier tails than the Laplace approximation
 
 
+#: Rows of the stencil that :func:`_hessian` passes to ``f`` at once: a master curve of 200
+#: isotherms has some 200 parameters and 83 000 stencil points, which ``f`` evaluated over
+#: every data point in one piece (83 000 × 1000 complex, a MemoryError).
+STENCIL_CHUNK = 1024
+
+
 def _hessian(f, u0: np.ndarray, h: np.ndarray):
     """Gradient and Hessian of ``f`` (vectorised over rows) at ``u0`` by central differences,
-    in one call of ``f``; None if a point of the stencil leaves the support."""
+    in calls of ``f`` on at most :data:`STENCIL_CHUNK` points; None if a point of the stencil
+    leaves the support."""
     d = u0.size
     eye = np.eye(d) * h
-    pts = [u0]
-    for i in range(d):
-        pts += [u0 + eye[i], u0 - eye[i]]
     pairs = [(i, j) for i in range(d) for j in range(i + 1, d)]
-    for i, j in pairs:
-        pts += [u0 + eye[i] + eye[j], u0 + eye[i] - eye[j], u0 - eye[i] + eye[j],
-                u0 - eye[i] - eye[j]]
-    v = f(np.array(pts))
+    pts = np.empty((1 + 2 * d + 4 * len(pairs), d))
+    pts[0] = u0
+    for i in range(d):
+        pts[1 + 2 * i], pts[2 + 2 * i] = u0 + eye[i], u0 - eye[i]
+    base = 1 + 2 * d
+    for k, (i, j) in enumerate(pairs):
+        pts[base + 4 * k: base + 4 * k + 4] = (u0 + eye[i] + eye[j], u0 + eye[i] - eye[j],
+                                               u0 - eye[i] + eye[j], u0 - eye[i] - eye[j])
+    v = np.concatenate([np.asarray(f(pts[k:k + STENCIL_CHUNK]))
+                        for k in range(0, pts.shape[0], STENCIL_CHUNK)])
     if not np.all(np.isfinite(v)):
         return None
     f0 = v[0]

@@ -5,6 +5,7 @@ tempered ladder's particles, importance sampling), and written as NetCDF."""
 from __future__ import annotations
 
 import errno
+import hashlib
 import math
 import os
 import shutil
@@ -146,8 +147,21 @@ class PosteriorResult:
             "rhat_max": self.rhat_max, "ess_bulk_min": self.ess_bulk_min,
             "ess_tail_min": self.ess_tail_min, "ess_min": self.ess_min,
             "converged": self.converged, "messages": list(self.messages),
-            "sampler": self.sampler,
+            "sampler": self.sampler, "draws_sha256": draws_digest(self.samples),
         }
+
+
+def draws_digest(samples) -> str:
+    """SHA-256 of a set of draws (rows), in hex, whatever their order: what ties a posterior's
+    NetCDF to the ``summary.json`` written with it (:func:`bayesfo.load` refuses a NetCDF
+    whose draws are not those the summary describes: one copied in from another run)."""
+    a = np.asarray(samples, dtype="<f8")
+    a = a.reshape(a.shape[0], -1) if a.ndim else a.reshape(1, 1)
+    a = a + 0.0  # -0.0 and 0.0 alike
+    rows = a[np.lexsort(a.T[::-1])] if a.size else a
+    h = hashlib.sha256(f"{a.shape[0]}x{a.shape[1]}:".encode())
+    h.update(np.ascontiguousarray(rows).tobytes())
+    return h.hexdigest()
 
 
 @dataclass(frozen=True)

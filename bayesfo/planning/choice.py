@@ -275,6 +275,33 @@ def _checked(data, window, points, cost) -> tuple[float, float]:
     return w_lo, w_hi
 
 
+#: How far beyond the measured frequencies [decades] a proposed frequency may lie: the
+#: structures' predictions further out are extrapolations that the data do not constrain (a
+#: window of 1e-6 to 1e6 rad/s proposed 1e6, four decades beyond the data, with an "expected
+#: change" of ln B of -128350).
+MAX_REACH_DECADES = 3.0
+
+
+def capped_window(data, w_lo: float, w_hi: float) -> tuple[float, float, str | None]:
+    """The window cut to :data:`MAX_REACH_DECADES` beyond the data's frequencies, and a note
+    saying so where it was (else None)."""
+    reach = 10.0 ** MAX_REACH_DECADES * (1 + 1e-9)  # a window just at the reach is kept
+    lo = max(w_lo, float(data.omega.min()) / reach)
+    hi = min(w_hi, float(data.omega.max()) * reach)
+    if lo >= hi:
+        raise InputError(f"argument 'window' ({w_lo:.4g}, {w_hi:.4g}) lies wholly more than "
+                         f"{MAX_REACH_DECADES:g} decades beyond the measured frequencies "
+                         f"({float(data.omega.min()):.4g}-{float(data.omega.max()):.4g} "
+                         "rad/s), where the data constrain no prediction; give a window that "
+                         "reaches nearer")
+    if (lo, hi) == (w_lo, w_hi):
+        return w_lo, w_hi, None
+    return lo, hi, (f"the window {w_lo:.4g}-{w_hi:.4g} rad/s is cut to {lo:.4g}-{hi:.4g} rad/s, "
+                    f"{MAX_REACH_DECADES:g} decades beyond the measured frequencies at most: "
+                    "further out the structures' predictions are extrapolations the data do "
+                    "not constrain")
+
+
 def _named_notes(ranked, names) -> list[str]:
     """What the user should know of the structures ``--structures`` names: the best ranked
     structure left out, and named structures that fail the posterior predictive checks (telling
@@ -328,8 +355,9 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     data = result.data
     lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
     w_lo, w_hi = _checked(data, window, points, cost)
+    w_lo, w_hi, cut = capped_window(data, w_lo, w_hi)
     ranked = [result[n] for n in result.ranking]
-    notes = []
+    notes = [] if cut is None else [cut]
     if structures is not None:
         names = [structures] if isinstance(structures, str) else list(structures)
         known = {r.name for r in ranked}

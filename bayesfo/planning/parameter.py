@@ -9,7 +9,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .choice import N_CANDIDATES, N_DRAWS, _checked, _draws_at, _relative_sigma, seconds
+from .choice import (
+    N_CANDIDATES,
+    N_DRAWS,
+    _checked,
+    _draws_at,
+    _relative_sigma,
+    capped_window,
+    seconds,
+)
 
 __all__ = ["ParameterDesign", "design_parameter"]
 
@@ -88,6 +96,13 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
         An unknown structure or parameter, or a bad window, count or cost.
     """
     w_lo, w_hi = _checked(result.data, window, points, cost)
+    w_lo, w_hi, cut = capped_window(result.data, w_lo, w_hi)
+    if cut is not None:
+        import warnings
+
+        from ..errors import DataWarning
+
+        warnings.warn(cut, DataWarning, stacklevel=2)
     name = structure or (result.ranking[0] if result.ranking else None)
     if name not in result.ranking:
         raise InputError(f"design: no structure '{name}' with a posterior in the comparison; it "

@@ -30,20 +30,29 @@ from .response import plot_bode, plot_nyquist, plot_residuals
 from .style import comparison_styles, style
 
 
-def save_figure(fig, path, *, close: bool = False) -> None:
+def save_figure(fig, path, *, close: bool = False, named: bool = False) -> None:
     """Save ``fig`` to ``path`` (format from the suffix) through a temporary file; with
-    ``close``, close it afterwards (also when the save fails)."""
+    ``close``, close it afterwards (also when the save fails). With ``named`` (a file the user
+    named: ``--figure FILE``), a symbolic link is written through and a device or FIFO written
+    into, never replaced (:func:`bayesfo._io.write_target`)."""
     if close:
         import matplotlib.pyplot as plt
 
         try:
-            return save_figure(fig, path)
+            return save_figure(fig, path, named=named)
         finally:
             plt.close(fig)
-    from .._io import publish
+    from .._io import is_special, publish, write_into, write_target
     from .._signals import cause
 
-    path = Path(path)
+    path = write_target(path) if named else Path(path)
+    if named and is_special(path):
+        import io
+
+        buffer = io.BytesIO()
+        fig.savefig(buffer, dpi=200, format=path.suffix.lower().lstrip(".") or "png")
+        write_into(path, buffer.getvalue())
+        return None
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)

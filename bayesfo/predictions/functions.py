@@ -56,6 +56,14 @@ BAND = 0.94
 MAX_DRAWS = 2000
 #: Draws evaluated at once in the time domain (the contour's nodes multiply the work).
 _CHUNK = 250
+#: Arguments evaluated at once: they are taken in chunks of this many, so that memory stays
+#: bounded whatever their number (``--time 1e-6:1e6:100000``, the command line's largest
+#: grid, took 22 GB in one piece; a chunk's contour values are 250 × 200 × 20 complex, 16 MB).
+_X_CHUNK = 200
+#: Largest number of values (draws × arguments) that a :class:`Prediction` keeps in
+#: ``values``; beyond it ``values`` is None and only the band is kept (2000 draws × 100 000
+#: times would be 1.6 GB).
+MAX_KEPT_VALUES = 20_000_000
 
 
 @dataclass(frozen=True)
@@ -82,8 +90,9 @@ class Prediction:
     notes : tuple of str
         What the user should know (an inadequate structure carrying weight, the two
         weightings disagreeing, a discrete spectrum).
-    values : ndarray, shape (n_draws, n_x)
-        The quantity for each draw used.
+    values : ndarray, shape (n_draws, n_x), or None
+        The quantity for each draw used; None where they would be more than
+        :data:`MAX_KEPT_VALUES` (the band is computed in chunks of the arguments).
     symbol : str
         The quantity's symbol in the letters of the data (E′, E(t), D(t) for tensile data;
         :mod:`bayesfo.data.symbols`).
@@ -216,7 +225,10 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
         raise InputError("predict: a temperature applies to a master curve only (bayesfo "
                          "mastercurve); a comparison describes the data at their own temperature")
     weights, notes, drawn = _mixture(result, structure, average, rng)
-    values = np.concatenate([_evaluate(s, theta, quantity, x) for s, theta in drawn], axis=0)
+    median, lo, hi, values = _chunked_band(
+        lambda part: np.concatenate([_evaluate(s, theta, quantity, part)
+                                     for s, theta in drawn], axis=0),
+        x, sum(theta.shape[0] for _, theta in drawn))
     if average is None:
         notes += _misfit_note(result[next(iter(weights))])
     if quantity in ("relaxation_spectrum", "retardation_spectrum"):
@@ -225,7 +237,6 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
             notes.append(f"{', '.join(discrete)}: integer orders give a discrete spectrum "
                          "(lines at the relaxation times), which a continuous density shows "
                          "as 0 between them")
-    median, lo, hi = _band(values)
     undefined = np.flatnonzero(np.isnan(median))
     if undefined.size:
         shown = ", ".join(f"{v:.4g}" for v in x[undefined[:6]])
@@ -253,11 +264,16 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
     t = mc.reference_temperature if temperature is None else temperature
     master, theta, log_a, log_b, mean_a = _master_draws(mc, structure, average, t, rng)
     a = 10.0 ** log_a[:, None]
-    x_ref = x[None, :] * a if domain == "omega" else x[None, :] / a
-    values = _evaluate(master, theta, quantity, x_ref)
     pa, pb = _SCALING[QUANTITIES[quantity][2]]
-    if pa or pb:
-        values = values * 10.0 ** (pa * log_a + pb * log_b)[:, None]
+
+    def at(part):
+        values = _evaluate(master, theta, quantity,
+                           part[None, :] * a if domain == "omega" else part[None, :] / a)
+        if pa or pb:
+            values = values * 10.0 ** (pa * log_a + pb * log_b)[:, None]
+        return values
+
+    median, lo, hi, values = _chunked_band(at, x, theta.shape[0])
     notes = [] if temperature is None else [
         f"at {float(t):g} °C from the master curve at {mc.reference_temperature:g} °C with each "
         f"draw's shifts (log10 a_T median {np.median(log_a):.3g}"
@@ -267,7 +283,6 @@ def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) 
         notes.append(missed[0].lower() + missed[1:].rstrip(".") + "; the band is the posterior "
                      "of its mean function, without the data's scatter or its misfit, so "
                      "measured values may lie outside it")
-    median, lo, hi = _band(values)
     # At the posterior mean shift, as the reduced window: an isotherm's own frequencies at its
     # own temperature are then inside it.
     window = mc.reduced_omega() / 10.0 ** mean_a
@@ -523,6 +538,23 @@ def evaluate_together(structure, theta, quantities, x) -> dict[str, np.ndarray]:
     with np.errstate(all="ignore"):
         values = _time_domain(structure, theta, quantities, x)
     return dict(zip(quantities, values, strict=True))
+
+
+def _chunked_band(values_at, x, n_draws: int):
+    """Median, HDI ends and (up to :data:`MAX_KEPT_VALUES`, else None) the values of
+    ``values_at(part)`` (draws × part) over ``x``, taken in chunks of :data:`_X_CHUNK`
+    arguments: each column's band is its own, so the chunks give the same band as one piece,
+    in memory that does not grow with the number of arguments."""
+    step = _X_CHUNK
+    keep = n_draws * x.size <= MAX_KEPT_VALUES
+    bands, kept = [], []
+    for i in range(0, x.size, step):
+        values = values_at(x[i:i + step])
+        bands.append(_band(values))
+        if keep:
+            kept.append(values)
+    median, lo, hi = (np.concatenate(parts) for parts in zip(*bands, strict=True))
+    return median, lo, hi, (np.concatenate(kept, axis=1) if keep else None)
 
 
 def _band(values) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

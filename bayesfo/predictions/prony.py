@@ -125,6 +125,8 @@ class Prony:
         For a master curve whose evidence rejects every shift law: why none is written.
     shift_table : tuple of (float, float)
         Then the isotherms' own shifts, (temperature [°C], log10 a_T) at posterior means.
+    g_inf_fixed : bool
+        Whether ``g_inf`` was held at 0 (a liquid, or ``liquid=True``) rather than fitted.
     """
 
     tau: np.ndarray
@@ -147,6 +149,7 @@ class Prony:
     max_terms: int | None = None
     shift_note: str = ""
     shift_table: tuple = ()
+    g_inf_fixed: bool = False
 
     @property
     def g_0(self) -> float:
@@ -282,9 +285,14 @@ class Prony:
             return []
         unit = _unit_suffix(self.unit)
         if self.g_inf == 0.0:
-            return (["g_inf = 0: the model relaxes fully (a liquid)"] if model == 0.0 else
-                    [f"g_inf = 0 as asked, where the model's long-time modulus is {model:.6g}"
-                     f"{unit}"])
+            if model == 0.0:
+                return ["g_inf = 0: the model relaxes fully (a liquid)"]
+            if self.g_inf_fixed:
+                return [f"g_inf = 0 as asked, where the model's long-time modulus is "
+                        f"{model:.6g}{unit}"]
+            return [f"g_inf was fitted as 0 (the terms carry the relaxation up to the longest "
+                    f"relaxation time, {longest:.4g} s), where the model's long-time modulus "
+                    f"is {model:.6g}{unit}"]
         what = ("relaxes fully (a liquid)" if model == 0.0
                 else "does not settle (its G(t) grows without bound)" if math.isinf(model)
                 else f"has the long-time modulus {model:.6g}{unit}")
@@ -444,7 +452,8 @@ def prony_series(result, *, per_decade: int | None = None, liquid: bool | None =
                    symbol=data.symbol, measured_max=float(np.max(measured)),
                    model_g_inf=model_g_inf, max_rel_error_storage=err_storage,
                    max_rel_error_loss=err_loss, band_fraction=_band_fraction(series_t, g_t),
-                   rule=rule, max_terms=max_terms, shift_note=law_note, shift_table=table)
+                   rule=rule, max_terms=max_terms, shift_note=law_note, shift_table=table,
+                   g_inf_fixed=bool(liquid))
 
 
 def _nnls(g: np.ndarray, omega: np.ndarray, tau: np.ndarray, liquid: bool):

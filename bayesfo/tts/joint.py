@@ -147,6 +147,8 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         raise InputError(f"shifts must be one of {', '.join(SHIFTS_FROM)}, got {shifts!r}")
     names = _master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
+    _warn_negative_loss(iso)
+    _warn_temperature_gap(iso)
     if noise not in ("auto", *NOISE_MODELS):
         raise InputError(f"noise must be one of auto, {', '.join(NOISE_MODELS)}, got {noise!r}")
     if shifts == "smooth":
@@ -216,6 +218,10 @@ def _checks(iso, chosen: MasterCurve, vertical: str) -> tuple[dict, list]:
     notes = []
     if vgp["valid"] is not True:
         notes.append(describe(vgp))
+    if vgp["valid"] is None and parts["consistent"] is None:
+        notes.append("superposition untested (tts_valid null): no neighbouring isotherms share "
+                     "values of |G*|, G′, G″ or tan δ, so the shifts come from the master "
+                     "function alone, not from overlapping data")
     if parts["consistent"] is False:
         notes.append(describe_parts(parts) + (
             "" if vertical == "none" else " (the model's vertical shifts account for the "
@@ -348,6 +354,43 @@ def _try_on_shifts(iso, structure, noise, seed, sh, reach):
         return fit_on_shifts(iso, structure, noise, seed, sh, reach)
     except InputError as exc:
         return str(exc)
+
+
+def _warn_negative_loss(iso) -> None:
+    """Warn of isotherms with points of negative loss, as ``compare`` and ``inspect`` do: no
+    passive master function fits them."""
+    import warnings
+
+    from ..errors import DataWarning
+
+    for data, t in zip(iso.data, iso.temperatures, strict=True):
+        bad = data.omega[data.dissipation_violations()]
+        if bad.size:
+            shown = ", ".join(f"{w:.4g}" for w in bad[:6]) + (
+                f" and {bad.size - 6} more" if bad.size > 6 else "")
+            loss = "Im J > 0" if data.kind == "compliance" else "Im G < 0"
+            warnings.warn(f"the isotherm at {t:g} °C ({data.label}): {bad.size} of "
+                          f"{data.n_frequencies} points have negative loss ({loss}), impossible "
+                          f"for a passive {data.kind}, at omega = {shown} rad/s; no passive "
+                          "master function can fit them", DataWarning, stacklevel=3)
+
+
+#: Neighbouring isotherms further apart than this [°C] are warned of: a temperature in kelvin
+#: read as °C (293.15 beside 10 °C) gave a master curve with WLF C1 0.80.
+TEMPERATURE_GAP = 200.0
+
+
+def _warn_temperature_gap(iso) -> None:
+    import warnings
+
+    from ..errors import DataWarning
+
+    temps = sorted(float(t) for t in iso.temperatures)
+    for low, high in zip(temps, temps[1:]):
+        if high - low > TEMPERATURE_GAP:
+            warnings.warn(f"the isotherms at {low:g} and {high:g} °C are {high - low:g} °C "
+                          "apart, with none between: is a temperature in kelvin read as °C? "
+                          "(write '293.15 K', not '293.15')", DataWarning, stacklevel=3)
 
 
 def _master_names(structures) -> list:

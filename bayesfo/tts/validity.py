@@ -162,6 +162,10 @@ def _shift_of(xl, yl, xu, yu) -> dict | None:
     xl, yl, xu, yu = xl[ok_l], yl[ok_l], xu[ok_u], yu[ok_u]
     if xl.size < 3 or xu.size < 3:
         return None
+    # No value in common: no horizontal shift lays one curve on the other (the overlay's
+    # search would end at its window's edge, where the curves come closest, and "agree").
+    if max(yl.min(), yu.min()) >= min(yl.max(), yu.max()):
+        return None
     d = overlay_shift(xl, (yl,), xu, (yu,), min_inside=3, refine=True)
     if d is None:
         return None

@@ -51,3 +51,26 @@ def test_moments_that_overflow_are_undefined_not_a_warning():
     assert s["hdi_low"] <= s["median"] <= s["hdi_high"]
     ordinary = summarise_draws(np.arange(5.0), 2.0, "s")
     assert ordinary["mean"] == 2.0 and math.isclose(ordinary["sd"], math.sqrt(2.5))
+
+
+def test_the_hessian_stencil_is_evaluated_in_bounded_chunks():
+    """A master curve of 200 isotherms (some 200 parameters) has 83 000 stencil points: the log
+    posterior was evaluated on all of them at once (83 000 × 1000 complex, a MemoryError). The
+    chunks give the same gradient and Hessian."""
+    import numpy as np
+
+    from bayesfo.inference import _peaks
+
+    a = np.random.default_rng(0).normal(size=(30, 30))
+    a = a @ a.T + 30 * np.eye(30)
+    largest = []
+
+    def f(u):
+        largest.append(u.shape[0])
+        return -0.5 * np.einsum("ni,ij,nj->n", u, a, u)
+
+    out = _peaks._hessian(f, np.full(30, 0.1), np.full(30, 1e-3))
+    assert max(largest) <= _peaks.STENCIL_CHUNK < 1 + 2 * 30 + 2 * 30 * 29
+    f0, grad, hess = out
+    np.testing.assert_allclose(hess, -a, rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(grad, -a @ np.full(30, 0.1), rtol=1e-6)

@@ -835,3 +835,26 @@ def test_an_eplexor_xls_workbook_is_read_directly():
     np.testing.assert_allclose(first.data.response, 1e6 * (rows[:10, 2] + 1j * rows[:10, 3]),
                                rtol=1e-12)
     assert sets[-1].temperature == pytest.approx(100.0, abs=0.1)
+
+
+def test_a_temperature_without_unit_that_reads_as_kelvin_is_warned_of(tmp_path):
+    """'# temperature: 293.15' was read as 293.15 °C without a word (issue 65): the master
+    curve of it beside '273.15 K' and '10 C' gave WLF C1 0.80."""
+    import warnings as _warnings
+
+    from bayesfo.data import read_isotherms
+    from bayesfo.data.temperature import temperature_of_file
+    from bayesfo.errors import DataWarning
+
+    path = tmp_path / "k.csv"
+    path.write_text("# temperature: 293.15\nomega,storage,loss\n1,1,1\n2,2,2\n3,3,3\n")
+    for reader in (lambda: read_isotherms(path)[0].temperature, lambda: temperature_of_file(path)):
+        with pytest.warns(DataWarning, match=r"'# temperature: 293.15' has no unit and is read "
+                                             r"as 293.15 °C, yet it looks like kelvin \(20 °C\)"):
+            assert reader() == 293.15
+    for text in ("20", "150", "293.15 K", "20.15"):
+        path.write_text(f"# temperature: {text}\nomega,storage,loss\n1,1,1\n2,2,2\n3,3,3\n")
+        with _warnings.catch_warnings():
+            _warnings.simplefilter("error", DataWarning)
+            read_isotherms(path)
+            temperature_of_file(path)

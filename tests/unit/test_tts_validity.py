@@ -171,3 +171,70 @@ def test_isotherms_shifted_by_whole_grid_steps_merge_their_common_frequencies():
     common = np.isclose(reduced.omega, w[3], rtol=1e-8)
     assert common.sum() == 1
     assert np.isclose(reduced.response[common][0], (g[3] + 2.0 * g[0]) / 2)
+
+
+def test_parts_without_common_values_are_untested_not_agreeing():
+    """Isotherms whose G′, G″ and tan δ share no values (the adhesive at −40, 0 and 150 °C):
+    the overlay's search ended at its window's edge (−1.999 decades for every part), where the
+    curves come closest, and the parts "agreed" (issue 65)."""
+    from pathlib import Path
+
+    import bayesfo as bf
+    from bayesfo.tts.validity import shifts_by_part
+
+    folder = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+    isotherms = [bf.read(folder / f"{n}.csv") for n in ("Tm040C", "Tp000C", "Tp150C")]
+    check = shifts_by_part(isotherms, [-40.0, 0.0, 150.0])
+    assert check["consistent"] is None
+    assert all(p[part] is None for p in check["pairs"] for part in ("storage", "loss",
+                                                                     "tan_delta"))
+    assert van_gurp_palmen(isotherms, [-40.0, 0.0, 150.0])["valid"] is None
+
+
+def test_mastercurve_warns_of_negative_loss_as_compare_does(monkeypatch):
+    """The adhesive at −40 °C has points of G″ < 0: compare and inspect said so, mastercurve
+    did not (issue 65). The fits are not run here: the warning comes before them."""
+    from pathlib import Path
+
+    import bayesfo as bf
+    import bayesfo.parallel
+    from bayesfo.errors import DataWarning
+    from bayesfo.tts import mastercurve
+
+    class Stop(Exception):
+        pass
+
+    def stop(*args, **kwargs):
+        raise Stop
+
+    monkeypatch.setattr(bayesfo.parallel, "executor", stop)
+    folder = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+    isotherms = [(bf.read(folder / f"{n}.csv"), t) for n, t in (("Tm040C", -40.0),
+                                                                 ("Tm030C", -30.0))]
+    with pytest.warns(DataWarning, match=r"the isotherm at -40 °C .*: 1 of 17 points have "
+                                         r"negative loss \(Im G < 0\)"), pytest.raises(Stop):
+        mastercurve(isotherms, "zener")
+
+
+def test_mastercurve_warns_of_isotherms_hundreds_of_degrees_apart(monkeypatch):
+    """293.15 (kelvin meant, °C read) beside 10 °C: a master curve with WLF C1 0.80."""
+    from pathlib import Path
+
+    import bayesfo as bf
+    import bayesfo.parallel
+    from bayesfo.errors import DataWarning
+    from bayesfo.tts import mastercurve
+
+    class Stop(Exception):
+        pass
+
+    def stop(*args, **kwargs):
+        raise Stop
+
+    monkeypatch.setattr(bayesfo.parallel, "executor", stop)
+    folder = Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
+    isotherms = [(bf.read(folder / "Tp010C.csv"), 10.0), (bf.read(folder / "Tp020C.csv"),
+                                                          293.15)]
+    with pytest.warns(DataWarning, match=r"the isotherms at 10 and 293.15 °C are 283.15 °C "
+                                         r"apart"), pytest.raises(Stop):
+        mastercurve(isotherms, "zener")

@@ -8,6 +8,9 @@ from pathlib import Path
 
 from ..errors import InputError
 
+#: The files of a directory that are read as isotherms (lab exports, RepTate's .osc and
+#: .tts, spreadsheets).
+DIRECTORY_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".osc", ".tts", ".xls", ".xlsx")
 #: Master structures ranked by default: a few seconds each on 20 isotherms.
 DEFAULT_STRUCTURES = "zener,max-n2m1,fractional_zener_ll"
 
@@ -79,7 +82,7 @@ def add_parser(subparsers):
 
 def read_isotherm_files(paths, temperatures=None, columns=None) -> list[tuple]:
     """(FrequencyResponse, temperature) of every isotherm in ``paths`` (files, or directories
-    of ``*.csv``); ``temperatures`` (°C, one per file in that order) where the files do not
+    of data files, :data:`DIRECTORY_SUFFIXES`); ``temperatures`` (°C, one per file in that order) where the files do not
     say them; ``columns`` (``{role: column}``, :func:`~bayesfo.data.columns_from_text`) for
     every file, as ``--columns`` of ``compare``."""
     from ..data import read_isotherms
@@ -88,9 +91,11 @@ def read_isotherm_files(paths, temperatures=None, columns=None) -> list[tuple]:
     files = []
     for p in map(Path, paths):
         if p.is_dir():
-            found = sorted(p.glob("*.csv"))
+            found = sorted(f for f in p.iterdir()
+                           if f.is_file() and f.suffix.lower() in DIRECTORY_SUFFIXES)
             if not found:
-                raise InputError(f"'{p}': a directory without *.csv files")
+                raise InputError(f"'{p}': a directory without data files ("
+                                 + ", ".join(f"*{x}" for x in DIRECTORY_SUFFIXES) + ")")
             files.extend(found)
         elif p.is_file():
             files.append(p)
@@ -211,6 +216,12 @@ def _print(mc, out) -> None:
         p = "-" if r["probability"] is None else f"{r['probability']:.3f}"
         if r.get("dropped"):
             print(f"   {r['structure']:<22} dropped: {r['dropped']}")
+            continue
+        if r.get("log_evidence_upper") is not None:
+            p = "-" if r["probability"] is None else f"≤ {r['probability']:.1e}"
+            print(f"   {r['structure']:<22} ln Z "
+                  f"{'≤ ' + format(r['log_evidence_upper'], '.2f'):>20}  P {p}  not sampled "
+                  "(its best fit bounds ln Z)")
             continue
         print(f"   {r['structure']:<22} ln Z {z:>20}  P {p:>6}  "
               f"{'certified' if r['certified'] else 'NOT certified'} ({r['sampler']})")

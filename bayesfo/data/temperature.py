@@ -23,6 +23,15 @@ _TEMPERATURE_IN_NAME = re.compile(rf"({_NUMBER})\s*°\s*C")
 
 _TEMPERATURE_IN_STEM = re.compile(r"(?:^|[_\-\s.])T([mp+\-])?(\d+)(?:[.p](\d+))?C(?=$|[_\-\s.])",
                                   re.IGNORECASE)
+#: Other common ways to name a temperature in a file name: ``_-10C``, ``_25C``, ``25degC``,
+#: ``25°C`` (a number with its unit, standing alone), and ``T25``, ``T-35`` (a T and a number).
+_OTHER_TEMPERATURES_IN_STEM = (
+    re.compile(r"(?:^|(?<=[_\s.]))([+\-])?(\d+)(?:[.p](\d+))?\s*(?:°\s*C|deg\s*C|C)"
+               r"(?=$|[_\-\s.])", re.IGNORECASE),
+    re.compile(r"(?:^|(?<=[\-]))()(\d+)(?:[.p](\d+))?\s*(?:°\s*C|deg\s*C|C)(?=$|[_\-\s.])",
+               re.IGNORECASE),
+    re.compile(r"(?:^|(?<=[_\-\s.]))T([+\-])?(\d+)(?:[.p](\d+))?(?=$|[_\-\s.])"),
+)
 
 
 def parse_temperature(text: str) -> float | None:
@@ -63,14 +72,24 @@ def temperature_from_stem(stem: str) -> float | None:
 
     ``m`` or ``-`` before the digits is a minus sign, ``p`` or ``+`` a plus sign; ``T20p5C`` is
     20.5 °C. The pattern must stand alone in the stem (at its start or end, or between ``_``,
-    ``-``, ``.`` or spaces).
+    ``-``, ``.`` or spaces). Also a number with its unit (``foam_dma_-10C``, ``sample_25C``,
+    ``x_25degC``; a ``-`` after ``_`` or a space is a minus sign, after a letter a separator)
+    and a ``T`` with a number (``T25``, ``run_T-35``).
 
     Examples
     --------
     >>> temperature_from_stem("Tm010C"), temperature_from_stem("run3_T20p5C")
     (-10.0, 20.5)
+    >>> temperature_from_stem("foam_dma_-10C"), temperature_from_stem("x_25degC")
+    (-10.0, 25.0)
+    >>> temperature_from_stem("run_T-35"), temperature_from_stem("PI-130C")
+    (-35.0, 130.0)
     """
     m = _TEMPERATURE_IN_STEM.search(stem)
+    for other in _OTHER_TEMPERATURES_IN_STEM:
+        if m:
+            break
+        m = other.search(stem)
     if not m:
         return None
     value = float(m.group(2) + ("." + m.group(3) if m.group(3) else ""))

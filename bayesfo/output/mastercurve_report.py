@@ -47,6 +47,25 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     text = mc.misfit()
     if text:
         out.append((text, True))
+    if mc.shifts_from == "smooth":
+        out.append(("The shifts come from a model-free master (smooth curves of ln G′ and ln G″ "
+                    "against log10 a_T ω, integrated out): no structure's misfit moves them; "
+                    "the master functions below are fitted to the isotherms so shifted.", False))
+        gone = mc.shift_evidence.get("undetermined") or []
+        if gone:
+            out.append(("The data do not fix the shift of the isotherm(s) at "
+                        + ", ".join(f"{t:g}" for t in gone) + " °C (a featureless stretch of "
+                        "the master curve); the shift laws are fitted without them.", True))
+    vev = mc.vertical_evidence
+    if vev:
+        order = sorted((k for k in vev if vev[k]["log_evidence"] is not None),
+                       key=lambda k: -vev[k]["log_evidence"])
+        if len(order) > 1:
+            names = {"none": "no vertical shift", "density": "the density correction "
+                     "b_T = T_ref/T", "free": "free vertical shifts"}
+            out.append((f"Vertical shifts: {names[order[0]]} (ln Z "
+                        f"{vev[order[0]]['log_evidence'] - vev[order[1]]['log_evidence']:.1f} "
+                        f"above {names[order[1]]}).", False))
     ranked = [r for r in mc.ranking if r.get("log_evidence") is not None]
     if len(ranked) > 1:
         gap = ranked[0]["log_evidence"] - ranked[1]["log_evidence"]
@@ -86,7 +105,8 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
         else:
             out.append((f"{preferred}; it misses them by χ²/dof {chi2:.3g}.", chi2 > 4.0))
     if not mc.posterior.converged:
-        out.append((f"The joint posterior of {mc.structure} is not certified: "
+        out.append((f"The {'joint ' if mc.shifts_from == 'joint' else ''}posterior of "
+                    f"{mc.structure} is not certified: "
                     f"{'; '.join(mc.posterior.messages)}.", True))
     return out
 
@@ -105,9 +125,10 @@ def _isotherms_table(mc) -> str:
 
 def _ranking_table(mc) -> str:
     rows = "".join(
-        f"<tr><td class='text'>{_e(r['structure'])}</td><td>{_num(r['log_evidence'])}</td>"
+        f"<tr><td class='text'>{_e(r['structure'])}</td><td>{_law_log_z(r)}</td>"
         f"<td>{_num(r['log_evidence_err'])}</td><td>{_num(r['probability'], '.3f')}</td>"
-        f"<td class='text'>{'yes' if r['certified'] else 'NO'} ({_e(r['sampler'])})</td></tr>"
+        f"<td class='text'>{'yes' if r['certified'] else 'NO'} ({_e(r['sampler'])}"
+        f"{': ' + _e(r['dropped']) if r.get('dropped') else ''})</td></tr>"
         for r in mc.ranking)
     return ("<table><tr><th class='text'>master function</th><th>ln Z</th><th>± err</th>"
             "<th>probability</th><th class='text'>certified</th></tr>" + rows + "</table>")

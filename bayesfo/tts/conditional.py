@@ -28,26 +28,35 @@ from .spectrum import NAME as SPECTRUM
 from .spectrum import Spectrum
 
 
-def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shifts,
-                  reach: float) -> MasterCurve:
-    """The master curve of ``structure`` on the isotherms shifted by ``shifts`` (see the
-    module).
+def best_on_shifts(iso: _Isotherms, structure, noise: str, seed: int,
+                   shifts: Shifts) -> tuple[np.ndarray, float]:
+    """The optima of ``structure`` on the isotherms shifted by ``shifts`` (scaled, rows) and the
+    highest log-likelihood among the admissible ones (the noise at its maximum-likelihood
+    value): an upper bound of the structure's ln Z.
 
     Raises
     ------
     InputError
         No admissible fit of the structure to the shifted isotherms.
     """
-    from ..identify.optimize import fit_structure
-    from ..inference import Likelihood, certified_posterior
-    from ..inference._arviz import preload
-    from ..inference.results import result_from_draws
-    from ..inference.transform import _Transform
-    from ..parallel import settle_worker
-    from ..structures import Scaling, get_structure
-    from ..structures.response import dissipation_grid
+    from ..inference import Likelihood
 
-    settle_worker(preload)
+    master, reduced, scaling, modes, _ = _setup(iso, structure, seed, shifts)
+    lik = Likelihood(master, reduced, noise=noise, scaling=scaling)
+    theta = modes if not lik.noise_param else np.column_stack(
+        [modes, lik.noise_estimate(modes)])
+    ok = lik.in_support(theta)
+    if not ok.any():
+        raise InputError(f"no admissible fit of {master.name} to the shifted isotherms")
+    return modes, float(np.max(lik(theta[ok])))
+
+
+def _setup(iso: _Isotherms, structure, seed: int, shifts: Shifts, modes=None):
+    """(master, the isotherms at the shifts' posterior mean, scaling, optima (scaled), the
+    reduced window scaled)."""
+    from ..identify.optimize import fit_structure
+    from ..structures import Scaling, get_structure
+
     sp = shifts.posterior
     spectral = structure == SPECTRUM or isinstance(structure, Spectrum)
     joint = iso.joint
@@ -57,14 +66,41 @@ def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shi
     w = reduced.omega / scaling.omega_ref
     if spectral:
         master = Spectrum.over(w.min(), w.max())
-        modes = master.seed(FrequencyResponse(w, reduced.response / scaling.g_ref,
-                                              kind=joint.kind))[None, :]
+        if modes is None:
+            modes = master.seed(FrequencyResponse(w, reduced.response / scaling.g_ref,
+                                                  kind=joint.kind))[None, :]
     else:
         master = get_structure(structure) if isinstance(structure, str) else structure
-        fit = fit_structure(master, reduced, rng=seed, seed_methods=True, scaling=scaling)
-        modes = master.to_scaled(master.to_physical(
-            np.atleast_2d(fit.optima if fit.optima.size else fit.theta_scaled), fit.scaling),
-            scaling)
+        if modes is None:
+            fit = fit_structure(master, reduced, rng=seed, seed_methods=True, scaling=scaling)
+            modes = master.to_scaled(master.to_physical(
+                np.atleast_2d(fit.optima if fit.optima.size else fit.theta_scaled),
+                fit.scaling), scaling)
+    return master, reduced, scaling, modes, w
+
+
+def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shifts,
+                  reach: float, modes=None) -> MasterCurve:
+    """The master curve of ``structure`` on the isotherms shifted by ``shifts`` (see the
+    module), from its optima ``modes`` where :func:`best_on_shifts` found them.
+
+    Raises
+    ------
+    InputError
+        No admissible fit of the structure to the shifted isotherms.
+    """
+    from ..inference import Likelihood, certified_posterior
+    from ..inference._arviz import preload
+    from ..inference.results import result_from_draws
+    from ..inference.transform import _Transform
+    from ..parallel import settle_worker
+    from ..structures.response import dissipation_grid
+
+    settle_worker(preload)
+    sp = shifts.posterior
+    spectral = structure == SPECTRUM or isinstance(structure, Spectrum)
+    joint = iso.joint
+    master, reduced, scaling, modes, w = _setup(iso, structure, seed, shifts, modes)
     lik = Likelihood(master, reduced, noise=noise, scaling=scaling)
     if not np.any(lik.in_support(np.c_[modes, np.full(len(modes), 0.05)]
                                  if lik.noise_param else modes)):
@@ -111,7 +147,7 @@ def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shi
     curves = joint_lik.model(joint_post.samples_scaled[rows, :k_all])
     g = joint_lik.g_scaled
     fitted = np.median(curves.real, axis=0) + 1j * np.median(curves.imag, axis=0)
-    isotherm_fit = isotherm_misfit(iso, fitted, g)
+    isotherm_fit = isotherm_misfit(iso, fitted, g, joint_lik.noise)
     shift_draws = shifted.log_shifts(physical[:, :k_all])
     ev = found.evidence
     return MasterCurve(
@@ -128,11 +164,13 @@ def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shi
         master=master.physical(scaling) if spectral else master, law=shifts.law)
 
 
-def isotherm_misfit(iso: _Isotherms, fitted, g) -> dict:
-    """Each isotherm's rms relative residual, of |G*| and of each part (storage, loss), of the
-    fitted curve ``fitted`` against the data ``g`` (both scaled, the joint data's order); the
-    isotherms missed: a part whose rms exceeds :data:`ISOTHERM_MISFIT` times the median
-    isotherm's of that part."""
+def isotherm_misfit(iso: _Isotherms, fitted, g, noise: str) -> dict:
+    """Each isotherm's rms relative residual of the fitted curve ``fitted`` against the data
+    ``g`` (both scaled, the joint data's order), of |G*| and, under ``relative_parts`` noise
+    (each part's error relative to itself), of each part (storage, loss: a terminal G′ or a
+    glassy G″ that |G*| hides); the isotherms missed: an rms over :data:`ISOTHERM_MISFIT` times
+    the median isotherm's. Under the other noise models a small part's relative residual is
+    large by the noise alone, and |G*| is the measure."""
     rel = np.abs(fitted - g) / np.abs(g)
     with np.errstate(divide="ignore", invalid="ignore"):
         parts = {"storage": np.abs(fitted.real - g.real) / np.abs(g.real),
@@ -147,7 +185,7 @@ def isotherm_misfit(iso: _Isotherms, fitted, g) -> dict:
         return np.array(out)
 
     total = rms(rel)
-    by_part = {k: rms(v) for k, v in parts.items()}
+    by_part = {k: rms(v) for k, v in parts.items()} if noise == "relative_parts" else {}
     missed = set()
     for values in (total, *by_part.values()):
         med = np.nanmedian(values)

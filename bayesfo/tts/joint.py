@@ -37,6 +37,7 @@ from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F
 from .laws import _fit_laws
 from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
 from .result import ISOTHERM_MISFIT, MasterCurve, _num
+from .shifts import BOUND_MARGIN
 from .smooth import UNDETERMINED
 from .spectrum import NAME as SPECTRUM
 from .spectrum import Spectrum
@@ -253,13 +254,35 @@ def _on_smooth_shifts(iso, names, noise: str, vertical: str, law: str, seed: int
                            noise=noise if noise in ("relative_parts", "proportional")
                            else "auto", submit=None if workers == 1 else pool.submit)
         noise = sh.noise if noise == "auto" else noise
-        tried = dict(zip(names, [f.result() for f in [
-            pool.submit(_try_on_shifts, iso, s, noise, seed, sh, reach) for s in names]],
-            strict=True))
-        fits = [f for f in tried.values() if isinstance(f, MasterCurve)]
-        dropped = {(s if isinstance(s, str) else s.name): why for s, why in tried.items()
-                   if isinstance(why, str)}
-        if not fits and SPECTRUM not in names:
+        # Each structure's best fit first; the best one is sampled, then the others whose
+        # best fit reaches within BOUND_MARGIN nats of its ln Z (ln Z ≤ max ln L: the rest
+        # have posterior probability below e^-BOUND_MARGIN and are set aside with the bound).
+        best = dict(zip(names, [f.result() for f in [
+            pool.submit(_try_best, iso, s, noise, seed, sh) for s in names]], strict=True))
+        dropped = {_name(s): why for s, why in best.items() if isinstance(why, str)}
+        fitted = {s: b for s, b in best.items() if not isinstance(b, str)}
+        fits, bounded = [], {}
+        if fitted:
+            order = sorted(fitted, key=lambda s: -fitted[s][1])
+            lead = _try_on_shifts(iso, order[0], noise, seed, sh, reach, fitted[order[0]][0])
+            rest = order[1:]
+            if isinstance(lead, str):
+                dropped[_name(order[0])] = lead
+                ceiling = -np.inf
+            else:
+                fits.append(lead)
+                ceiling = (lead.log_evidence - BOUND_MARGIN if math.isfinite(lead.log_evidence)
+                           else -np.inf)
+            bounded = {_name(s): fitted[s][1] for s in rest if fitted[s][1] < ceiling}
+            todo = [s for s in rest if fitted[s][1] >= ceiling]
+            for s, f in zip(todo, [f.result() for f in [
+                    pool.submit(_try_on_shifts, iso, s, noise, seed, sh, reach, fitted[s][0])
+                    for s in todo]], strict=True):
+                if isinstance(f, str):
+                    dropped[_name(s)] = f
+                else:
+                    fits.append(f)
+        if not fits and not bounded and SPECTRUM not in names:
             spectrum = _try_on_shifts(iso, SPECTRUM, noise, seed, sh, reach)
             if isinstance(spectrum, MasterCurve):
                 fits = [spectrum]
@@ -277,6 +300,14 @@ def _on_smooth_shifts(iso, names, noise: str, vertical: str, law: str, seed: int
                 "certified": bool(f.posterior.converged), "sampler": f.posterior.sampler}
                for f, pi in sorted(zip(fits, p, strict=True), key=lambda fp: -fp[0].log_evidence
                                    if math.isfinite(fp[0].log_evidence) else np.inf)]
+    top = z[best] if np.isfinite(z[best]) else None
+    ranking += [{"structure": k, "log_evidence": None, "log_evidence_err": None,
+                 "log_evidence_upper": _num(v),
+                 "probability": (None if top is None else
+                                 _num(math.exp(min(0.0, v - top)) / float(np.nansum(
+                                     np.exp(z - z[best]))))),
+                 "probability_upper": True, "certified": False, "sampler": "not sampled"}
+                for k, v in bounded.items()]
     ranking += [{"structure": k, "log_evidence": None, "log_evidence_err": None,
                  "probability": None, "certified": False, "sampler": "dropped", "dropped": v}
                 for k, v in dropped.items()]
@@ -285,6 +316,9 @@ def _on_smooth_shifts(iso, names, noise: str, vertical: str, law: str, seed: int
              f"against log10 a_T ω, integrated out), not from {chosen.structure}: its misfit "
              f"cannot move them; {chosen.structure} is fitted to the isotherms so shifted"]
     notes += list(sh.notes)
+    notes += [f"{k} was not sampled: its best fit reaches a log-likelihood of {v:.1f}, which "
+              f"bounds its ln Z from above, {z[best] - v:.0f} nats below the ln Z of "
+              f"{chosen.structure}" for k, v in bounded.items()]
     notes += [f"{k} was dropped: {v}" for k, v in dropped.items()]
     gone = sh.posterior.undetermined()
     if gone:
@@ -298,8 +332,8 @@ def _on_smooth_shifts(iso, names, noise: str, vertical: str, law: str, seed: int
         far = [i for i in range(mean_b.size) if abs(mean_b[i]) > VERTICAL_PLAUSIBLE]
         if far:
             notes.append("the free vertical shifts reach "
-                         + ", ".join(f"{mean_b[i]:+.2f} decades at {iso.temperatures[i]:g} °C"
-                                     for i in far)
+                         + ", ".join(f"{mean_b[i]:+.2f} decades (b_T = {10.0 ** mean_b[i]:.2g} "
+                                     f"at {iso.temperatures[i]:g} °C)" for i in far)
                          + f", beyond the density and temperature ratios they stand "
                            f"for (±{VERTICAL_PLAUSIBLE:g}): there the isotherms' shapes "
                            "differ, which superposition does not explain (see the van "
@@ -346,12 +380,26 @@ def _laws_once(laws: dict, law_evidence: dict) -> dict:
     return out
 
 
-def _try_on_shifts(iso, structure, noise, seed, sh, reach):
+def _name(structure) -> str:
+    return structure if isinstance(structure, str) else structure.name
+
+
+def _try_best(iso, structure, noise, seed, sh):
+    """:func:`~bayesfo.tts.conditional.best_on_shifts`, or the reason it failed (a string)."""
+    from .conditional import best_on_shifts
+
+    try:
+        return best_on_shifts(iso, structure, noise, seed, sh)
+    except InputError as exc:
+        return str(exc)
+
+
+def _try_on_shifts(iso, structure, noise, seed, sh, reach, modes=None):
     """:func:`~bayesfo.tts.conditional.fit_on_shifts`, or the reason it failed (a string)."""
     from .conditional import fit_on_shifts
 
     try:
-        return fit_on_shifts(iso, structure, noise, seed, sh, reach)
+        return fit_on_shifts(iso, structure, noise, seed, sh, reach, modes)
     except InputError as exc:
         return str(exc)
 

@@ -168,13 +168,18 @@ class MasterCurve:
         if self.law != "free":  # the law the joint posterior sampled
             return {"name": self.law, "reference_temperature": self.reference_temperature,
                     "parameters": self.laws[self.law]["parameters"], "probabilities": probs,
-                    "method": f"the {self.law} law's parameters sampled with the master "
-                              "structure (summarised over the posterior draws)"}
+                    "method": f"the {self.law} law's parameters sampled with the "
+                              + ("model-free master" if self.shifts_from == "smooth"
+                                 else "master structure")
+                              + " (summarised over the posterior draws)"}
         best = max(probs, key=probs.get)
+        evidence = self.laws[best].get("probability_method", "").startswith("ln Z")
         return {"name": best, "reference_temperature": self.reference_temperature,
                 "parameters": self.laws[best]["parameters"], "probabilities": probs,
-                "method": "BIC of each law fitted to the posterior mean and covariance of the "
-                          "shifts; parameters over the posterior draws"}
+                "method": ("ln Z of the model-free master with each law inside; parameters "
+                           "fitted to each posterior draw of the shifts" if evidence else
+                           "BIC of each law fitted to the posterior mean and covariance of "
+                           "the shifts; parameters over the posterior draws")}
 
     def reduced_omega(self) -> np.ndarray:
         """The reduced angular frequencies a_T·ω [rad/s] of every point at the posterior mean

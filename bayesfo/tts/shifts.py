@@ -113,8 +113,8 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
                   seed: int = 0, submit=None) -> Shifts:
     """The shifts of the isotherms ``iso`` (:class:`~bayesfo.tts.isotherms._Isotherms`) under
     the model-free master, the noise model, the vertical shift and the law chosen by ln Z
-    where ``"auto"`` (in that order: the noise model on the first vertical option with free
-    shifts, the vertical shift with free shifts, then the laws).
+    where ``"auto"`` (the noise model and the vertical shift together, with free shifts;
+    then the laws).
 
     ``submit(function, *args)`` runs the models' fits side by side (a pool's ``submit``; it
     returns futures); without it they run here one after the other.
@@ -131,32 +131,31 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
         return [fut.result() for fut in [submit(f, *a) for f, *a in calls]]
 
     verticals = VERTICALS if vertical == "auto" else (vertical,)
+    noises = NOISE if noise == "auto" else (noise,)
     notes = []
-    chosen_noise, n_evidence = noise, {}
-    noise_posts = {}
-    if noise == "auto":
-        noises = NOISE
-        noise_posts = dict(zip(noises, many([
-            (_sampled, m, start_of(m, seeds), seed) for m in
-            [SmoothMaster.of(iso, verticals[0], "free", reach, k) for k in noises]]),
-            strict=True))
-        chosen_noise, n_evidence, n_notes = _weigh(noise_posts, {}, "noise")
-        notes += n_notes
-    models = {v: SmoothMaster.of(iso, v, "free", reach, chosen_noise) for v in verticals}
-    # Free vertical shifts contain the other two: they start from the better one's maximum
-    # (from the seeds, the optimiser may stop at a lower local maximum).
-    first = [v for v in verticals if v != "free"]
-    done = {verticals[0]: noise_posts[chosen_noise]} if noise_posts else {}
-    todo = [v for v in first if v not in done]
-    posts = dict(zip(todo, many([(_sampled, models[v], start_of(models[v], seeds), seed)
-                                 for v in todo]), strict=True))
-    posts.update(done)
+    # Every noise model with every vertical option: the noise model is told apart where the
+    # vertical shift is right (misfit from a missing vertical shift reads as noise). Free
+    # vertical shifts contain the other two: they start from the better one's maximum (from
+    # the seeds, the optimiser may stop at a lower local maximum).
+    simple = [(k, v) for k in noises for v in verticals if v != "free"]
+    fitted = dict(zip(simple, many([
+        (_sampled, m, start_of(m, seeds), seed) for m in
+        [SmoothMaster.of(iso, v, "free", reach, k) for k, v in simple]]), strict=True))
     if "free" in verticals:
-        start = start_of(models["free"], seeds)
-        if posts:
-            near = max(posts.values(), key=lambda p: p.max_log_likelihood)
-            start = _nested_start(models["free"], near)
-        posts["free"] = _sampled(models["free"], start, seed)
+        calls = []
+        for k in noises:
+            model = SmoothMaster.of(iso, "free", "free", reach, k)
+            nested = [p for (kk, _), p in fitted.items() if kk == k]
+            start = (_nested_start(model, max(nested, key=lambda p: p.max_log_likelihood))
+                     if nested else start_of(model, seeds))
+            calls.append((_sampled, model, start, seed))
+        fitted.update(zip([(k, "free") for k in noises], many(calls), strict=True))
+    chosen_noise, n_evidence = noises[0], {}
+    if len(noises) > 1:
+        best_of = {k: max((fitted[(k, v)] for v in verticals), key=_z) for k in noises}
+        chosen_noise, n_evidence, n_notes = _weigh(best_of, {}, "noise")
+        notes += n_notes
+    posts = {v: fitted[(chosen_noise, v)] for v in verticals}
     posts = {v: posts[v] for v in verticals}
     chosen_v, v_evidence = verticals[0], {}
     if len(verticals) > 1:
@@ -182,9 +181,18 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
     if len(laws) > 1:
         chosen_law, l_evidence, l_notes = _weigh(law_posts, bounded, "horizontal shifts")
         notes += l_notes
-    post = law_posts[chosen_law]
-    notes += [f"shifts ({_label(chosen_law, 'law')}): {m}" for m in post.messages]
-    return Shifts(post, chosen_v, chosen_law, v_evidence, l_evidence, tuple(notes),
+    if law == "auto":
+        # The shift factors are the isotherms' own (free shifts) whatever law the evidence
+        # prefers: a law is a description of them, and a law that holds nearly but not
+        # exactly would give intervals narrower than the shifts' own.
+        post, reported = law_posts["free"], "free"
+        if chosen_law != "free":
+            notes.append(f"the shift factors are each isotherm's own (free shifts); "
+                         f"{_label(chosen_law, 'law')} describes them")
+    else:
+        post, reported = law_posts[chosen_law], chosen_law
+    notes += [f"shifts ({_label(reported, 'law')}): {m}" for m in post.messages]
+    return Shifts(post, chosen_v, reported, v_evidence, l_evidence, tuple(notes),
                   chosen_noise, n_evidence)
 
 

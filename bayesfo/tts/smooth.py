@@ -310,6 +310,17 @@ class SmoothMaster:
         return band, np.clip(eigvals_banded(band, lower=True), 0.0, None)
 
     @cached_property
+    def _penalty_dense(self) -> np.ndarray:
+        """DᵀD as a dense matrix (for the gradient's traces)."""
+        band = self._penalty[0]
+        n = band.shape[1]
+        out = np.zeros((n, n))
+        for d in range(3):
+            idx = np.arange(n - d)
+            out[idx + d, idx] = out[idx, idx + d] = band[d, :n - d]
+        return out
+
+    @cached_property
     def _centred(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(the weight 1/κ of each part of each point, 0 where the part is left out; centred
         logs, 0 where left out; the level of each part; Σ ln κ of each part): the variance of
@@ -398,15 +409,18 @@ class SmoothMaster:
         log-uniform parameters) at one parameter set, in closed form: the envelope theorem
         for the fitted coefficients β̂ = A⁻¹c and tr(A⁻¹ ∂A) for the determinant."""
         th = np.atleast_2d(np.asarray(theta, float))[:1]
-        value = float(self.log_likelihood(th)[0])
         m = th.shape[1]
         grad = np.zeros(m)
-        if not math.isfinite(value):
-            return value, grad
         lo, n_basis = self._grid
+        if not (np.all(np.isfinite(th)) and self.ordered(th)[0]):
+            return -math.inf, grad
         x, v = self._positions(th)
-        weight = self._centred[0]
+        if not np.all((x > lo + 3 * KNOT_STEP) & (x < lo + (n_basis - 3) * KNOT_STEP)):
+            return -math.inf, grad
+        weight, _, _, log_kappa = self._centred
         dtd, eig = self._penalty
+        pen = self._penalty_dense
+        value = 0.0
         d_x = np.zeros(x.shape[1])   # ∂ ln p/∂x of each point
         d_v = np.zeros(x.shape[1])   # ∂ ln p/∂(vertical offset of its log)
         u = (x[0] - lo) / KNOT_STEP
@@ -421,14 +435,18 @@ class SmoothMaster:
             s2 = sigma ** 2
             band, c, rr, _, _, r = self._normal_equations(x, v, p, np.array([rho]),
                                                           np.array([sigma]))
-            full = np.zeros((n_basis, n_basis))
-            for d in range(4):
-                idx = np.arange(n_basis - d)
-                full[idx + d, idx] = full[idx, idx + d] = band[0, d, :n_basis - d]
-            chol = cholesky_banded(band[0], lower=True, check_finite=False)
+            try:
+                chol = cholesky_banded(band[0], lower=True, check_finite=False)
+            except np.linalg.LinAlgError:
+                return -math.inf, np.zeros(m)
             inv = cho_solve_banded((chol, True), np.eye(n_basis), check_finite=False)
             beta = inv @ c[0]
             w = weight[p]
+            n = int((w > 0).sum())
+            log_det_p = float(np.sum(np.log(eig / rho ** 2 + 1.0 / LEVEL_SD ** 2)))
+            value += (-0.5 * n * math.log(2.0 * math.pi * s2) - 0.5 * log_kappa[p]
+                      + 0.5 * log_det_p - float(np.sum(np.log(chol[0])))
+                      - 0.5 * (float(rr[0]) / s2 - float(c[0] @ beta)))
             fitted = np.sum(b * beta[cols], axis=1)
             e = np.where(w > 0, r[0] - fitted, 0.0)
             slope = np.sum(db * beta[cols], axis=1)
@@ -437,15 +455,13 @@ class SmoothMaster:
             lever = np.einsum("na,nab,nb->n", b, block, db)
             d_x += w * (e * slope - lever) / s2
             d_v -= w * e / s2
-            # Hyperparameters (derivatives in ln ρ and ln σ).
-            pen = np.zeros((n_basis, n_basis))
-            for d in range(3):
-                idx = np.arange(n_basis - d)
-                pen[idx + d, idx] = pen[idx, idx + d] = dtd[d, :n_basis - d]
-            btb = (full - pen / rho ** 2 - np.eye(n_basis) / LEVEL_SD ** 2) * s2
+            # Hyperparameters (derivatives in ln ρ and ln σ); tr(A⁻¹ BᵀB/σ²) from
+            # tr(A⁻¹ A) = n_basis less the prior's share.
+            tr_pen = float(np.sum(inv * pen))
+            tr_data = n_basis - tr_pen / rho ** 2 - float(np.trace(inv)) / LEVEL_SD ** 2
             grad[m - 4 + p] = (-np.sum((eig / rho ** 2) / (eig / rho ** 2 + 1 / LEVEL_SD ** 2))
-                               + (np.sum(inv * pen) + beta @ pen @ beta) / rho ** 2)
-            grad[m - 2 + p] = -int((w > 0).sum()) + (e @ (w * e) + np.sum(inv * btb)) / s2
+                               + (tr_pen + beta @ pen @ beta) / rho ** 2)
+            grad[m - 2 + p] = -n + float(e @ (w * e)) / s2 + tr_data
         # Shifts: each point's x moves with its isotherm's log10 a_T; its log with log10 b_T.
         n_iso = len(self.temperatures)
         per_iso_x = np.bincount(self.point_isotherm, d_x, n_iso)
@@ -609,7 +625,7 @@ def start_of(model: SmoothMaster, log_shifts) -> np.ndarray:
     return np.clip(theta, b[:, 0] + 1e-6 * span, b[:, 1] - 1e-6 * span)
 
 
-def _optimum(model: SmoothMaster, u0: np.ndarray, free=None) -> np.ndarray:
+def _optimum(model: SmoothMaster, u0: np.ndarray, free=None, hess=None) -> np.ndarray:
     """The maximum of the log-likelihood in the sampling coordinates (L-BFGS-B within the
     prior box, with the closed-form gradient), over the parameters ``free`` (a mask; default
     all), the others held at ``u0``. Each parameter is measured in units of its curvature at
@@ -620,7 +636,7 @@ def _optimum(model: SmoothMaster, u0: np.ndarray, free=None) -> np.ndarray:
     free = np.ones(u0.size, bool) if free is None else free
     scale = np.ones(u0.size)
     if int(free.sum()) > 4:
-        curvature = -np.diag(_hessian(model, u0))
+        curvature = -np.diag(_hessian(model, u0) if hess is None else hess)
         ok = np.isfinite(curvature) & (curvature > 0)
         scale[ok] = 1.0 / np.sqrt(curvature[ok])
     scale = scale[free]
@@ -635,13 +651,13 @@ def _optimum(model: SmoothMaster, u0: np.ndarray, free=None) -> np.ndarray:
 
     sol = minimize(f_and_g, u0[free] / scale, jac=True, method="L-BFGS-B",
                    bounds=model.bounds[free] / scale[:, None],
-                   options={"maxiter": 2000, "ftol": 1e-12, "gtol": 1e-6})
+                   options={"maxiter": 2000, "ftol": 1e-10, "gtol": 1e-3})
     out = u0.copy()
     out[free] = sol.x * scale
     return out
 
 
-def _newton(model: SmoothMaster, u: np.ndarray, steps: int = 8):
+def _newton(model: SmoothMaster, u: np.ndarray, steps: int = 4):
     """Newton steps from ``u`` (Hessian by differences of the gradient, halved steps until
     the likelihood rises, the prior box kept): where horizontal and vertical shifts trade off
     against each other, L-BFGS stops short of the maximum. Returns the point, its
@@ -665,9 +681,9 @@ def _newton(model: SmoothMaster, u: np.ndarray, steps: int = 8):
             break
         gain = new - value
         u, value = trial, new
-        hess = _hessian(model, u)
-        if gain < 1e-4:
+        if gain < 1e-3:  # the Hessian barely moved: the one in hand serves the proposal
             break
+        hess = _hessian(model, u)
     return u, value, hess
 
 
@@ -707,14 +723,15 @@ def _well_conditioned(cov: np.ndarray) -> np.ndarray:
     return 0.5 * (out + out.T)
 
 
-def best_fit(model: SmoothMaster, start: np.ndarray) -> tuple[np.ndarray, float]:
+def best_fit(model: SmoothMaster, start: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
     """The maximum of the likelihood from ``start`` (natural units): its point in the sampling
-    coordinates and its log-likelihood, an upper bound of ln Z under the normalised prior."""
+    coordinates, its log-likelihood (an upper bound of ln Z under the normalised prior) and
+    the Hessian there."""
     u0 = model.to_u(start)
     hyper = np.zeros(u0.size, bool)
     hyper[-4:] = True  # smoothness and noise first, the shifts held at the start
-    u_map, value, _ = _newton(model, _optimum(model, _optimum(model, u0, hyper)))
-    return u_map, value
+    u1 = _optimum(model, u0, hyper)
+    return _newton(model, _optimum(model, u1))
 
 
 def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
@@ -743,8 +760,8 @@ def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
 
     rng = np.random.default_rng(seed)
     bounds = model.bounds
-    u_map, max_ll = best_fit(model, start) if fit is None else fit
-    mean, cov = u_map, _proposal_cov(_hessian(model, u_map), bounds)
+    u_map, max_ll, hess = best_fit(model, start) if fit is None else fit
+    mean, cov = u_map, _proposal_cov(hess, bounds)
     log_prior = -model.log_prior_volume
     messages = []
     best = None

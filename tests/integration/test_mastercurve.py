@@ -70,10 +70,10 @@ def test_shifts_and_the_wlf_law_are_recovered(wlf_case):
         p = law["parameters"][name]
         assert p["hdi_low"] <= value <= p["hdi_high"], (name, p)
     assert mc.laws["wlf"]["chi2_per_dof"] < 4
-    # law="auto": the WLF law inside the joint posterior has the highest ln Z of the three
-    # models of the shifts (six isotherms: two parameters instead of five free shifts), so it
-    # is kept; its C1, C2 are sampled with the master structure.
-    assert mc.law == "wlf" and law["method"].startswith("the wlf law's parameters sampled")
+    # law="auto": the WLF law inside the model-free master has the highest ln Z of the three
+    # models of the shifts (six isotherms: two parameters instead of five free shifts); the
+    # shift factors stay each isotherm's own, which the law describes.
+    assert mc.law == "free" and law["method"].startswith("ln Z of the model-free master")
     ev = mc.law_evidence
     assert ev["wlf"]["probability"] > 0.99 and ev["wlf"]["certified"]
     assert ev["wlf"]["log_evidence"] > ev["free"]["log_evidence"]
@@ -83,9 +83,14 @@ def test_shifts_and_the_wlf_law_are_recovered(wlf_case):
     assert arr["log_evidence"] is None and arr["probability_upper"] and not arr["certified"]
     assert arr["log_evidence_upper"] < ev["free"]["log_evidence"] - LAW_BOUND_MARGIN
     assert arr["probability"] < 1e-4
-    assert mc.log_evidence == ev["wlf"]["log_evidence"]
-    assert mc.notes[0].startswith("the shifts follow the WLF law (ln Z ")
-    assert len(mc.notes) == 2 and mc.notes[1].startswith("the Arrhenius law was not sampled")
+    # The shifts come from the model-free master, whose ln Z weighed the laws (and the noise
+    # model: the isotherms were made with complex noise proportional to |G*|, and no vertical
+    # shift); the structure's ln Z is that of the isotherms so shifted, which ranks it.
+    assert mc.shifts_from == "smooth" and mc.log_evidence == mc.ranking[0]["log_evidence"]
+    assert mc.shift_evidence["noise"] == "proportional" and mc.vertical == "none"
+    assert mc.vertical_evidence["none"]["probability"] > 0.99
+    assert any(n.startswith("horizontal shifts: the WLF law (ln Z ") for n in mc.notes)
+    assert any(n.startswith("the Arrhenius law was not sampled") for n in mc.notes)
     # One master curve: superposition holds by the van Gurp–Palmen test, and the joint fit
     # misses no isotherm.
     assert mc.tts_valid is True and mc.to_dict()["tts_valid"] is True
@@ -258,18 +263,24 @@ def test_vertical_shifts_are_recovered_and_the_density_factor_is_exact():
     for f, a, b in zip(factors, truth_a, truth_b, strict=True):
         if f["temperature"] == 20.0:
             continue
-        assert f["log10_bT"]["hdi_low"] <= b <= f["log10_bT"]["hdi_high"], f
+        # The model-free master takes logs of each part: under complex noise proportional to
+        # |G*| (these isotherms) a small G″ (tan δ of 0.05 on the Zener's plateau) has a
+        # relative error of 15 %, whose log is biased by about half its variance; its HDIs are
+        # then short of the truth by up to 0.03 decade (BENCHMARKS.md, master curves).
+        assert abs(f["log10_bT"]["mean"] - b) < 0.03, f
         assert f["log10_bT"]["sd"] < 0.02  # 1 % noise on 12 points: well determined
-        assert f["log10_aT"]["hdi_low"] - 0.02 <= a <= f["log10_aT"]["hdi_high"] + 0.02, f
-    none = _fit(data)
-    assert free.log_evidence > none.log_evidence + 50
+        assert abs(f["log10_aT"]["mean"] - a) < 0.05, f
+    auto = _fit(data)
+    ev = auto.vertical_evidence
+    assert auto.vertical == "free" and ev["free"]["probability"] > 0.99
+    assert ev["free"]["log_evidence"] > ev["none"]["log_evidence"] + 50
     assert "log10_bT_0C" in free.posterior.param_names
     assert not any(n.startswith("log10_bT") for n in free.to_dict()["parameters"])
     # The reduced data lie on the reference's curve: b_T G_i(ω) = G_master(a_T ω).
     master = free.master_data()
     expected = get_structure("zener").response([ZENER], master.omega, "modulus")[0]
     assert np.median(np.abs(master.response / expected - 1)) < 0.02
-    with pytest.raises(InputError, match="vertical must be one of none, density, free"):
+    with pytest.raises(InputError, match="vertical must be one of auto, none, density, free"):
         _fit(data, vertical="yes")
     # Factors beyond density and temperature ratios are fitted, and a note says so.
     assert not any("free vertical shifts reach" in n for n in free.notes)
@@ -373,7 +384,7 @@ def test_a_shift_law_inside_the_posterior_is_stored_and_loaded(tmp_path, run_cli
     status, out, err = run_cli("mastercurve", *files, "--structures", "zener", "--law", "wlf",
                                "--reference-temperature", "20", "--out", tmp_path / "mc")
     assert status == 0, err
-    assert "shift factors (WLF) of zener" in out and "report.html" in out
+    assert "shift factors (WLF) of the model-free master" in out and "report.html" in out
     report = (tmp_path / "mc" / "report.html").read_text()
     assert "Superposition holds by the van Gurp" in report and report.count("<img") == 3
     status, _, err = run_cli("design", tmp_path / "mc")
@@ -517,7 +528,7 @@ def test_the_report_says_in_words_what_the_master_curve_found(wlf_case, tmp_path
         "temperatures": list(mc.temperatures), "rms_relative": [0.08, 0.2, 0.12, 0.1, 0.1, 0.3],
         "misfit": []}})
     text, flagged = next((t, f) for t, f in mastercurve_verdict(bad) if "misses" in t)
-    assert flagged and text.startswith("The joint fit of zener misses the isotherms by 8–30 % "
+    assert flagged and text.startswith("The fit of zener misses the isotherms by 8–30 % "
                                        "rms (median 11 %)")
 
 
@@ -636,11 +647,11 @@ def test_a_master_function_that_misses_the_isotherms_is_said_where_it_is_used(wl
     checks = dict(mc.tts_checks, isotherm_fit=dict(mc.tts_checks["isotherm_fit"],
                                                    rms_relative=[0.08, 0.2, 0.09], misfit=[]))
     missing = replace(mc, tts_checks=checks)
-    assert missing.misfit() == ("The joint fit of zener misses the isotherms by 8–20 % rms "
+    assert missing.misfit() == ("The fit of zener misses the isotherms by 8–20 % rms "
                                 "(median 9 %): it does not describe them; other master "
                                 "functions (or 'spectrum', which needs no structure) may.")
     notes = bf.predict(missing, "storage", W).notes
-    assert any(n.startswith("the joint fit of zener misses the isotherms by 8–20 % rms") and
+    assert any(n.startswith("the fit of zener misses the isotherms by 8–20 % rms") and
                "measured values may lie outside it" in n for n in notes)
     from bayesfo.output.mastercurve_report import mastercurve_verdict
 

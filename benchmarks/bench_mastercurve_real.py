@@ -6,10 +6,12 @@ against published shifts, and the command's time.
    frequencies where they overlap, in decades; the −40/−30 °C pair, where the van Gurp–Palmen
    test finds superposition failing, reported apart), for the model-free shifts and for the
    shifts that best overlay each pair on its own (the floor).
-2. The raw polyisoprene isotherms of RepTate (PI 94.9k, −45…25 °C; GPL, read from
-   ../shared/data/reference-gpl, never copied), whose published master curve uses WLF
-   C1 = 8.772, C2 = 114.03 °C at −35 °C: the default shifts against the published ones, each
-   taken relative to the reference isotherm.
+2. The raw polyisoprene isotherms of RepTate (PI88K-09, −45…25 °C; GPL, read from
+   ../shared/data/reference-gpl, never copied) against RepTate's published master curve of the
+   same material (PI_94.9k_T-35.tts): the shift that lays each raw isotherm's loss angle on the
+   published master's (tan δ is free of the vertical factor) is the published shift, taken
+   relative to the reference isotherm; beside it the WLF law of the file's header
+   (C1 = 8.772, C2 = 114.03 °C at −35 °C), which those shifts do not follow.
 3. The command ``bayesfo mastercurve`` (figures, report) on the adhesive, as a process.
 
     python benchmarks/bench_mastercurve_real.py [--rounds N]
@@ -39,6 +41,20 @@ ADHESIVE = ROOT / "examples" / "data" / "adhesive_468mp"
 PI = (ROOT.parent / "shared" / "data" / "reference-gpl" / "reptate_pi_linear" / "original"
       / "osc_raw_PI88K-09")
 PI_WLF = (8.772, 114.03, -35.0)
+PI_MASTER = PI.parent / "tts_mastercurves" / "PI_94.9k_T-35.tts"
+
+
+def published_shifts(isotherms):
+    """Each isotherm's loss angle laid on the published master curve's: log10 a_T."""
+    rows = np.loadtxt(PI_MASTER, skiprows=1)
+    order = np.argsort(rows[:, 0])
+    xm, phase = np.log10(rows[order, 0]), np.arctan2(rows[order, 2], rows[order, 1])
+    out = []
+    for d, _ in isotherms:
+        o = np.argsort(d.omega)
+        out.append(overlay_shift(xm, (phase,), np.log10(d.omega[o]),
+                                 (np.angle(d.response[o]),), refine=True))
+    return np.array(out)
 
 
 def mismatch(isotherms, log_a, log_b):
@@ -105,18 +121,22 @@ def main() -> int:
         mc = mastercurve(pi, "fractional_zener_ll", workers=0)
         took = time.perf_counter() - t0
         temps = np.array(mc.temperatures)
+        ref = temps.tolist().index(mc.reference_temperature)
         c1, c2, t_pub = PI_WLF
-        published = -c1 * (temps - t_pub) / (c2 + temps - t_pub)
-        published = published - published[temps.tolist().index(mc.reference_temperature)]
+        header = -c1 * (temps - t_pub) / (c2 + temps - t_pub)
+        header = header - header[ref]
+        published = published_shifts(pi)
+        published = published - published[ref]
         f = mc.shift_factors()
         mean = np.array([x["log10_aT"]["mean"] for x in f])
         sd = np.array([x["log10_aT"]["sd"] for x in f])
         print(f"polyisoprene 94.9k, {len(pi)} isotherms, T_ref {mc.reference_temperature:g} °C: "
               f"noise {mc.shift_evidence['noise']}, vertical {mc.vertical}, {took:.1f} s")
-        for t, m, s, p in zip(temps, mean, sd, published, strict=True):
-            print(f"  {t:6g} °C  ours {m:8.3f} ± {s:.3f}   published WLF {p:8.3f}   "
-                  f"difference {m - p:+.3f}")
-        print(f"  largest |difference| {np.max(np.abs(mean - published)):.3f} decade")
+        for t, m, s, p, h in zip(temps, mean, sd, published, header, strict=True):
+            print(f"  {t:6g} °C  ours {m:8.3f} ± {s:.3f}   published master {p:8.3f}   "
+                  f"difference {m - p:+.3f}   (header's WLF {h:8.3f})")
+        print(f"  largest |difference| from the published master's shifts "
+              f"{np.max(np.abs(mean - published)):.3f} decade")
 
     times = []
     for _ in range(args.rounds):
@@ -126,7 +146,7 @@ def main() -> int:
                             "--out", f"{tmp}/mc"], check=True, capture_output=True,
                            env={"MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"})
             times.append(time.perf_counter() - t0)
-    print(f"command 'bayesfo mastercurve' on the adhesive (default structures, figures): "
+    print("command 'bayesfo mastercurve' on the adhesive (default structures, figures): "
           + ", ".join(f"{t:.1f}" for t in times) + " s")
     return 0
 

@@ -80,7 +80,9 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     high = np.array([f["log10_aT"]["hdi_high"] for f in factors])
     ax = axes[2]
     shifts = {"free": "", "wlf": ", WLF sampled", "arrhenius": ", Arrhenius sampled"}[mc.law]
-    if mc.law == "free" and mc.law_evidence:
+    if mc.law == "free" and mc.shifts_from == "smooth":
+        shifts = ", each isotherm's own"
+    elif mc.law == "free" and mc.law_evidence:
         shifts = f"; free shifts P {mc.law_evidence['free']['probability']:.2f}"
     ax.errorbar(temps, mean, yerr=[mean - low, high - mean], fmt="o", color="k", ms=3,
                 capsize=2, label=f"posterior (94 % HDI{shifts})")

@@ -14,6 +14,7 @@ predictions, Prony series and ``load`` treat them as any master curve's.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -105,9 +106,15 @@ def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shi
     if not np.any(lik.in_support(np.c_[modes, np.full(len(modes), 0.05)]
                                  if lik.noise_param else modes)):
         raise InputError(f"no admissible fit of {master.name} to the shifted isotherms")
-    found = certified_posterior(lik, modes, sampler="auto", seed=seed)
+    # The posterior's warnings are its notes (the master curve's notes, said once by the
+    # command), not warnings raised in the middle of a master curve.
+    with warnings.catch_warnings(record=True) as held:
+        warnings.simplefilter("always")
+        found = certified_posterior(lik, modes, sampler="auto", seed=seed)
     post = found.posterior
     notes = list(found.notes)
+    notes += [str(w.message) for w in held if str(w.message) not in notes
+              and issubclass(w.category, UserWarning)]
     if not post.converged:
         notes.append(f"{master.name}: the posterior is not certified "
                      f"({'; '.join(post.messages)})")

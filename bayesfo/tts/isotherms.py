@@ -111,9 +111,11 @@ def _isotherms(isotherms, reference_temperature) -> _Isotherms:
 
 
 # ---------------------------------------------------------------------------- seeds
-def _pair_shift(lower: FrequencyResponse, upper: FrequencyResponse) -> float:
+def _pair_shift(lower: FrequencyResponse, upper: FrequencyResponse,
+                phase_only: bool = False) -> float:
     """log10 of the factor by which ``upper``'s frequencies are multiplied to lie on
-    ``lower``'s curve (log|G*| and phase overlaid where the two overlap), by a grid search."""
+    ``lower``'s curve (log|G*| and phase overlaid where the two overlap, or the phase alone,
+    which a vertical shift leaves alone), by a grid search."""
     def curve(d):
         order = np.argsort(d.omega)
         return (np.log10(d.omega[order]), np.log10(np.abs(d.response[order])),
@@ -121,7 +123,8 @@ def _pair_shift(lower: FrequencyResponse, upper: FrequencyResponse) -> float:
 
     xl, ml, pl = curve(lower)
     xu, mu, pu = curve(upper)
-    d = overlay_shift(xl, (ml, pl), xu, (mu, pu))
+    d = (overlay_shift(xl, (pl,), xu, (pu,)) if phase_only
+         else overlay_shift(xl, (ml, pl), xu, (mu, pu)))
     return 0.0 if d is None else d
 
 
@@ -163,16 +166,39 @@ def overlay_shift(xl, yl, xu, yu, *, min_inside: int = 2,
                                      for v in fine]))])
 
 
-def _seed_shifts(iso: _Isotherms) -> np.ndarray:
-    """log10 a_T of each isotherm from the pairwise overlays, 0 at the reference."""
+def _seed_shifts(iso: _Isotherms, phase_only: bool = False) -> np.ndarray:
+    """log10 a_T of each isotherm from the pairwise overlays (of the phase alone with
+    ``phase_only``: seeds for free vertical shifts), 0 at the reference."""
     n = len(iso.data)
-    steps = [_pair_shift(iso.data[i], iso.data[i + 1]) for i in range(n - 1)]
+    steps = [_pair_shift(iso.data[i], iso.data[i + 1], phase_only) for i in range(n - 1)]
     shifts = np.zeros(n)
     for i in range(iso.reference + 1, n):
         shifts[i] = shifts[i - 1] + steps[i - 1]
     for i in range(iso.reference - 1, -1, -1):
         shifts[i] = shifts[i + 1] - steps[i]
     return shifts
+
+
+def _vertical_seeds(iso: _Isotherms, log_shifts) -> np.ndarray:
+    """log10 b_T of each isotherm (0 at the reference) that lays its log|G*| on its
+    neighbour's where the two overlap at the horizontal shifts ``log_shifts``."""
+    n = len(iso.data)
+    curves = []
+    for d, a in zip(iso.data, log_shifts, strict=True):
+        order = np.argsort(d.omega)
+        curves.append((np.log10(d.omega[order]) + a, np.log10(np.abs(d.response[order]))))
+    steps = []
+    for (xl, yl), (xu, yu) in zip(curves, curves[1:]):
+        inside = (xu >= xl.min()) & (xu <= xl.max())
+        # b_T multiplies a modulus (divides a compliance) onto the reference's scale.
+        gap = float(np.mean(np.interp(xu[inside], xl, yl) - yu[inside])) if inside.any() else 0.0
+        steps.append(gap if iso.joint.kind == "modulus" else -gap)
+    out = np.zeros(n)
+    for i in range(iso.reference + 1, n):
+        out[i] = out[i - 1] + steps[i - 1]
+    for i in range(iso.reference - 1, -1, -1):
+        out[i] = out[i + 1] - steps[i]
+    return out
 
 
 def _reduced(iso: _Isotherms, log_shifts, log_vertical=None) -> FrequencyResponse:

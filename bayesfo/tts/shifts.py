@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import SHIFT_MARGIN, SHIFT_RANGE
+from .model import SHIFT_MARGIN, SHIFT_RANGE, VERTICAL_RANGE
 from .smooth import NOISE, ShiftPosterior, SmoothMaster, best_fit, sample_shifts, start_of
 
 #: The vertical shifts that ``vertical="auto"`` chooses among, and the laws of ``law="auto"``.
@@ -82,7 +82,7 @@ def _weigh(posts: dict, bounded: dict, what: str) -> tuple[str, dict, list]:
                                             if math.isfinite(p.log_evidence_err) else None),
                        "probability": (weights[k] / total if math.isfinite(z[k]) else None),
                        "certified": bool(p.converged),
-                       "sampler": p.sampler}
+                       "sampler": p.sampler, "max_log_likelihood": p.max_log_likelihood}
     notes = []
     for k, b in bounded.items():
         evidence[k] = {"log_evidence": None, "log_evidence_err": None,
@@ -119,7 +119,7 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
     ``submit(function, *args)`` runs the models' fits side by side (a pool's ``submit``; it
     returns futures); without it they run here one after the other.
     """
-    from .isotherms import _seed_shifts
+    from .isotherms import _seed_shifts, _vertical_seeds
 
     seeds = _seed_shifts(iso)
     reach = max(SHIFT_RANGE, float(np.max(np.abs(seeds))) + SHIFT_MARGIN)
@@ -146,8 +146,15 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
         for k in noises:
             model = SmoothMaster.of(iso, "free", "free", reach, k)
             nested = [p for (kk, _), p in fitted.items() if kk == k]
-            start = (_nested_start(model, max(nested, key=lambda p: p.max_log_likelihood))
-                     if nested else start_of(model, seeds))
+            if nested:
+                start = _nested_start(model, max(nested, key=lambda p: p.max_log_likelihood))
+            else:  # tan δ is free of the vertical shift: the phases place the isotherms
+                phase = _seed_shifts(iso, phase_only=True)
+                start = start_of(model, phase)
+                k = model.n_horizontal
+                vertical = np.clip(np.delete(_vertical_seeds(iso, phase), model.reference),
+                                   -0.9 * VERTICAL_RANGE, 0.9 * VERTICAL_RANGE)
+                start[k:k + vertical.size] = vertical
             calls.append((_sampled, model, start, seed))
         fitted.update(zip([(k, "free") for k in noises], many(calls), strict=True))
     chosen_noise, n_evidence = noises[0], {}

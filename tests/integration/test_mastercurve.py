@@ -185,9 +185,13 @@ def test_the_command_on_the_bundled_adhesive_isotherms(tmp_path, run_cli):
     # The default master structures, ranked by ln Z; the shifts are the best one's.
     ranked = summary["structures"]
     assert {r["structure"] for r in ranked} == {"zener", "max-n2m1", "fractional_zener_ll"}
-    z = [r["log_evidence"] for r in ranked]
+    # Sampled ones first, by ln Z; one whose best fit stays 10 nats below the leader's ln Z is
+    # set aside with that bound (ln Z ≤ max ln L).
+    z = [r["log_evidence"] for r in ranked if r["log_evidence"] is not None]
     assert z == sorted(z, reverse=True) and summary["structure"] == ranked[0]["structure"]
-    assert sum(r["probability"] for r in ranked) == pytest.approx(1.0)
+    for r in ranked[len(z):]:
+        assert r["sampler"] == "not sampled" and r["log_evidence_upper"] < z[0] - 10
+    assert sum(r["probability"] for r in ranked[:len(z)]) == pytest.approx(1.0, abs=1e-4)
     assert set(summary["shift_law"]["probabilities"]) == {"wlf", "arrhenius"}
     master = bf.read(tmp_path / "mc" / "master.csv")  # a data set compare reads
     assert master.n_frequencies == sum(bf.read(f).n_frequencies for f in files)
@@ -273,7 +277,7 @@ def test_vertical_shifts_are_recovered_and_the_density_factor_is_exact():
     auto = _fit(data)
     ev = auto.vertical_evidence
     assert auto.vertical == "free" and ev["free"]["probability"] > 0.99
-    assert ev["free"]["log_evidence"] > ev["none"]["log_evidence"] + 50
+    assert ev["free"]["log_evidence"] > ev["none"]["max_log_likelihood"] + 50
     assert "log10_bT_0C" in free.posterior.param_names
     assert not any(n.startswith("log10_bT") for n in free.to_dict()["parameters"])
     # The reduced data lie on the reference's curve: b_T G_i(ω) = G_master(a_T ω).
@@ -438,7 +442,7 @@ def test_the_master_curve_figure_shows_the_shifts_and_the_laws_evidence(wlf_case
         labels = [t.get_text() for t in drawn.axes[2].get_legend().get_texts()]
         p = mc.law_evidence["wlf"]["probability"]
         assert labels[0].startswith("WLF C1 ") and labels[0].endswith(f"(P {p:.2f})")
-        assert labels[2] == "posterior (94 % HDI, WLF sampled)"
+        assert labels[2] == "posterior (94 % HDI, each isotherm's own)"
         # The master's median lies on the reference isotherm's truth.
         z = get_structure("zener").response([ZENER], drawn.values["omega_reduced"], "modulus")[0]
         assert np.max(np.abs(drawn.values["storage_median"] / z.real - 1)) < 0.03
@@ -473,8 +477,10 @@ def test_a_relaxation_spectrum_master_gives_the_shifts_without_a_structure(tmp_p
     assert status == 0, err
     summary = json.loads((tmp_path / "mc" / "summary.json").read_text())
     ranked = {r["structure"]: r for r in summary["structures"]}
-    assert ranked["zener"]["log_evidence"] > ranked["spectrum"]["log_evidence"]
-    assert ranked["spectrum"]["certified"]
+    spectrum = ranked["spectrum"]
+    assert ranked["zener"]["log_evidence"] > (spectrum["log_evidence"]
+                                              or spectrum["log_evidence_upper"])
+    assert spectrum["certified"] or spectrum["sampler"] == "not sampled"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         mc = bf.mastercurve(isotherms(truth), "spectrum", reference_temperature=20.0,

@@ -170,19 +170,23 @@ def _seed_shifts(iso: _Isotherms, phase_only: bool = False) -> np.ndarray:
     """log10 a_T of each isotherm from the pairwise overlays (of the phase alone with
     ``phase_only``: seeds for free vertical shifts), 0 at the reference."""
     n = len(iso.data)
-    steps = [_pair_shift(iso.data[i], iso.data[i + 1], phase_only) for i in range(n - 1)]
-    shifts = np.zeros(n)
-    for i in range(iso.reference + 1, n):
-        shifts[i] = shifts[i - 1] + steps[i - 1]
-    for i in range(iso.reference - 1, -1, -1):
-        shifts[i] = shifts[i + 1] - steps[i]
-    return shifts
+    return _chained([_pair_shift(iso.data[i], iso.data[i + 1], phase_only)
+                     for i in range(n - 1)], iso.reference)
+
+
+def _chained(steps, reference: int) -> np.ndarray:
+    """Values of every isotherm from the steps between neighbours, 0 at the reference."""
+    out = np.zeros(len(steps) + 1)
+    for i in range(reference + 1, out.size):
+        out[i] = out[i - 1] + steps[i - 1]
+    for i in range(reference - 1, -1, -1):
+        out[i] = out[i + 1] - steps[i]
+    return out
 
 
 def _vertical_seeds(iso: _Isotherms, log_shifts) -> np.ndarray:
     """log10 b_T of each isotherm (0 at the reference) that lays its log|G*| on its
     neighbour's where the two overlap at the horizontal shifts ``log_shifts``."""
-    n = len(iso.data)
     curves = []
     for d, a in zip(iso.data, log_shifts, strict=True):
         order = np.argsort(d.omega)
@@ -193,12 +197,7 @@ def _vertical_seeds(iso: _Isotherms, log_shifts) -> np.ndarray:
         # b_T multiplies a modulus (divides a compliance) onto the reference's scale.
         gap = float(np.mean(np.interp(xu[inside], xl, yl) - yu[inside])) if inside.any() else 0.0
         steps.append(gap if iso.joint.kind == "modulus" else -gap)
-    out = np.zeros(n)
-    for i in range(iso.reference + 1, n):
-        out[i] = out[i - 1] + steps[i - 1]
-    for i in range(iso.reference - 1, -1, -1):
-        out[i] = out[i + 1] - steps[i]
-    return out
+    return _chained(steps, iso.reference)
 
 
 def _reduced(iso: _Isotherms, log_shifts, log_vertical=None) -> FrequencyResponse:

@@ -45,6 +45,40 @@ def shift_name(temperature: float, factor: str = "aT") -> str:
     return f"log10_{factor}_{text}C"
 
 
+def log_shifts(theta, temperatures, reference: int, law: str, start: int) -> np.ndarray:
+    """log10 a_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms), from
+    parameter sets whose shift parameters begin at column ``start``: one free log10 a_T per
+    isotherm but the reference, or a law's constants (``wlf``: C1, C2 [°C]; ``arrhenius``:
+    E_a [J/mol])."""
+    theta = np.atleast_2d(np.asarray(theta, float))
+    temps = np.asarray(temperatures, float)[None, :]
+    t_ref = temperatures[reference]
+    if law == "wlf":
+        with np.errstate(all="ignore"):
+            return wlf(temps, t_ref, theta[:, start:start + 1], theta[:, start + 1:start + 2])
+    if law == "arrhenius":
+        return arrhenius(temps, t_ref, theta[:, start:start + 1])
+    shifted = [i for i in range(len(temperatures)) if i != reference]
+    out = np.zeros((theta.shape[0], len(temperatures)))
+    out[:, shifted] = theta[:, start:start + len(shifted)]
+    return out
+
+
+def log_vertical(theta, temperatures, reference: int, vertical: str, start: int) -> np.ndarray:
+    """log10 b_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms): 0, the
+    density correction T_ref/T [K], or free ones from column ``start`` of the parameter sets
+    (one per isotherm but the reference)."""
+    theta = np.atleast_2d(np.asarray(theta, float))
+    out = np.zeros((theta.shape[0], len(temperatures)))
+    if vertical == "density":
+        t = np.asarray(temperatures) + KELVIN
+        out[:] = np.log10(t[reference] / t)
+    elif vertical == "free":
+        shifted = [i for i in range(len(temperatures)) if i != reference]
+        out[:, shifted] = theta[:, start:start + len(shifted)]
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class ShiftedStructure(Parametrised):
     """A master structure seen through the isotherms: the structure's parameters followed by
@@ -145,30 +179,13 @@ class ShiftedStructure(Parametrised):
 
     def log_shifts(self, theta) -> np.ndarray:
         """log10 a_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
-        theta = np.atleast_2d(np.asarray(theta, float))
-        k = self.master.n_params
-        temps = np.asarray(self.temperatures, float)[None, :]
-        t_ref = self.temperatures[self.reference]
-        if self.law == "wlf":
-            with np.errstate(all="ignore"):
-                return wlf(temps, t_ref, theta[:, k:k + 1], theta[:, k + 1:k + 2])
-        if self.law == "arrhenius":
-            return arrhenius(temps, t_ref, theta[:, k:k + 1])
-        out = np.zeros((theta.shape[0], len(self.temperatures)))
-        out[:, list(self.shifted)] = theta[:, k:k + len(self.shifted)]
-        return out
+        return log_shifts(theta, self.temperatures, self.reference, self.law,
+                          self.master.n_params)
 
     def log_vertical(self, theta) -> np.ndarray:
         """log10 b_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
-        theta = np.atleast_2d(np.asarray(theta, float))
-        out = np.zeros((theta.shape[0], len(self.temperatures)))
-        if self.vertical == "density":
-            t = np.asarray(self.temperatures) + KELVIN
-            out[:] = np.log10(t[self.reference] / t)
-        elif self.vertical == "free":
-            start = self.master.n_params + len(self.horizontal)
-            out[:, list(self.shifted)] = theta[:, start:start + len(self.shifted)]
-        return out
+        return log_vertical(theta, self.temperatures, self.reference, self.vertical,
+                            self.master.n_params + len(self.horizontal))
 
     def response(self, theta, omega, kind: str = "compliance") -> np.ndarray:
         """The master's response at each point's reduced frequency a_T·ω, divided by b_T

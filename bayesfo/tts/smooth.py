@@ -41,7 +41,17 @@ from scipy.linalg import cho_solve_banded, cholesky_banded, eigvals_banded
 from ..errors import InputError
 from ..priors import LogUniform, Uniform
 from .laws import arrhenius, wlf
-from .model import EA_MAX, EA_MIN, KELVIN, VERTICAL_RANGE, WLF_C1_MAX, WLF_C2_MAX, shift_name
+from .model import (
+    EA_MAX,
+    EA_MIN,
+    KELVIN,
+    VERTICAL_RANGE,
+    WLF_C1_MAX,
+    WLF_C2_MAX,
+    log_shifts,
+    log_vertical,
+    shift_name,
+)
 
 #: The name of the model-free master in rankings, summaries and messages.
 NAME = "smooth"
@@ -269,29 +279,12 @@ class SmoothMaster:
     # ------------------------------------------------------------------ shifts
     def log_shifts(self, theta) -> np.ndarray:
         """log10 a_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
-        theta = np.atleast_2d(np.asarray(theta, float))
-        temps = np.asarray(self.temperatures, float)[None, :]
-        t_ref = self.temperatures[self.reference]
-        if self.law == "wlf":
-            with np.errstate(all="ignore"):
-                return wlf(temps, t_ref, theta[:, 0:1], theta[:, 1:2])
-        if self.law == "arrhenius":
-            return arrhenius(temps, t_ref, theta[:, 0:1])
-        out = np.zeros((theta.shape[0], len(self.temperatures)))
-        out[:, list(self.shifted)] = theta[:, :len(self.shifted)]
-        return out
+        return log_shifts(theta, self.temperatures, self.reference, self.law, 0)
 
     def log_vertical(self, theta) -> np.ndarray:
         """log10 b_T of every isotherm (0 at the reference), shape (n_sets, n_isotherms)."""
-        theta = np.atleast_2d(np.asarray(theta, float))
-        out = np.zeros((theta.shape[0], len(self.temperatures)))
-        if self.vertical == "density":
-            t = np.asarray(self.temperatures) + KELVIN
-            out[:] = np.log10(t[self.reference] / t)
-        elif self.vertical == "free":
-            k = self.n_horizontal
-            out[:, list(self.shifted)] = theta[:, k:k + len(self.shifted)]
-        return out
+        return log_vertical(theta, self.temperatures, self.reference, self.vertical,
+                            self.n_horizontal)
 
     # ------------------------------------------------------------------ the spline
     @cached_property

@@ -1,6 +1,6 @@
-"""The noise model as part of the model: without a stated σ, ``compare`` runs each structure
-under constant and under proportional noise and keeps the one with the larger evidence, states
-both, and flags the exponents whose intervals differ between them (``noise_sensitive``)."""
+"""The noise model as part of the model: without a stated σ, ``compare`` weighs constant,
+proportional and relative-parts noise for each structure by evidence, keeps the one with the
+largest, states each, and flags the exponents whose intervals differ between them (``noise_sensitive``)."""
 
 import warnings
 from pathlib import Path
@@ -46,28 +46,37 @@ def test_span_is_half_a_decade():
     assert 0.45 < np.log10(g.max() / g.min()) < 0.6
 
 
+NOISES = ("constant", "proportional", "relative_parts")
+
+
 @pytest.mark.parametrize("truth", ["proportional", "constant"])
 def test_evidence_picks_the_noise_model_that_made_the_data(truth):
+    """Constant against relative noise is decided. Proportional and relative-parts noise
+    coincide where |Re G| = |Im G|; on these data |Re G/Im G| stays within 0.9-2.5, and their
+    ln Z differ by about 1 (measured: 68.5 and 69.4): either may be chosen for proportional
+    data, and the reported ln Z averages over both."""
     result = _compare(zener_data(0, truth, level=0.04, theta=WIDE))["zener"]
     record = result.to_dict()
-    assert record["noise"] == truth
+    family = {truth} if truth == "constant" else {"proportional", "relative_parts"}
+    assert record["noise"] in family
     models = record["noise_models"]
-    assert set(models["models"]) == {"constant", "proportional"}
-    assert models["chosen"] == truth
-    assert models["models"][truth]["probability"] > NOISE_DECISIVE
-    other = ({"constant", "proportional"} - {truth}).pop()
-    assert models["models"][truth]["log_evidence"] > models["models"][other]["log_evidence"] + 5
+    assert set(models["models"]) == set(NOISES)
+    assert models["chosen"] == record["noise"]
+    share = sum(models["models"][n]["probability"] for n in family)
+    assert share > NOISE_DECISIVE
+    chosen = models["models"][record["noise"]]["log_evidence"]
+    for other in set(NOISES) - family:
+        assert chosen > models["models"][other]["log_evidence"] + 5
     assert "chosen by evidence" in record["noise_reason"]
-    # The reported ln Z treats the noise model as a nuisance: the mean of the two evidences
-    # (equal prior weights), ln Z of the decisive model - ln 2 up to its e^-5 share.
-    z = np.array([models["models"][n]["log_evidence"] for n in ("constant", "proportional")])
-    marginal = float(np.logaddexp(*z) - np.log(2.0))
+    # The reported ln Z treats the noise model as a nuisance: the mean of the three
+    # evidences (equal prior weights).
+    z = np.array([models["models"][n]["log_evidence"] for n in NOISES])
+    marginal = float(np.logaddexp.reduce(z) - np.log(3.0))
     assert record["log_evidence"] == pytest.approx(marginal, abs=1e-9)
     assert models["marginal"]["log_evidence"] == record["log_evidence"]
-    assert models["marginal"]["prior"] == {"constant": 0.5, "proportional": 0.5}
-    assert abs(record["log_evidence"] - (z.max() - np.log(2.0))) < 0.01
+    assert models["marginal"]["prior"] == pytest.approx({n: 1 / 3 for n in NOISES})
     ev = result.criteria.evidence
-    assert ev.given_noise.log_z == pytest.approx(models["models"][truth]["log_evidence"])
+    assert ev.given_noise.log_z == pytest.approx(chosen)
 
 
 def test_a_forced_or_stated_noise_model_is_not_second_guessed():

@@ -119,7 +119,8 @@ class Likelihood:
     structure : Structure
     data : FrequencyResponse
     noise : {"auto", "known", "constant", "proportional", "relative_parts"}
-        ``auto`` follows :func:`choose_noise` (never ``relative_parts``).
+        ``auto`` follows the rule of :func:`choose_noise` (never ``relative_parts``;
+        :func:`bayesfo.compare` chooses by evidence instead).
     priors : dict, optional
         Overrides of structure or noise priors, ``{name: Prior}``.
     scaling : Scaling, optional

@@ -25,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_noise_coverage import candidates  # noqa: E402
 
 import bayesfo as bf  # noqa: E402
+from bayesfo.options import DEFAULT_STRUCTURES  # noqa: E402
 
 FILES = ["examples/data/adhesive_468mp/Tp020C.csv", "examples/data/adhesive_468mp/Tm030C.csv",
          "examples/data/adhesive_468mp/Tp080C.csv", "examples/data/adhesive_468mp/Tp150C.csv",
@@ -37,8 +38,7 @@ def run(path, structures, seed, before: bool):
             warnings.catch_warnings():
         warnings.simplefilter("ignore")
         t0 = time.perf_counter()
-        kw = {} if structures is None else {"structures": structures}
-        result = bf.compare(data, seed=seed, progress=False, **kw)
+        result = bf.compare(data, structures or DEFAULT_STRUCTURES, seed=seed, progress=False)
     return result, time.perf_counter() - t0
 
 

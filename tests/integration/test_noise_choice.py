@@ -395,4 +395,9 @@ def test_auto_chooses_relative_parts_on_a_rheometers_data():
 
     (text, _), = _noise_sentences("zener", result["zener"])
     assert text.startswith("Noise model of zener: relative_parts, chosen by evidence")
+    from bayesfo.output.report import _noise
+
+    assert ("by evidence per structure", "relative_parts for zener (relative errors σ_rel of "
+            "the real and imaginary parts separately, the cost that pyRheo and RheoJAX "
+            "minimise)") in _noise(result)
     assert _compare(data, noise="proportional")["zener"].posterior.noise == "proportional"

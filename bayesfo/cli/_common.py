@@ -89,10 +89,10 @@ def add_comparison_options(p, each: str = "the fit"):
     p.add_argument("--structures", default=DEFAULT_STRUCTURES,
                    help=f"comma list, with shortcuts maxN and all (default {DEFAULT_STRUCTURES})")
     p.add_argument("--noise", default="auto", choices=NOISE_MODELS,
-                   help="noise model (default: known if the data give sigma, else constant or "
-                        "proportional, whichever has the larger evidence for each structure; "
-                        "relative_parts, the relative errors of the real and imaginary parts "
-                        "that pyRheo fits, only when asked for)")
+                   help="noise model (default: known if the data give sigma, else constant, "
+                        "proportional or relative_parts (the relative errors of the real and "
+                        "imaginary parts, a rheometer's), whichever has the largest evidence "
+                        "for each structure; any other value forces that model)")
     p.add_argument("--prior", action="append", default=[], metavar="NAME=TYPE:A:B",
                    help="override a prior, e.g. q=uniform:0.2:1 or sigma_rel=log-uniform:1e-4:0.1; "
                         "one per parameter; the card's coefficients are sampled on the scaled "

@@ -398,9 +398,10 @@ class Comparison:
         if not records:
             return None
         models = list(dict.fromkeys(n for rec in records for n in rec["marginal"]["prior"]))
+        listed = models[0] if len(models) == 1 else ", ".join(models[:-1]) + " and " + models[-1]
         return (f"ln Z treats the noise model as a nuisance (the mean of the evidences under "
-                f"{' and '.join(models)} noise, equal prior weights), so every structure is "
-                "ranked on one footing; each posterior is under its more probable noise model")
+                f"{listed} noise, equal prior weights), so every structure is ranked on one "
+                "footing; each posterior is under its most probable noise model")
 
     def predict(self, quantity: str, x, *, structure: str | None = None,
                 average: str | None = None, seed: int = 0):

@@ -39,12 +39,13 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     structures : str or sequence of Structure or str
         Structures, names or comma lists of names (``"voigt,zener"``, ``"max3"``).
     noise : {"auto", "known", "constant", "proportional", "relative_parts"}
-        ``auto``: ``known`` when the data carry σ; else every structure runs under
-        ``constant`` and ``proportional`` noise and keeps the one with the larger ln Z
-        (:data:`~bayesfo.comparison.steps.SCREEN_MARGIN` lets a quick estimate set aside a model that trails far behind);
-        both are stated in the result (``criteria.noise_models``). Any other value forces
-        that model; ``relative_parts`` (relative errors σ_rel·|Re G| and σ_rel·|Im G| of each
-        part, pyRheo's cost) is only used when forced, never by ``auto``.
+        ``auto``: ``known`` when the data carry σ; else every structure weighs ``constant``,
+        ``proportional`` and ``relative_parts`` noise (relative errors σ_rel·|Re G| and
+        σ_rel·|Im G| of each part, a rheometer's, pyRheo's cost; left out where a part is
+        exactly 0) and keeps the one with the largest ln Z
+        (:data:`~bayesfo.comparison.steps.SCREEN_MARGIN` lets a quick estimate set aside a
+        model that trails far behind); each is stated in the result
+        (``criteria.noise_models``). Any other value forces that model.
     seed : int
         The same seed gives the same numbers.
     priors : dict, optional

@@ -11,7 +11,7 @@ after the other; with worker processes the parent submits (1) for every
 structure, largest first, and as each comes back either has the result (a structure with one
 noise model to sample runs (2) and (3) in the task of (1): nothing to ship) or submits (2) for
 each noise model at once, and (3) when their posteriors are back. A structure whose screen
-cannot choose between constant and proportional noise thus costs one posterior on the
+cannot choose among the noise models thus costs one posterior on the
 comparison's critical path, not two in sequence.
 
 (3) runs in a worker, not in the parent: shipping the two runs to it costs less than the step
@@ -84,15 +84,15 @@ def _first(s, data, options):
     """Step (1); with a single noise model to sample, (2) and (3) follow in the same task.
     Returns ("result", StructureResult) or ("sample", (fit, screened, noise models))."""
     fit, screened, noises = fit_and_screen(s, data, options)
-    if len(noises) > 1 or _deferred(screened) is not None:
+    if len(noises) > 1 or _deferred(screened):
         return "sample", (fit, screened, noises)
     runs = [sample_held(s, data, noises[0], fit, options)]
     return "result", conclude(s, data, fit, screened, runs, options)
 
 
-def _deferred(screened):
-    """The noise model that waits for the leader's ln Z (:func:`~.steps.settle`), or None."""
-    return None if screened is None else screened.deferred
+def _deferred(screened) -> tuple:
+    """The noise models that wait for the leader's ln Z (:func:`~.steps.settle`)."""
+    return () if screened is None else screened.deferred
 
 
 def _rank(what: str, *, quick: bool) -> int:
@@ -208,11 +208,11 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
 
     def sample(i):
         # Step (2) of every noise model to sample now; the leader's run also finds whether the
-        # deferred one can be set aside (steps.settle).
+        # deferred ones can be set aside (steps.settle).
         fit, screened, noises = prepared[i]
         for noise in noises:
             submit(i, noise, sample_held, structures[i], data, noise, fit, options,
-                   _deferred(screened))
+                   _deferred(screened) if noise == noises[0] else ())
 
     def after_sample(i):
         s, (fit, screened, noises) = structures[i], prepared[i]
@@ -221,12 +221,13 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False) -> 
                 return
             if runs[i][noise][1] is not None:
                 return end(i, StructureResult(s, error=runs[i][noise][1]))
-        if (other := _deferred(screened)) is not None:
-            settled = settle(screened, runs[i][noises[0]][0])
-            if settled is None:  # not set aside: sampled after all
-                prepared[i] = (fit, None, [*noises, other.noise])
-                return submit(i, other.noise, sample_held, s, data, other.noise, fit, options)
-            screened = settled
+        if _deferred(screened):
+            screened, rest = settle(screened, runs[i][noises[0]][0])
+            if rest:  # not set aside: sampled after all
+                prepared[i] = (fit, screened, [*noises, *rest])
+                for noise in rest:
+                    submit(i, noise, sample_held, s, data, noise, fit, options)
+                return None
         submit(i, "conclude", conclude, s, data, fit, screened,
                [runs[i][noise][0] for noise in noises], options)
 

@@ -1,8 +1,9 @@
 """The steps of one structure's run on one data set, run as tasks by :mod:`.schedule`.
 
 (1) :func:`fit_and_screen`: the global optimisation (the modes) and, without σ in the data,
-the quick noise screen (:func:`screen`), which may set aside a noise model that trails far
-behind, or defer one until the other's ln Z is known (:class:`Deferred`);
+the quick noise screen (:func:`screen`) of the constant, proportional and relative-parts noise
+models, which may set aside those that trail far behind, or defer some until the leader's ln Z
+is known (:class:`Deferred`);
 :func:`fit_and_probe` does the same and says whether the rest promises to be quick.
 (2) :func:`sample_held`: one certified posterior per noise model still in the running
 (:func:`~bayesfo.inference.certified.certified_posterior`), its warnings held back; a deferred
@@ -30,7 +31,7 @@ from ..inference.adequacy import check_adequacy
 from ..inference.certified import certified_posterior, evidence_check
 from ..inference.evidence import other_noise_evidence
 from ..inference.importance import K_HAT_MAX, screen_noise
-from ..inference.likelihood import NOISE_PRIORS
+from ..inference.likelihood import NOISE_PRIORS, zero_part
 from ..structures import Structure
 from .criteria import _criteria, _holdout, fit_log_likelihood
 from .criteria_types import Criteria
@@ -88,7 +89,7 @@ class NoiseRun:
     post: Any
     criteria: dict
     caught: list = field(default_factory=list)
-    aside: dict | None = None
+    aside: dict = field(default_factory=dict)
 
 
 class Deferred(NamedTuple):
@@ -104,12 +105,15 @@ class Deferred(NamedTuple):
 class Screen(NamedTuple):
     """The noise screen's decision: the leading noise model and every candidate's quick
     estimate (:func:`~bayesfo.inference.importance.screen_noise`), as records of
-    ``{"log_z", "method", "intervals"}``. With ``deferred``, the other noise model is not set
-    aside yet: the leader is sampled first, and :func:`settle` decides."""
+    ``{"log_z", "method", "intervals"}``. The leader is sampled, and with it the models of
+    ``also``; a candidate in neither nor in ``deferred`` is set aside by its quick estimate.
+    The models of ``deferred`` (:class:`Deferred`) are not set aside yet: the leader is sampled
+    first, and :func:`settle` decides."""
 
     leader: str
     quick: dict
-    deferred: Deferred | None = None
+    deferred: tuple = ()
+    also: tuple = ()
 
 
 class _Entry(NamedTuple):
@@ -137,17 +141,22 @@ def remedy(lik) -> str:
 
 def _noise_candidates(data: FrequencyResponse, noise: str) -> tuple[str, ...]:
     """The noise models a structure is run with: the one asked for; ``auto`` (which the
-    likelihood resolves to ``known``, saying why) when the data carry σ; else both
-    ``constant`` and ``proportional``, between which the evidence chooses. (:func:`compare`
-    refuses ``auto`` without σ where the response is exactly 0: relative noise has no scale
-    there.)"""
+    likelihood resolves to ``known``, saying why) when the data carry σ; else those of
+    :data:`NOISE_CANDIDATES`, among which the evidence chooses, less ``relative_parts`` where a
+    real or imaginary part is exactly 0 (:func:`~bayesfo.inference.likelihood.zero_part`: the
+    relative error of that part has no scale). (:func:`compare` refuses ``auto`` without σ
+    where the response is exactly 0: relative noise has no scale there.)"""
     if noise != "auto" or data.sigma is not None:
         return (noise,)
+    if zero_part(data) is not None:
+        return tuple(n for n in NOISE_CANDIDATES if n != "relative_parts")
     return NOISE_CANDIDATES
 
 
-#: The noise models between which ``noise="auto"`` chooses by evidence, when the data carry no σ.
-NOISE_CANDIDATES = ("constant", "proportional")
+#: The noise models among which ``noise="auto"`` chooses by evidence, when the data carry no σ:
+#: one σ for every point, σ proportional to |G|, and a relative error of each part (G' and G''
+#: each with its own relative error, the usual error model of a rheometer or DMA).
+NOISE_CANDIDATES = ("constant", "proportional", "relative_parts")
 
 
 def sample(s: Structure, data: FrequencyResponse, noise: str, fit,
@@ -176,7 +185,7 @@ def _exponent_intervals(run: NoiseRun) -> dict:
 
 
 #: A noise model whose quick ln Z (:func:`~bayesfo.inference.importance.screen_noise`) trails
-#: the other's by this many nats (posterior odds above 150:1) is not sampled in full, provided
+#: the leader's by this many nats (posterior odds above 150:1) is not sampled in full, provided
 #: its own estimate is reliable (Pareto k̂ < 0.7; a heavy-tailed estimate of the leader only
 #: understates its lead).
 SCREEN_MARGIN = 5.0
@@ -200,24 +209,32 @@ def _quick_estimates(s, data, candidates, fit, options: RunOptions) -> dict:
 
 
 def screen(s, data, candidates, fit, options: RunOptions, quick=None) -> Screen | None:
-    """The quick ln Z of each candidate noise model, and the leader where it is decisive (see
-    :data:`SCREEN_MARGIN`); where it is not, and some candidate's quick estimate does not
-    promise a quick posterior, the one to defer (:func:`_deferral`); None when all candidates
+    """The quick ln Z of each candidate noise model; those that trail the leader decisively
+    (see :data:`SCREEN_MARGIN`) are set aside. Of the rest, where every quick estimate promises
+    a quick posterior, all are sampled at once; where not, the one whose likelihood reaches
+    highest is sampled first and the others wait (:func:`_deferral`). None when all candidates
     must be sampled at once. ``quick``: the estimates of :func:`_quick_estimates`, when already
     made."""
     if len(candidates) < 2:
         return None
     if quick is None:
         quick = _quick_estimates(s, data, candidates, fit, options) if fit.optima.size else {}
+    aside = []
     if all(quick.get(noise) is not None for noise in candidates):
         order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
-        leader, other = order[0], order[1]
-        if (quick[leader]["log_z"] - quick[other]["log_z"] >= SCREEN_MARGIN
-                and quick[other]["k_hat"] < K_HAT_MAX):
-            return Screen(leader, {noise: quick[noise] for noise in candidates})
-    if all(_quick_promise(quick.get(noise)) for noise in candidates):
-        return None  # both posteriors promise to be quick: sampled at once
-    return _deferral(s, data, candidates, fit, options, quick)
+        top = quick[order[0]]["log_z"]
+        aside = [n for n in order[1:] if top - quick[n]["log_z"] >= SCREEN_MARGIN
+                 and quick[n]["k_hat"] < K_HAT_MAX]
+    known = {n: q for n, q in quick.items() if q is not None}
+    left = [n for n in candidates if n not in aside]
+    if all(_quick_promise(quick.get(noise)) for noise in left):
+        if not aside:
+            return None  # every posterior promises to be quick: sampled at once
+        leader, *also = sorted(left, key=lambda n: -quick[n]["log_z"])
+        return Screen(leader, known, also=tuple(also))
+    if len(left) == 1:
+        return Screen(left[0], known)
+    return _deferral(s, data, left, fit, options, known)
 
 
 def _quick_promise(estimate) -> bool:
@@ -231,7 +248,7 @@ def _quick_promise(estimate) -> bool:
 #: Where each noise model's maximum likelihood is sought: the residual weights of
 #: :func:`~bayesfo.identify.optimize.fit_structure` under which its likelihood is a sum of
 #: squares (σ the same at every point, or proportional to |G|).
-NOISE_WEIGHTING = {"constant": "none", "proportional": "relative"}
+NOISE_WEIGHTING = {"constant": "none", "proportional": "relative", "relative_parts": "parts"}
 
 
 def _best_log_likelihood(s, data, noise, fit, options: RunOptions, *,
@@ -257,21 +274,28 @@ def _best_log_likelihood(s, data, noise, fit, options: RunOptions, *,
 
 def _deferral(s, data, candidates, fit, options: RunOptions, quick) -> Screen:
     """Where the screen does not decide and a posterior promises to be slow (a tempered ladder
-    or emcee), the noise model whose likelihood reaches higher (polished optima,
-    :func:`_best_log_likelihood`) is sampled first, and the other waits for its ln Z
+    or emcee), the noise model whose likelihood reaches highest (polished optima,
+    :func:`_best_log_likelihood`) is sampled first, and the others wait for its ln Z
     (:func:`settle`, :func:`_set_aside`)."""
     best = {n: _best_log_likelihood(s, data, n, fit, options) for n in candidates}
-    leader, other = sorted(candidates, key=lambda n: -best[n][0])
+    leader, *others = sorted(candidates, key=lambda n: -best[n][0])
     return Screen(leader, {n: q for n, q in quick.items() if q is not None},
-                  Deferred(other, best[other][1]))
+                  tuple(Deferred(n, best[n][1]) for n in others))
 
 
 #: How the record of a noise model set aside by its maximum likelihood names its ln Z.
 BOUND_METHOD = "upper bound (maximum likelihood)"
 
 
-def _set_aside(s, data, deferred: Deferred | None, fit, options: RunOptions,
-               run: NoiseRun) -> dict | None:
+def _set_aside(s, data, deferred, fit, options: RunOptions, run: NoiseRun) -> dict:
+    """For each deferred noise model (a tuple of :class:`Deferred`), the record that sets it
+    aside after the leader's posterior ``run`` (:func:`_set_aside_one`), or None where it must
+    be sampled: ``{noise: record or None}``."""
+    return {d.noise: _set_aside_one(s, data, d, fit, options, run) for d in deferred or ()}
+
+
+def _set_aside_one(s, data, deferred: Deferred, fit, options: RunOptions,
+                   run: NoiseRun) -> dict | None:
     """The record (``{"log_z", "method", "intervals"}``) with which the deferred noise model
     is set aside after the leader's certified posterior ``run``, or None where it must be
     sampled. Set aside where it trails the leader's ln Z by :data:`SCREEN_MARGIN`, by
@@ -301,20 +325,21 @@ def _set_aside(s, data, deferred: Deferred | None, fit, options: RunOptions,
     return {"log_z": bound, "method": BOUND_METHOD, "intervals": {}}
 
 
-def settle(screened: Screen, run: NoiseRun) -> Screen | None:
-    """After the leader's posterior (``run``), the deferred noise model of ``screened``: set
-    aside with the record that :func:`sample_held` found for it (``run.aside``; see
-    :func:`_set_aside`), as a :class:`Screen` without ``deferred``; None where it is sampled
-    too."""
-    if run.aside is None:
-        return None
-    return Screen(screened.leader, {**screened.quick, screened.deferred.noise: run.aside})
+def settle(screened: Screen, run: NoiseRun) -> tuple[Screen, list[str]]:
+    """After the leader's posterior (``run``), the deferred noise models of ``screened``: those
+    set aside with the record that :func:`sample_held` found for them (``run.aside``; see
+    :func:`_set_aside`) join the screen's records, in a :class:`Screen` without ``deferred``;
+    returned with the list of the others, which are sampled too."""
+    records = {d.noise: run.aside.get(d.noise) for d in screened.deferred}
+    rest = [n for n, r in records.items() if r is None]
+    found = {n: r for n, r in records.items() if r is not None}
+    return Screen(screened.leader, {**screened.quick, **found}, also=screened.also), rest
 
 
 def choose_noise(name: str, runs: list[NoiseRun],
                  screened: Screen | None) -> tuple[NoiseRun, dict]:
-    """The run whose noise model has the larger evidence, and the record of the choice: each
-    noise model's ln Z (certified, or the quick estimate of a model left out by the screen),
+    """The run whose noise model has the largest evidence, and the record of the choice: each
+    noise model's ln Z (certified, or the estimate of a model the screen set aside),
     its posterior probability (equal prior odds) and the exponents' intervals, and
     ``sensitive`` when an exponent's intervals under the two models do not overlap.
 
@@ -328,9 +353,10 @@ def choose_noise(name: str, runs: list[NoiseRun],
         entries.append(_Entry(r.lik.noise, e.log_z if e is not None else -np.inf,
                               None if e is None else float(e.log_z_err),
                               None if e is None else e.method, _exponent_intervals(r), r))
+    sampled_noise = {r.lik.noise for r in runs}
     if screened is not None:
         for noise, q in screened.quick.items():
-            if noise != screened.leader:
+            if noise not in sampled_noise:
                 entries.append(_Entry(noise, q["log_z"], None, q["method"], q["intervals"],
                                       None))
     # Against an upper bound, the lead and the probability are lower bounds.
@@ -360,19 +386,33 @@ def choose_noise(name: str, runs: list[NoiseRun],
             "hdi": {k: [float(lo), float(hi)] for k, (lo, hi) in hdi.items()},
         }
     intervals = [e.intervals for e in entries]
-    apart = []
-    for param in intervals[best]:
-        spans = [iv[param] for iv in intervals if param in iv]
-        if max(lo for lo, _ in spans) > min(hi for _, hi in spans):
-            apart.append(param)
+    # The models the evidence has not excluded (probability of at least 1 − NOISE_DECISIVE):
+    # exponents that part only under a model it has excluded are decided by it.
+    plausible = [i for i in range(len(entries))
+                 if i == best or not np.isfinite(prob[i]) or prob[i] >= 1.0 - NOISE_DECISIVE]
+
+    def parted(among):
+        out = []
+        for param in intervals[best]:
+            spans = [intervals[i][param] for i in among if param in intervals[i]]
+            if max(lo for lo, _ in spans) > min(hi for _, hi in spans):
+                out.append(param)
+        return out
+
+    apart = parted(range(len(entries)))
+    contested = parted(plausible)
     # Unknown (None) where a model set aside by its maximum likelihood has no intervals.
     unknown = any(param not in iv for iv in intervals for param in intervals[best])
     record["sensitive"] = True if apart else (None if unknown else False)
     record["sensitive_parameters"] = apart
-    other = next(i for i in range(len(entries)) if i != best)
+    record["contested_parameters"] = contested
+    # The runner-up: the lead is stated against it.
+    other = max((i for i in range(len(entries)) if i != best), key=lambda i: log_z[i])
     with np.errstate(invalid="ignore"):  # neither has an evidence: -inf - -inf
         delta = log_z[best] - log_z[other]
-    reason = (f"chosen by evidence over {' and '.join(e.noise for e in entries)} noise "
+    names = [e.noise for e in entries]
+    listed = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+    reason = (f"chosen by evidence over {listed} noise "
               + (f"(ln Z higher by {least}{delta:.1f}; probability {least}"
                  f"{prob[best]:.3f})" if np.isfinite(delta) else "(the other has no evidence)")
               if np.isfinite(log_z[best]) else
@@ -380,12 +420,15 @@ def choose_noise(name: str, runs: list[NoiseRun],
               "choose by; the first is kept")
     chosen.post = replace(chosen.post, noise_reason=reason)
     if apart:
-        ours, theirs = intervals[best], intervals[other]
+        decided = not contested
+        among = plausible if contested else range(len(entries))
         shown = "; ".join(
-            f"{p} {ours[p][0]:.3g}…{ours[p][1]:.3g} under {entries[best].noise} noise, "
-            f"{theirs[p][0]:.3g}…{theirs[p][1]:.3g} under {entries[other].noise}"
-            for p in apart)
-        decided = np.isfinite(prob[best]) and prob[best] >= NOISE_DECISIVE
+            f"{p} " + ", ".join(
+                f"{intervals[i][p][0]:.3g}…{intervals[i][p][1]:.3g} under {entries[i].noise}"
+                + (" noise" if k == 0 else "")
+                for k, i in enumerate([best, *(j for j in among if j != best)])
+                if p in intervals[i])
+            for p in (contested or apart))
         msg = (f"{name}: the exponents depend on the noise model: 94 % intervals do not overlap "
                f"({shown}); " + (f"the evidence favours {entries[best].noise} noise with "
                                  f"probability {least}{prob[best]:.3f}" if np.isfinite(prob[best])
@@ -432,8 +475,9 @@ def fit_and_screen(s: Structure, data: FrequencyResponse, options: RunOptions):
 
 
 def _to_sample(candidates, screened: Screen | None) -> list[str]:
-    """The noise models to sample now: the leader where the screen has one, else all."""
-    return list(candidates) if screened is None else [screened.leader]
+    """The noise models to sample now: the leader and those sampled with it where the screen
+    has one, else all."""
+    return list(candidates) if screened is None else [screened.leader, *screened.also]
 
 
 def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions, fitted=None):
@@ -460,8 +504,8 @@ def fit_and_probe(s: Structure, data: FrequencyResponse, options: RunOptions, fi
     if (options.sampler != "auto" or options.evidence != "auto"
             or options.evidence_check or not fit.optima.size):
         return (fit, screened, noises), False
-    # The promise covers a deferred noise model too: it may be sampled where the leader is.
-    promised = noises + ([screened.deferred.noise] if screened and screened.deferred else [])
+    # The promise covers the deferred noise models too: they may be sampled where the leader is.
+    promised = noises + ([d.noise for d in screened.deferred] if screened else [])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for noise in promised:
@@ -484,13 +528,13 @@ def _fit(s: Structure, data: FrequencyResponse, options: RunOptions):
 
 
 def sample_held(s: Structure, data: FrequencyResponse, noise: str, fit,
-                options: RunOptions, deferred: Deferred | None = None) -> NoiseRun:
+                options: RunOptions, deferred: tuple = ()) -> NoiseRun:
     """Step 2: :func:`sample` under one noise model, its warnings held back in
     ``run.caught`` (category, message, file, line): only the chosen model's reach the user
     (:func:`conclude`; the other's are kept in its record).
 
-    With ``deferred`` (the noise model waiting for this one's ln Z, :func:`_deferral`),
-    ``run.aside`` is the record that sets it aside, where this posterior allows
+    With ``deferred`` (the noise models waiting for this one's ln Z, :func:`_deferral`),
+    ``run.aside`` holds the record that sets each aside, where this posterior allows
     (:func:`_set_aside`; for :func:`settle`)."""
     with warnings.catch_warnings(record=True) as held:
         warnings.simplefilter("always")

@@ -44,7 +44,7 @@ REPAIR_MAX_FAILED = 3
 #: How far inside the passive region the repaired optima lie (relative dissipation).
 REPAIR_MARGIN = 1e-8
 
-WEIGHTINGS = ("auto", "sigma", "relative", "none")
+WEIGHTINGS = ("auto", "sigma", "relative", "parts", "none")
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,7 +146,9 @@ class _Problem:
             wt = 1.0 / np.abs(self.g)
         else:
             wt = np.ones_like(self.w)
-        self.wt = wt
+        # "parts": each part by itself (1/|Re g|, 1/|Im g|), the cost of relative_parts noise.
+        self.wt_re, self.wt_im = ((1.0 / np.abs(self.g.real), 1.0 / np.abs(self.g.imag))
+                                  if weighting == "parts" else (wt, wt))
         self.log = np.array([isinstance(p.prior, LogUniform) for p in structure.parameters])
         lo, hi = np.array([p.prior.bounds for p in structure.parameters], dtype=float).T
         self.lo = np.where(self.log, np.log(lo, where=self.log, out=np.ones_like(lo)), lo)
@@ -159,8 +161,8 @@ class _Problem:
     def residuals_many(self, u):
         """Stacked weighted residuals for many points u, shape (n_sets, 2N)."""
         model = self.s.response(self.theta(u), self.w, self.kind)
-        r = (model - self.g) * self.wt
-        return np.concatenate([r.real, r.imag], axis=-1)
+        r = model - self.g
+        return np.concatenate([r.real * self.wt_re, r.imag * self.wt_im], axis=-1)
 
     def fun(self, u):
         return _finite(self.residuals_many(u[None, :])[0])
@@ -239,7 +241,7 @@ def fit_structure(
         which start at positive magnitudes 10^U(-1.5, 1.5) on the scaled data.
     rng : numpy.random.Generator or int or None
         Source of the random starts (reproducible for a given seed).
-    weighting : {"auto", "sigma", "relative", "none"}
+    weighting : {"auto", "sigma", "relative", "parts", "none"}
         Residual weights; see :func:`choose_weighting`.
     starts : array_like, shape (k, n_params), optional
         Extra starts in physical units.

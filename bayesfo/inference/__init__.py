@@ -47,8 +47,9 @@ def run_posterior(structure, data, *, noise: str = "auto", priors=None, seed: in
     structure : Structure
     data : FrequencyResponse
     noise : {"auto", "known", "constant", "proportional", "relative_parts"}
-        See :mod:`bayesfo.inference.likelihood`; ``auto`` (:func:`choose_noise`) never chooses
-        ``relative_parts``.
+        See :mod:`bayesfo.inference.likelihood`; ``auto`` here follows the rule of
+        :func:`choose_noise`, which never picks ``relative_parts`` (:func:`bayesfo.compare`
+        chooses by evidence instead).
     priors : dict, optional
         Prior overrides ``{name: Prior}`` (structure or noise parameters).
     seed : int

@@ -21,7 +21,8 @@ models:
     deviations σ_rel·|Re G_k| and σ_rel·|Im G_k| (data values), σ_rel sampled with the prior of
     ``proportional``. σ_rel is then the relative error of each part, and E|ΔG_k|² =
     σ_rel²·|G_k|² at every point, the convention of ``proportional`` (with which it coincides
-    where |Re G_k| = |Im G_k|). The pointwise log-likelihood is
+    where |Re G_k| = |Im G_k|). The usual error model of a rheometer or DMA, which reports G'
+    and G'' each with a relative error. The pointwise log-likelihood is
 
         ln p(G_k | θ) = −ln(2π σ_rel² |Re G_k|·|Im G_k|)
                         − [(ΔRe_k / Re G_k)² + (ΔIm_k / Im G_k)²] / (2 σ_rel²),
@@ -30,7 +31,9 @@ models:
     Σ_k (ΔRe_k / Re G_k)² + (ΔIm_k / Im G_k)², the cost that pyRheo and RheoJAX minimise on
     storage and loss moduli. It weights each part by itself where one is much smaller than the
     other (G' ≪ G'' or G' ≫ G''), where ``proportional`` weights both by |G|. Data with a part
-    exactly 0 cannot use it. Opt-in: ``auto`` never chooses it.
+    exactly 0 cannot use it. :func:`bayesfo.compare` weighs it by evidence with ``constant`` and
+    ``proportional`` under ``noise="auto"``; the rule of :func:`choose_noise` (a bare
+    :class:`Likelihood`) never picks it.
 
 Everything is evaluated on the scaled data (ω/ω_ref, G/g_ref) and vectorised over parameter sets;
 the log-likelihood is reported in physical units (the scaling adds −2·ln g_ref per point).
@@ -77,8 +80,8 @@ def choose_noise(data: FrequencyResponse, noise: str = "auto") -> tuple[str, str
     """Resolve ``"auto"`` by a rule, and say why.
 
     This is the default of a bare :class:`Likelihood`. :func:`bayesfo.compare` does not use the
-    rule: without σ it runs each structure under both ``constant`` and ``proportional`` noise
-    and keeps the one with the larger evidence (see ``docs/adequacy.md``).
+    rule: without σ it weighs ``constant``, ``proportional`` and ``relative_parts`` noise for
+    each structure by evidence and keeps the one with the largest (see ``docs/adequacy.md``).
 
     Returns
     -------
@@ -116,7 +119,8 @@ class Likelihood:
     structure : Structure
     data : FrequencyResponse
     noise : {"auto", "known", "constant", "proportional", "relative_parts"}
-        ``auto`` follows :func:`choose_noise` (never ``relative_parts``).
+        ``auto`` follows the rule of :func:`choose_noise` (never ``relative_parts``;
+        :func:`bayesfo.compare` chooses by evidence instead).
     priors : dict, optional
         Overrides of structure or noise priors, ``{name: Prior}``.
     scaling : Scaling, optional
@@ -297,26 +301,32 @@ class Likelihood:
 
             ∫_a^b σ^(-2n) e^(-S/σ²) dσ/(σ ln(b/a)) = Γ(n) [P(n, S/a²) − P(n, S/b²)] / (2 S^n ln(b/a)),
 
-        P the regularised lower incomplete gamma function. None where it does not apply (known
-        or ``relative_parts`` noise, or a noise prior that is not log-uniform)."""
+        P the regularised lower incomplete gamma function. Under ``relative_parts`` the 2n real
+        parts give the same integral with S = ½ Σ_k (ΔRe_k/Re g_k)² + (ΔIm_k/Im g_k)² and the
+        normalisation ∏ 1/(2π |Re g_k|·|Im g_k|). None where it does not apply (known noise, or
+        a noise prior that is not log-uniform)."""
         from scipy.special import gammainc, gammaln
 
         prior = self.noise_param[1] if self.noise_param else None
-        if self.noise not in ("constant", "proportional") or not isinstance(prior, LogUniform):
+        if self.noise == "known" or not isinstance(prior, LogUniform):
             return None
         theta_structure = np.atleast_2d(theta_structure)
         model = self.structure.response(theta_structure, self.omega_scaled, self.data.kind)
-        r2 = np.abs(self.g_scaled - model) ** 2
-        n = r2.shape[1]
-        if self.noise == "constant":
-            s, log_w = r2.sum(axis=1), 0.0
+        n = model.shape[1]
+        if self.noise == "relative_parts":
+            s = 0.5 * self._relative_parts2(model).sum(axis=1)
+            log_norm = n * self._unit_shift + float(self._log_parts.sum())
         else:
-            s, log_w = (r2 / self._abs_g2).sum(axis=1), float(np.log(self._abs_g2).sum())
+            r2 = np.abs(self.g_scaled - model) ** 2
+            if self.noise == "constant":
+                s, log_w = r2.sum(axis=1), 0.0
+            else:
+                s, log_w = (r2 / self._abs_g2).sum(axis=1), float(np.log(self._abs_g2).sum())
+            log_norm = n * (self._unit_shift - math.log(math.pi)) - log_w
         a, b = prior.low, prior.high
         with np.errstate(divide="ignore", invalid="ignore"):
             mass = gammainc(n, s / a**2) - gammainc(n, s / b**2)
-            out = (n * (self._unit_shift - math.log(math.pi)) - log_w
-                   - math.log(2.0 * math.log(b / a)) + gammaln(n) - n * np.log(s)
+            out = (log_norm - math.log(2.0 * math.log(b / a)) + gammaln(n) - n * np.log(s)
                    + np.log(mass))
         return np.where(np.isfinite(out), out, -np.inf)
 

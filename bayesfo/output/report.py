@@ -105,13 +105,14 @@ def _noise(comparison) -> list[tuple[str, str]]:
             chosen.setdefault(r.posterior.noise, []).append(r.name)
         elif (r.posterior.noise, r.posterior.noise_reason) not in seen:
             seen.append((r.posterior.noise, r.posterior.noise_reason))
-    # relative_parts is never chosen by evidence: say what it means where it was asked for.
-    seen = [(n, f"{why} (relative errors σ_rel of the real and imaginary parts separately, the "
-                "cost that pyRheo and RheoJAX minimise)" if n == "relative_parts" else why)
-            for n, why in seen]
+    # Say what relative_parts means, whether asked for or chosen by evidence.
+    parts = ("relative errors σ_rel of the real and imaginary parts separately, the cost that "
+             "pyRheo and RheoJAX minimise")
+    seen = [(n, f"{why} ({parts})" if n == "relative_parts" else why) for n, why in seen]
     if chosen:
         seen.append(("by evidence per structure", "; ".join(
-            f"{noise} for {_join(names)}" for noise, names in chosen.items())))
+            f"{noise} for {_join(names)}" + (f" ({parts})" if noise == "relative_parts" else "")
+            for noise, names in chosen.items())))
     return seen
 
 

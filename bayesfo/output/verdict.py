@@ -322,14 +322,29 @@ def _undecided_noise(name, result) -> str:
         return ""
     chosen, models = record["chosen"], record["models"]
     p = models[chosen]["probability"]
-    if p is None or p >= NOISE_DECISIVE:
+    if p is None or p >= NOISE_DECISIVE or not _contested(record):
         return ""
-    names = [chosen, *(n for n in models if n != chosen)]
+    names = [chosen, *(n for n in _plausible(models) if n != chosen)]
     parts = [f"{ORDER_SYMBOLS.get(param, param)} " + ", ".join(
         f"{models[n]['hdi'][param][0]:.3g}–{models[n]['hdi'][param][1]:.3g} under {n}"
         + (" noise" if i == 0 else "") for i, n in enumerate(names) if param in models[n]["hdi"])
-        for param in record["sensitive_parameters"]]
+        for param in _contested(record)]
     return f"{name} ({'; '.join(parts)}; probability {p:.3f} for {chosen})"
+
+
+def _plausible(models) -> list[str]:
+    """The noise models the evidence has not excluded (probability of at least
+    1 − NOISE_DECISIVE, or none stated)."""
+    from ..comparison.steps import NOISE_DECISIVE
+
+    return [n for n, m in models.items()
+            if m["probability"] is None or m["probability"] >= 1.0 - NOISE_DECISIVE]
+
+
+def _contested(record) -> list[str]:
+    """The exponents whose intervals part among the noise models the evidence has not excluded
+    (records written before ``contested_parameters`` existed: every sensitive one)."""
+    return record.get("contested_parameters", record["sensitive_parameters"])
 
 
 def _noise_sentences(name, result) -> list[tuple[str, bool]]:
@@ -355,11 +370,18 @@ def _noise_sentences(name, result) -> list[tuple[str, bool]]:
     if not record["sensitive"]:
         return [(text, False)]
     parts = []
-    for param in record["sensitive_parameters"]:
+    decided = (p is not None and p >= NOISE_DECISIVE) or not _contested(record)
+    shown = [chosen, *(n for n in (others if decided else _plausible(models)) if n != chosen)]
+    for param in record["sensitive_parameters"] if decided else _contested(record):
         spans = [f"{models[n]['hdi'][param][0]:.3g}–{models[n]['hdi'][param][1]:.3g} under {n} "
-                 "noise" for n in [chosen, *others] if param in models[n]["hdi"]]
+                 "noise" for n in shown if param in models[n]["hdi"]]
         parts.append(f"{param} {'; '.join(spans)}")
-    decided = p is not None and p >= NOISE_DECISIVE
+    excluded = [n for n in others if n not in _plausible(models)]
+    if decided and (p is None or p < NOISE_DECISIVE) and excluded:
+        # The intervals part only under models the evidence excludes.
+        return [(text + f" Its exponents differ only under {_join(excluded)} noise "
+                 f"({HDI_PERCENT} % intervals that do not overlap: {'; '.join(parts)}), which "
+                 f"the evidence excludes (probability below {1 - NOISE_DECISIVE:.2f}).", False)]
     text += (f" Its exponents depend on the noise model ({HDI_PERCENT} % intervals that do not "
              f"overlap: {'; '.join(parts)})"
              + ("; the evidence decides between them." if decided else

@@ -67,6 +67,12 @@ PERIODS = 3.0
 #: this share of the entropy still missing: below, it would cost measuring time for nothing.
 NEGLIGIBLE = 1e-3
 NEGLIGIBLE_SHARE = 0.01
+#: Proposed frequencies lie at least this share of the width of the single-point information's
+#: peak apart (its full width at half maximum, in decades), and at least one candidate step,
+#: at most :data:`MAX_SPACING` decades: two points closer than that measure nearly the same
+#: thing (0.063 and 0.074 rad/s were proposed together, 0.07 decades apart).
+SPACING_SHARE = 0.5
+MAX_SPACING = 0.5
 #: |ln B| beyond which the evidence is decisive (Jeffreys: B > 100).
 DECISIVE = math.log(100.0)
 COSTS = ("uniform", "low-frequency")
@@ -109,6 +115,8 @@ class Design:
     notes : tuple of str
     asked : int
         The number of points asked for (the rules of thumb place as many).
+    spacing : float
+        The least distance between proposed frequencies [decades] (:func:`min_spacing`).
     """
 
     omega: np.ndarray = field(repr=False)
@@ -126,6 +134,7 @@ class Design:
     cost: str
     notes: tuple[str, ...] = ()
     asked: int = 0
+    spacing: float = math.nan
 
     def to_dict(self) -> dict:
         """The design as JSON (``bayesfo design --json``)."""
@@ -138,7 +147,7 @@ class Design:
                 "p_decisive": self.p_decisive, "alternatives": dict(self.alternatives),
                 "candidates": {"omega": self.omega.tolist(),
                                "information": self.information.tolist()},
-                "notes": list(self.notes)}
+                "min_spacing_decades": self.spacing, "notes": list(self.notes)}
 
 
 def seconds(omega) -> np.ndarray:
@@ -319,6 +328,40 @@ def _named_notes(ranked, names) -> list[str]:
     return notes
 
 
+def min_spacing(log_omega: np.ndarray, information: np.ndarray) -> float:
+    """The least distance [decades] between proposed frequencies: :data:`SPACING_SHARE` of the
+    full width at half maximum of the single-point information about its peak, at least one
+    step of the candidates' grid and at most :data:`MAX_SPACING`."""
+    step = float(log_omega[1] - log_omega[0]) if log_omega.size > 1 else 0.0
+    j = int(np.argmax(information))
+    half = information[j] / 2.0
+    if not half > 0:
+        return step
+    above = information >= half
+    lo = j
+    while lo > 0 and above[lo - 1]:
+        lo -= 1
+    hi = j
+    while hi < above.size - 1 and above[hi + 1]:
+        hi += 1
+    width = float(log_omega[hi] - log_omega[lo]) + step
+    return float(min(max(SPACING_SHARE * width, step), MAX_SPACING))
+
+
+def _inadequate_note(results) -> list[str]:
+    """Where every structure considered fails the posterior predictive checks: points that
+    tell them apart choose among descriptions that all miss the data."""
+    checked = [r.criteria.adequacy for r in results
+               if getattr(r.criteria, "adequacy", None) is not None]
+    if len(checked) < len(results) or any(a.adequate for a in checked):
+        return []
+    return [f"every structure considered ({', '.join(r.name for r in results)}) fails the "
+            "posterior predictive checks: the proposed points tell apart descriptions that all "
+            "miss the data; a structure that describes them is wanted first, or measure where "
+            f"the best one's parameters are least determined (--parameter NAME on "
+            f"{results[0].name})"]
+
+
 def design(result, *, window=None, points: int = 3, structures=None, cost: str = "uniform",
            seed: int = 0) -> Design:
     """The frequencies to measure next to tell the structures of ``result`` apart.
@@ -386,6 +429,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     if len(keep) < sum(probs >= MIN_PROBABILITY):
         notes.append(f"the {MAX_STRUCTURES} most probable structures are considered")
     results = [ranked[i] for i in keep]
+    notes += _inadequate_note(results)
     p = probs[keep] / probs[keep].sum()
     log_prior = np.log(p)
     entropy = float(-np.sum(p * np.log(p)))
@@ -406,6 +450,8 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     c = np.arange(omega.size)
     single, _ = pred.information(c[:, None], log_prior, rng)
     time = seconds(omega)
+    log_w = np.log10(omega)
+    spacing = min_spacing(log_w, single)
     chosen, proposed, info_so_far = [], [], 0.0
     for _ in range(points):
         # The first point's information is the candidates' own (the same estimate, so that the
@@ -413,7 +459,15 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         info = single if not chosen else pred.information(
             np.array([chosen + [j] for j in c]), log_prior, rng)[0]
         gains = info - info_so_far
-        gains[chosen] = -np.inf  # distinct frequencies, as a sweep measures them
+        # Distinct frequencies, as a sweep measures them, and apart by the spacing.
+        for k in chosen:
+            gains[np.abs(log_w - log_w[k]) < spacing - 1e-9] = -np.inf
+        gains[chosen] = -np.inf
+        if chosen and not np.isfinite(gains).any():
+            notes.append(f"after {len(chosen)} point(s) no frequency of the window lies "
+                         f"{spacing:.2f} decades or more from those proposed (the width of "
+                         "the information's peak)")
+            break
         if chosen and gains.max() < max(NEGLIGIBLE, NEGLIGIBLE_SHARE * entropy):
             notes.append(f"after {len(chosen)} point(s) no further frequency of the window "
                          "adds measurable information: the rest of the choice lies beyond the "
@@ -449,4 +503,4 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
                   entropy=entropy, leading=(results[0].name, results[1].name),
                   log_bayes_factor=float(ln_b), expected_change=expected,
                   p_decisive=p_decisive, alternatives=alternatives, window=(w_lo, w_hi),
-                  cost=cost, notes=tuple(notes), asked=int(points))
+                  cost=cost, notes=tuple(notes), asked=int(points), spacing=spacing)

@@ -270,3 +270,45 @@ def test_a_parameter_is_best_measured_where_it_shows():
         assert p["sd_after"] == pytest.approx(residual_sd, rel=0.15)
     with pytest.raises(InputError, match="has no parameter 'zz'; its parameters are a1, b0, q"):
         design_parameter(comp, "zz")
+
+
+def test_proposed_points_lie_apart_by_the_width_of_the_information(monkeypatch):
+    """Two structures that part most at the window's top with 10 % noise: without a spacing
+    the greedy choice puts its second point on the neighbouring candidate (100 and 86 rad/s,
+    0.07 decades apart, as 0.063 and 0.074 rad/s were proposed on silk data); with it the
+    points lie at least half the information peak's width apart (here the cap, 0.5)."""
+    import bayesfo.planning.choice as choice
+
+    a = _result("a", [1.0, 1.0, 0.5], 0.03, 0.3, seed=3, noise=0.1)
+    b = _result("b", [1.0, 1.0, 0.55], 0.03, 0.0, seed=4, noise=0.1)
+
+    def gaps(plan):
+        logs = np.log10([p["omega"] for p in plan.proposed])
+        return np.abs(logs[:, None] - logs[None, :])[np.triu_indices(logs.size, 1)]
+
+    plan = design(_make(a, b), window=(0.01, 100.0), points=5)
+    step = np.log10(plan.omega[1] / plan.omega[0])
+    assert 2 * step < plan.spacing <= choice.MAX_SPACING
+    assert len(plan.proposed) >= 2 and gaps(plan).min() >= plan.spacing - 1e-9
+    assert plan.to_dict()["min_spacing_decades"] == plan.spacing
+    with monkeypatch.context() as mp:
+        mp.setattr(choice, "SPACING_SHARE", 0.0)
+        stacked = design(_make(a, b), window=(0.01, 100.0), points=5)
+    assert gaps(stacked).min() < 0.1
+    # The rule on a known curve: a peak of half-maximum width 0.6 decades gives 0.3, within
+    # a step of the grid (0.1 decades).
+    x = np.linspace(-3, 3, 61)
+    info = np.exp(-0.5 * (x / (0.6 / 2.3548)) ** 2)
+    assert choice.min_spacing(x, info) == pytest.approx(0.3, abs=0.051)
+
+
+def test_a_design_among_structures_that_all_fail_the_checks_says_so():
+    a = _result("a", [1.0, 1.0, 0.5], 0.03, 0.3, seed=3)
+    b = _result("b", [1.0, 1.0, 0.55], 0.03, 0.0, seed=4)
+    for r in (a, b):
+        r.criteria.adequacy = SimpleNamespace(adequate=False)
+    plan = design(_make(a, b), window=(0.01, 100.0), points=2)
+    assert any("every structure considered (a, b) fails" in n for n in plan.notes)
+    b.criteria.adequacy = SimpleNamespace(adequate=True)
+    plan = design(_make(a, b), window=(0.01, 100.0), points=2)
+    assert not any("every structure considered" in n for n in plan.notes)

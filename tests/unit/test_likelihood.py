@@ -85,7 +85,7 @@ def test_prior_overrides():
         Likelihood(ZENER, _data(), priors={"c": LogUniform(1, 2)})
 
 
-@pytest.mark.parametrize("noise", ["constant", "proportional"])
+@pytest.mark.parametrize("noise", ["constant", "proportional", "relative_parts"])
 def test_the_noise_scale_integrated_out_matches_quadrature(noise):
     """Likelihood.log_noise_marginal (closed form, incomplete gamma) against scipy's quadrature
     of exp(ln L(θ, σ)) over the log-uniform prior of σ, at the truth and away from it."""

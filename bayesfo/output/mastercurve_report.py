@@ -76,6 +76,13 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     elif ranked:
         out.append((f"One master function, {ranked[0]['structure']}: ln Z = "
                     f"{ranked[0]['log_evidence']:.2f}.", False))
+    aside = [r for r in mc.ranking if r.get("log_evidence_upper") is not None]
+    if ranked and aside:
+        out.append((", ".join(r["structure"] for r in aside)
+                    + f" {'was' if len(aside) == 1 else 'were'} not sampled: the best fit "
+                    f"bounds ln Z at least "
+                    f"{ranked[0]['log_evidence'] - max(r['log_evidence_upper'] for r in aside):.0f}"
+                    f" below {ranked[0]['structure']}'s.", False))
     ev = mc.law_evidence
     if ev:
         order = sorted(ev, key=lambda k: -(ev[k]["log_evidence"] if ev[k]["log_evidence"]
@@ -198,7 +205,7 @@ def render_mastercurve_report(mc, figures: dict | None = None) -> str:
         f"<div class='verdict' id='verdict'>{sentences}</div>",
         f"<h2 id='isotherms'>Isotherms</h2><p>{len(mc.temperatures)} isotherms, reference "
         f"{mc.reference_temperature:g} °C; residual: each isotherm's relative rms residual "
-        f"under the joint fit.</p>{_isotherms_table(mc)}",
+        f"under the fit of the master structure.</p>{_isotherms_table(mc)}",
         f"<h2 id='ranking'>Master functions</h2>{_ranking_table(mc)}",
         f"<h2 id='shifts'>Shift factors of {_e(mc.structure)}</h2><p>Shifts: {_e(shifts)}; "
         f"vertical: {_e(mc.vertical)}.</p>{_shifts_table(mc)}",

@@ -429,7 +429,7 @@ class Comparison:
                 + (f"; {failed} failed" if failed else "") + ">")
 
     def _repr_html_(self) -> str:
-        from ..output.notebook import comparison_html
+        from .notebook import comparison_html
 
         return comparison_html(self)
 

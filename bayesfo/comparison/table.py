@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 
+from .._text import number  # noqa: F401  (the comparison's table writes its numbers)
 from .parameters import flagged_names, natural_block, physical_text
 
 #: The parameters that name a structure's fractional order, in order of preference: the
@@ -161,27 +162,6 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se",
                   "not_determined", "poorly_determined", "orders")
 
-
-
-def number(value, spec: str = ".2f", missing: str = "-") -> str:
-    """One number of a table in text: ``value`` formatted by ``spec``, or ``missing`` where it
-    is undefined (None, NaN or infinite; the reason is among the warnings).
-
-    Examples
-    --------
-    A value that rounds to zero is written without a sign ("0.000", not "-0.000").
-
-    >>> number(-12.3456), number(float("nan")), number(None, missing="–")
-    ('-12.35', '-', '–')
-    >>> number(-1e-17, ".3f"), number(-0.0004, ".3f"), number(-0.0, "g")
-    ('0.000', '0.000', '0')
-    """
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
-        return missing
-    text = format(value, spec)
-    if text.startswith("-") and not any(c in "123456789" for c in text.split("e")[0]):
-        return text[1:]
-    return text
 
 
 def order_means(row: dict) -> str:

@@ -11,7 +11,22 @@ import math
 from ..data.symbols import mode as mode_of
 from ..data.symbols import modulus_symbol
 from ..errors import InputError
-from .prony import DIGITS, FORMATS, GAS_CONSTANT, KELVIN, LSDYNA_MAX_TERMS, _has_unit
+
+#: Gas constant [J/(mol K)] and the kelvin of 0 °C, for the Arrhenius shift law.
+GAS_CONSTANT = 8.314462618
+KELVIN = 273.15
+#: The formats of a series: a table and the decks of three finite-element codes.
+FORMATS = ("csv", "abaqus", "ansys", "lsdyna")
+#: Terms *MAT_GENERAL_VISCOELASTIC takes (the long-term modulus is one of them, with β = 0).
+LSDYNA_MAX_TERMS = 18
+#: Significant digits of the moduli, ratios and times written.
+DIGITS = 10
+
+
+def _has_unit(unit: str) -> bool:
+    """Whether ``unit`` names a unit: not empty, not the arbitrary unit of data without one
+    (``a.u.``: :func:`~bayesfo.structures.physical.stress_unit`, ``[G]`` of earlier versions)."""
+    return bool(unit) and "[" not in unit and "a.u." not in unit
 
 
 def deck_text(prony, fmt: str) -> str:

@@ -132,7 +132,7 @@ class Prediction:
                    if np.any(self.extrapolated) else "") + ">")
 
     def _repr_html_(self) -> str:
-        from ..output.notebook import prediction_html
+        from .notebook import prediction_html
 
         return prediction_html(self)
 

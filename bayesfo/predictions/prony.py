@@ -47,14 +47,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from .decks import (  # noqa: F401  (the formats and constants of the decks, named here too)
+    DIGITS,
+    FORMATS,
+    GAS_CONSTANT,
+    KELVIN,
+    LSDYNA_MAX_TERMS,
+    _has_unit,
+    deck_text,
+    lsdyna_shift,
+)
 
-#: Gas constant [J/(mol K)] and the kelvin of 0 °C, for the Arrhenius shift law.
-GAS_CONSTANT = 8.314462618
-KELVIN = 273.15
-
-FORMATS = ("csv", "abaqus", "ansys", "lsdyna")
-#: Terms *MAT_GENERAL_VISCOELASTIC takes (the long-term modulus is one of them, with β = 0).
-LSDYNA_MAX_TERMS = 18
 #: Decades of relaxation times beyond the data window on each side.
 TAU_MARGIN = 2
 #: Decades of relaxation times added beyond 1/ω_min where G∞ = 0.
@@ -62,15 +65,12 @@ LIQUID_MARGIN = 1
 #: A g_0 more than this many times the largest measured |G*| is named in the files as the
 #: model's extrapolation.
 EXTRAPOLATED = 1.5
-
-
 #: A modulus ratio sum Abaqus and ANSYS take: Σ g_i/G0 < 1 (a relaxed modulus above zero);
 #: the ratios written sum to at most this.
 RATIO_SUM_MAX = 1 - 1e-6
 #: Log-spaced times (and frequencies) over the data window the series is judged on.
 DENSE = 2001
-#: Significant digits of the moduli, ratios and times written.
-DIGITS = 10
+
 
 
 @dataclass(frozen=True)
@@ -173,9 +173,9 @@ class Prony:
                 f"{self.max_rel_error_relaxation:.2g}, {band} the model's band>")
 
     def _repr_html_(self) -> str:
-        from ..output.notebook import prony_html
+        from .notebook import prony_html
 
-        return prony_html(self)
+        return prony_html(self, _unit_suffix(self.unit))
 
     def relaxation(self, t) -> np.ndarray:
         t = np.asarray(t, float)
@@ -241,7 +241,6 @@ class Prony:
 
     def text(self, fmt: str) -> str:
         """The series in ``fmt`` (one of :data:`FORMATS`; :func:`~.decks.deck_text`)."""
-        from .decks import deck_text
 
         return deck_text(self, fmt)
 
@@ -249,7 +248,6 @@ class Prony:
         """TREF [K], A and B of *MAT_GENERAL_VISCOELASTIC for the shift law, None without one
         (:func:`~.decks.lsdyna_shift`: A = −C1 ln 10, B = C2 for WLF; A = E_a/R, B = 0 for
         Arrhenius)."""
-        from .decks import lsdyna_shift
 
         return lsdyna_shift(self)
 
@@ -508,12 +506,6 @@ def _shift_law(mc) -> tuple[dict | None, str, tuple]:
              "parameters": {k: float(v["mean"]) for k, v in law["parameters"].items()},
              "temperatures": (float(min(mc.temperatures)), float(max(mc.temperatures))),
              "chi2_per_dof": float(mc.laws[law["name"]]["chi2_per_dof"])}, "", ())
-
-
-def _has_unit(unit: str) -> bool:
-    """Whether ``unit`` names a unit: not empty, not the arbitrary unit of data without one
-    (``a.u.``: :func:`~bayesfo.structures.physical.stress_unit`, ``[G]`` of earlier versions)."""
-    return bool(unit) and "[" not in unit and "a.u." not in unit
 
 
 def _unit_suffix(unit: str) -> str:

@@ -245,7 +245,7 @@ class MasterCurve:
                 + ("free" if self.law == "free" else self.law) + ">")
 
     def _repr_html_(self) -> str:
-        from ..output.notebook import mastercurve_html
+        from .notebook import mastercurve_html
 
         return mastercurve_html(self)
 

@@ -14,7 +14,7 @@ PACKAGE = Path(__file__).parents[2] / "bayesfo"
 #: infrastructure modules come first; ``cli`` is last and nothing imports it. ``predictions``
 #: works on any posterior's draws and comes before ``comparison``, whose results call it.
 LAYERS = (
-    ("errors", "_io", "_signals", "priors", "parallel", "outdir"),
+    ("errors", "_io", "_signals", "_text", "priors", "parallel", "outdir"),
     ("data",),
     ("structures", "models"),
     ("identify", "timeseries", "studies"),

@@ -1,5 +1,11 @@
-"""Time–temperature superposition as one posterior: a master structure and every isotherm's
-horizontal shift log10 a_T, on all isotherms' complex data at once.
+"""Time–temperature superposition: :func:`mastercurve`, the entry point, and the joint route.
+
+By default (``shifts="smooth"``) the shifts come from the model-free master
+(:mod:`bayesfo.tts.smooth`, chosen among noise models, vertical shifts and laws by
+:mod:`bayesfo.tts.shifts`) and the master structures are fitted to the isotherms so shifted
+(:mod:`bayesfo.tts.conditional`). The joint route (``shifts="joint"``), described below, fits
+a master structure and every isotherm's horizontal shift log10 a_T as one posterior, on all
+isotherms' complex data at once.
 
 Isotherm i, measured at temperature T_i, is modelled as the master function at reduced
 frequency: G_i(ω) = G_master(a_T,i · ω) / b_T,i, with a_T = b_T = 1 at the reference

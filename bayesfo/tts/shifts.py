@@ -123,10 +123,8 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
 
     seeds = _seed_shifts(iso)
     reach = max(SHIFT_RANGE, float(np.max(np.abs(seeds))) + SHIFT_MARGIN)
-    run = (lambda f, *a: f(*a)) if submit is None else None
-
     def many(calls):
-        if run is not None:
+        if submit is None:
             return [f(*a) for f, *a in calls]
         return [fut.result() for fut in [submit(f, *a) for f, *a in calls]]
 

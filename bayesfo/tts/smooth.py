@@ -476,39 +476,6 @@ class SmoothMaster:
             grad[k:k + len(self.shifted)] = per_iso_v[list(self.shifted)]
         return value, grad
 
-    def master_curve(self, theta, log_omega_reduced) -> np.ndarray:
-        """The posterior mean of ln|G′| and ln|G″| of the master function at reduced
-        log10 ω, given one parameter set: shape (2, n)."""
-        theta = np.atleast_2d(np.asarray(theta, float))[:1]
-        lo, n_basis = self._grid
-        x = self.log_omega + self.log_shifts(theta)[0, self.point_isotherm]
-        v = self.log_vertical(theta)[0, self.point_isotherm] * math.log(10.0)
-        v = v if self.kind == "modulus" else -v
-        k0, b = _basis(x, lo, n_basis)
-        weight, r, level, _ = self._centred
-        dtd, _ = self._penalty
-        m = theta.shape[1]
-        kq, bq = _basis(np.asarray(log_omega_reduced, float), lo, n_basis)
-        out = []
-        for p in range(2):
-            rho, sigma = theta[0, m - 4 + p], theta[0, m - 2 + p]
-            design = np.zeros((x.size, n_basis))
-            for a in range(4):
-                design[np.arange(x.size), k0 + a] = b[:, a]
-            rp = np.where(weight[p] > 0, r[p] + v, 0.0) * weight[p]
-            full = design.T @ (design * weight[p][:, None]) / sigma ** 2
-            pen = np.zeros((n_basis, n_basis))
-            for d in range(3):
-                idx = np.arange(n_basis - d)
-                pen[idx + d, idx] = pen[idx, idx + d] = dtd[d, :n_basis - d]
-            full += pen / rho ** 2 + np.eye(n_basis) / LEVEL_SD ** 2
-            beta = np.linalg.solve(full, design.T @ rp / sigma ** 2)
-            vals = np.zeros(kq.shape)
-            for a in range(4):
-                vals += bq[..., a] * beta[kq + a]
-            out.append(vals + level[p])
-        return np.array(out)
-
 
 # ---------------------------------------------------------------------------- the posterior
 #: Importance draws per round, and the certificate of the weights (the thresholds of

@@ -205,7 +205,7 @@ def isotherm_misfit(iso: _Isotherms, fitted, g, noise: str) -> dict:
 
 def laws_of(shift_draws, iso: _Isotherms, sp) -> dict:
     """WLF and Arrhenius fitted to the shift draws of the isotherms whose shifts the data fix
-    (:meth:`~bayesfo.tts.smooth.ShiftPosterior.undetermined` left out)."""
+    (:meth:`~bayesfo.tts.smooth_posterior.ShiftPosterior.undetermined` left out)."""
     gone = set(sp.undetermined())
     if len(iso.temperatures) - len(gone) < 3:  # too few left to fit a law to
         gone = set()

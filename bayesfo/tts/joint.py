@@ -44,7 +44,7 @@ from .laws import _fit_laws
 from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
 from .result import ISOTHERM_MISFIT, MasterCurve, _num
 from .shifts import BOUND_MARGIN
-from .smooth import UNDETERMINED
+from .smooth_posterior import UNDETERMINED
 from .spectrum import NAME as SPECTRUM
 from .spectrum import Spectrum
 

@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .model import SHIFT_MARGIN, SHIFT_RANGE, VERTICAL_RANGE
-from .smooth import NOISE, ShiftPosterior, SmoothMaster, best_fit, sample_shifts, start_of
+from .smooth import NOISE, SmoothMaster
+from .smooth_posterior import ShiftPosterior, best_fit, sample_shifts, start_of
 
 #: The vertical shifts that ``vertical="auto"`` chooses among, and the laws of ``law="auto"``.
 VERTICALS = ("none", "density", "free")

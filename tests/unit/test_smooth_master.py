@@ -16,7 +16,8 @@ from scipy.stats import multivariate_normal
 from bayesfo.data import FrequencyResponse
 from bayesfo.tts.isotherms import _isotherms
 from bayesfo.tts.shifts import smooth_shifts
-from bayesfo.tts.smooth import KNOT_STEP, LEVEL_SD, SmoothMaster, sample_shifts, start_of
+from bayesfo.tts.smooth import KNOT_STEP, LEVEL_SD, SmoothMaster
+from bayesfo.tts.smooth_posterior import sample_shifts, start_of
 
 TEMPS = [0.0, 10.0, 20.0, 30.0, 40.0]
 

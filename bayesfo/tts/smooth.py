@@ -25,8 +25,9 @@ thousand parameter sets, whatever the master curve looks like. The parameters ar
 (one free log10 a_T per isotherm other than the reference, or a law's constants), free
 log10 b_T where asked, and ρ_p, σ_p of each part (log-uniform).
 
-Its posterior is :mod:`bayesfo.tts.smooth_posterior`. The shifts so found do not depend on a structure describing the data; the structures are
-fitted afterwards to the isotherms so shifted (:mod:`bayesfo.tts.joint`).
+Its posterior is :mod:`bayesfo.tts.smooth_posterior`. The shifts so found do not depend on a
+structure describing the data; the structures are fitted afterwards to the isotherms so shifted
+(:mod:`bayesfo.tts.conditional`).
 """
 
 from __future__ import annotations

@@ -217,7 +217,8 @@ def _checks(iso, chosen: MasterCurve, vertical: str) -> tuple[dict, list]:
         van_gurp_palmen,
     )
 
-    vgp = van_gurp_palmen(iso.data, iso.temperatures)
+    vgp = van_gurp_palmen(iso.data, iso.temperatures, log_vertical=(
+        None if chosen.vertical_draws is None else chosen.vertical_draws.mean(axis=0)))
     parts = shifts_by_part(iso.data, iso.temperatures)
     against = joint_against_parts(parts, chosen.shift_draws)
     checks = {"van_gurp_palmen": vgp, "shift_parts": parts, "joint_against_parts": against,

@@ -13,9 +13,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .isotherms import _seed_shifts, _vertical_seeds
 from .model import SHIFT_MARGIN, SHIFT_RANGE, VERTICAL_RANGE
 from .smooth import NOISE, SmoothMaster
-from .smooth_posterior import ShiftPosterior, best_fit, sample_shifts, start_of
+from .smooth_posterior import (
+    ShiftPosterior,
+    _proposal_cov,
+    best_fit,
+    sample_shifts,
+    start_of,
+)
 
 #: The vertical shifts that ``vertical="auto"`` chooses among, and the laws of ``law="auto"``.
 VERTICALS = ("none", "density", "free")
@@ -89,7 +96,7 @@ def _weigh(posts: dict, bounded: dict, what: str) -> tuple[str, dict, list]:
         evidence[k] = {"log_evidence": None, "log_evidence_err": None,
                        "log_evidence_upper": b, "probability": weights[k] / total,
                        "probability_upper": True, "certified": False,
-                       "sampler": "not sampled"}
+                       "sampler": "not sampled", "max_log_likelihood": b}
         notes.append(f"{_label(k, what)} was not sampled: its best fit reaches a "
                      f"log-likelihood of {b:.1f}, which bounds its ln Z from above, "
                      f"{z[top] - b:.0f} nats below the ln Z of {_label(top, what)}")
@@ -120,8 +127,6 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
     ``submit(function, *args)`` runs the models' fits side by side (a pool's ``submit``; it
     returns futures); without it they run here one after the other.
     """
-    from .isotherms import _seed_shifts, _vertical_seeds
-
     seeds = _seed_shifts(iso)
     reach = max(SHIFT_RANGE, float(np.max(np.abs(seeds))) + SHIFT_MARGIN)
     def many(calls):
@@ -137,35 +142,44 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
     # vertical shifts contain the other two: they start from the better one's maximum (from
     # the seeds, the optimiser may stop at a lower local maximum).
     simple = [(k, v) for k in noises for v in verticals if v != "free"]
-    fitted = dict(zip(simple, many([
-        (_sampled, m, start_of(m, seeds), seed) for m in
-        [SmoothMaster.of(iso, v, "free", reach, k) for k, v in simple]]), strict=True))
+    models = {kv: SmoothMaster.of(iso, kv[1], "free", reach, kv[0]) for kv in simple}
+    fits = dict(zip(simple, many([(best_fit, models[kv], start_of(models[kv], seeds))
+                                  for kv in simple]), strict=True))
     if "free" in verticals:
         calls = []
         for k in noises:
-            model = SmoothMaster.of(iso, "free", "free", reach, k)
-            nested = [p for (kk, _), p in fitted.items() if kk == k]
+            model = models[(k, "free")] = SmoothMaster.of(iso, "free", "free", reach, k)
+            nested = [kv for kv in fits if kv[0] == k]
             if nested:
-                start = _nested_start(model, max(nested, key=lambda p: p.max_log_likelihood))
+                near = max(nested, key=lambda kv: fits[kv][1])
+                start = _nested_start(model, models[near], models[near].to_params(
+                    fits[near][0]))
             else:  # tan δ is free of the vertical shift: the phases place the isotherms
                 phase = _seed_shifts(iso, phase_only=True)
                 start = start_of(model, phase)
-                k = model.n_horizontal
+                h = model.n_horizontal
                 vertical = np.clip(np.delete(_vertical_seeds(iso, phase), model.reference),
                                    -0.9 * VERTICAL_RANGE, 0.9 * VERTICAL_RANGE)
-                start[k:k + vertical.size] = vertical
-            calls.append((_sampled, model, start, seed))
-        fitted.update(zip([(k, "free") for k in noises], many(calls), strict=True))
+                start[h:h + vertical.size] = vertical
+            calls.append((best_fit, model, start))
+        fits.update(zip([(k, "free") for k in noises], many(calls), strict=True))
+    # Sampled in the order of their Laplace estimates of ln Z, the likely leader first; one
+    # whose best fit stays BOUND_MARGIN below the leader's ln Z is set aside with that bound.
+    fitted, bounded_nv = _sample_bounded(models, fits, seed, many)
     chosen_noise, n_evidence = noises[0], {}
     if len(noises) > 1:
-        best_of = {k: max((fitted[(k, v)] for v in verticals), key=_z) for k in noises}
-        chosen_noise, n_evidence, n_notes = _weigh(best_of, {}, "noise")
+        best_of = {k: max((fitted[kv] for kv in fitted if kv[0] == k), key=_z)
+                   for k in noises if any(kv[0] == k for kv in fitted)}
+        out_of = {k: max(b for kv, b in bounded_nv.items() if kv[0] == k)
+                  for k in noises if k not in best_of}
+        chosen_noise, n_evidence, n_notes = _weigh(best_of, out_of, "noise")
         notes += n_notes
-    posts = {v: fitted[(chosen_noise, v)] for v in verticals}
-    posts = {v: posts[v] for v in verticals}
+    posts = {v: fitted[(chosen_noise, v)] for v in verticals if (chosen_noise, v) in fitted}
+    v_bounded = {v: bounded_nv[(chosen_noise, v)] for v in verticals
+                 if (chosen_noise, v) in bounded_nv}
     chosen_v, v_evidence = verticals[0], {}
     if len(verticals) > 1:
-        chosen_v, v_evidence, v_notes = _weigh(posts, {}, "vertical shift")
+        chosen_v, v_evidence, v_notes = _weigh(posts, v_bounded, "vertical shift")
         notes += v_notes
     laws = (LAWS if law == "auto" and len(iso.temperatures) >= AUTO_LAWS_MIN
             else ("free",) if law == "auto" else (law,))
@@ -202,15 +216,39 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
                   chosen_noise, n_evidence)
 
 
-def _sampled(model: SmoothMaster, start, seed: int) -> ShiftPosterior:
-    return sample_shifts(model, start, seed)
+def _laplace(model: SmoothMaster, fit) -> float:
+    """The Laplace estimate of ln Z at a best fit (its point, log-likelihood and Hessian in
+    the sampling coordinates): an ordering of the models, never a certified value."""
+    u, ll, hess = fit
+    cov = _proposal_cov(hess, model.bounds)
+    sign, log_det = np.linalg.slogdet(cov)
+    return (ll - model.log_prior_volume + 0.5 * u.size * math.log(2 * math.pi)
+            + 0.5 * (log_det if sign > 0 else -math.inf))
 
 
-def _nested_start(model: SmoothMaster, near: ShiftPosterior) -> np.ndarray:
-    """A start of the free-vertical ``model`` at the maximum of a model it contains."""
-    theta = near.map_theta
-    k = near.model.n_horizontal
-    vertical = np.delete(near.model.log_vertical(theta)[0], model.reference)
+def _sample_bounded(models: dict, fits: dict, seed: int, many) -> tuple[dict, dict]:
+    """The posteriors of ``models`` (``{key: SmoothMaster}``, best fits ``fits``) sampled
+    from the highest Laplace estimate down; a model whose best fit's log-likelihood (an upper
+    bound of its ln Z) lies :data:`BOUND_MARGIN` below the highest ln Z certified so far is
+    set aside: ``({key: ShiftPosterior}, {key: max ln L})``."""
+    order = sorted(models, key=lambda kv: -_laplace(models[kv], fits[kv]))
+    fitted, bounded = {}, {}
+    lead = order[0]
+    fitted[lead] = sample_shifts(models[lead], None, seed, fit=fits[lead])
+    ceiling = max(_z(p) for p in fitted.values()) - BOUND_MARGIN
+    rest = [kv for kv in order[1:] if fits[kv][1] >= ceiling]
+    bounded.update({kv: fits[kv][1] for kv in order[1:] if kv not in rest})
+    for kv, post in zip(rest, many([(sample_shifts, models[kv], None, seed, fits[kv])
+                                    for kv in rest]), strict=True):
+        fitted[kv] = post
+    return fitted, bounded
+
+
+def _nested_start(model: SmoothMaster, near: SmoothMaster, theta) -> np.ndarray:
+    """A start of the free-vertical ``model`` at the maximum ``theta`` (natural units) of a
+    model ``near`` that it contains."""
+    k = near.n_horizontal
+    vertical = np.delete(near.log_vertical(theta)[0], model.reference)
     return np.r_[theta[:k], vertical, theta[k:]]
 
 

@@ -26,8 +26,12 @@ EMCEE_STEPS = 1500
 MAX_DRAWS = 16000
 #: Degrees of freedom of the multivariate-t proposal (tails heavier than the Laplace normal).
 DF = 5
-#: Adapted rounds (proposal moments from the weighted draws) before emcee takes over.
-ROUNDS = 3
+#: Adapted rounds (a mixture of t's fitted to the weighted draws) before emcee takes over.
+ROUNDS = 4
+#: Widening of an adapted component's covariance, and the weight of the Laplace component
+#: kept in every adapted proposal.
+WIDEN = 1.5
+DEFENSIVE = 0.2
 #: A shift whose 94 % interval is wider than this [decades] is not determined by the data:
 #: an isotherm over a featureless plateau, whose shift slides along it.
 UNDETERMINED = 1.0
@@ -85,6 +89,54 @@ class ShiftPosterior:
         lo, hi = hdi_columns(self.shift_draws, 0.94)
         return [i for i in range(lo.size) if i != self.model.reference
                 and not (hi[i] - lo[i] <= UNDETERMINED)]
+
+
+class _TMixture:
+    """A proposal: a mixture of multivariate t's (weights, locations, shapes) with
+    :data:`DF` degrees of freedom. One component is the Laplace proposal; adapted ones are
+    fitted to weighted draws (k-means clusters, :class:`~bayesfo.inference._mixture._GaussianMixture`),
+    with the Laplace component kept beside them (a defensive mixture: the weights stay bounded
+    where the Laplace proposal covered the posterior)."""
+
+    def __init__(self, weights, locs, shapes, rng):
+        from scipy.stats import multivariate_t
+
+        self.weights = np.asarray(weights, float) / float(np.sum(weights))
+        self.parts = [multivariate_t(loc=m, shape=c, df=DF, seed=rng)
+                      for m, c in zip(locs, shapes, strict=True)]
+        self.rng = rng
+
+    def rvs(self, size: int) -> np.ndarray:
+        counts = self.rng.multinomial(size, self.weights)
+        out = np.vstack([np.atleast_2d(p.rvs(size=c)).reshape(c, -1)
+                         for p, c in zip(self.parts, counts, strict=True) if c])
+        return out[self.rng.permutation(size)]
+
+    def logpdf(self, x) -> np.ndarray:
+        from scipy.special import logsumexp
+
+        terms = np.array([math.log(w) + np.atleast_1d(p.logpdf(x))
+                          for w, p in zip(self.weights, self.parts, strict=True) if w > 0])
+        return logsumexp(terms, axis=0)
+
+    @classmethod
+    def adapted(cls, x, w, laplace: tuple, rng, defensive: float = DEFENSIVE):
+        """Fitted to draws ``x`` with normalised weights ``w`` (resampled, then clustered),
+        shapes widened by :data:`WIDEN`; the Laplace ``(loc, shape)`` kept with weight
+        ``defensive``."""
+        from ..inference._mixture import _GaussianMixture
+
+        pick = x[rng.choice(x.shape[0], size=DRAWS, replace=True, p=w)]
+        unique = np.unique(pick, axis=0)
+        if unique.shape[0] < 5 * x.shape[1]:  # too few distinct draws for a covariance
+            mean = w @ x
+            shape = _well_conditioned(WIDEN * np.cov(x, rowvar=False, aweights=w))
+            return cls([1.0 - defensive, defensive], [mean, laplace[0]],
+                       [shape, laplace[1]], rng)
+        fit = _GaussianMixture.fit(pick, rng)
+        shapes = [_well_conditioned(WIDEN * (c @ c.T)) for c in fit.chols]
+        return cls(list((1.0 - defensive) * fit.weights) + [defensive],
+                   list(fit.means) + [laplace[0]], shapes + [laplace[1]], rng)
 
 
 def start_of(model: SmoothMaster, log_shifts) -> np.ndarray:
@@ -249,68 +301,95 @@ def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
     -------
     ShiftPosterior
     """
+    rng = np.random.default_rng(seed)
+    u_map, max_ll, hess = best_fit(model, start) if fit is None else fit
+    laplace = (u_map, _proposal_cov(hess, model.bounds))
+    prop = _TMixture([1.0], [laplace[0]], [laplace[1]], rng)
+    best = None
+    for _ in range(ROUNDS):
+        got = _importance(model, prop)
+        if got is None:
+            break
+        if best is None or _better(got, best):
+            best = got
+        if got[2] < K_HAT_EVIDENCE and got[3] >= ESS_MIN:
+            break
+        # Adapt: a mixture of t's fitted to the weighted draws, the Laplace one beside it.
+        prop = _TMixture.adapted(got[0], got[1], laplace, rng)
+    if best is not None and best[2] < K_HAT_MAX and best[3] >= ESS_MIN:
+        return _from_weights(model, best, u_map, max_ll, rng, ())
+    messages = ("the importance weights did not certify the posterior (Pareto k "
+                f"{'n/a' if best is None else f'{best[2]:.2f}'}); emcee drew it",)
+    chain = _emcee(model, u_map, laplace[1], max_ll, seed, messages,
+                   None if best is None or best[2] >= K_HAT_EVIDENCE else best[4:6])
+    # The emcee draws shape one more proposal: where its weights certify, the posterior
+    # and ln Z come from them (emcee alone gives no ln Z).
+    x = model.to_u(chain.draws)
+    got = _importance(model, _TMixture.adapted(x, np.full(x.shape[0], 1.0 / x.shape[0]),
+                                               laplace, rng))
+    if got is not None and got[2] < K_HAT_MAX and got[3] >= ESS_MIN:
+        return _from_weights(model, got, u_map, max_ll, rng,
+                             ("importance weights from a proposal fitted to emcee's draws",))
+    return chain
+
+
+def _better(a, b) -> bool:
+    """Whether importance round ``a`` certifies more than ``b``: certified (k̂ < 0.7 with
+    ESS ≥ 1000) first, then the lower k̂."""
+    ok_a = a[2] < K_HAT_MAX and a[3] >= ESS_MIN
+    ok_b = b[2] < K_HAT_MAX and b[3] >= ESS_MIN
+    return (ok_a, -a[2]) > (ok_b, -b[2])
+
+
+def _importance(model: SmoothMaster, prop: _TMixture):
+    """One importance round: draws from ``prop`` until the weights' ESS reaches ESS_MIN (at
+    most MAX_DRAWS), or their tail (k̂) fails. ``(draws, normalised smoothed weights, k̂,
+    ESS, ln Z, its error)`` in the sampling coordinates; None where fewer than a tenth of
+    the draws fall in the prior's support."""
     from scipy.special import logsumexp
-    from scipy.stats import multivariate_t
 
     from ..inference._arviz import psis
 
-    rng = np.random.default_rng(seed)
     bounds = model.bounds
-    u_map, max_ll, hess = best_fit(model, start) if fit is None else fit
-    mean, cov = u_map, _proposal_cov(hess, bounds)
     log_prior = -model.log_prior_volume
-    messages = []
-    best = None
-    for _ in range(ROUNDS):
-        prop = multivariate_t(loc=mean, shape=cov, df=DF, seed=rng)
-        u = np.empty((0, mean.size))
-        log_w = np.empty(0)
-        # Draws from one proposal until the weights' ESS reaches ESS_MIN (at most
-        # MAX_DRAWS), where their tail (k̂) certifies them.
-        while u.shape[0] < MAX_DRAWS:
-            more = np.atleast_2d(prop.rvs(size=DRAWS))
-            inside = np.all((more > bounds[:, 0]) & (more < bounds[:, 1]), axis=1)
-            ll = np.full(DRAWS, -np.inf)
-            ll[inside] = model.log_likelihood(model.to_params(more[inside]))
-            u = np.vstack([u, more])
-            log_w = np.r_[log_w, ll + log_prior - prop.logpdf(more)]
-            finite = np.isfinite(log_w)
-            if finite.sum() < 0.1 * u.shape[0]:
-                break
-            smoothed, k_hat = psis(log_w[finite])
-            w = np.exp(smoothed - logsumexp(smoothed))
-            ess = float(1.0 / np.sum(w ** 2))
-            if k_hat >= K_HAT_MAX or ess >= ESS_MIN:
-                break
+    u = np.empty((0, bounds.shape[0]))
+    log_w = np.empty(0)
+    while u.shape[0] < MAX_DRAWS:
+        more = prop.rvs(DRAWS)
+        inside = np.all((more > bounds[:, 0]) & (more < bounds[:, 1]), axis=1)
+        ll = np.full(DRAWS, -np.inf)
+        ll[inside] = model.log_likelihood(model.to_params(more[inside]))
+        u = np.vstack([u, more])
+        log_w = np.r_[log_w, ll + log_prior - prop.logpdf(more)]
+        finite = np.isfinite(log_w)
         if finite.sum() < 0.1 * u.shape[0]:
+            return None
+        smoothed, k_hat = psis(log_w[finite])
+        w = np.exp(smoothed - logsumexp(smoothed))
+        ess = float(1.0 / np.sum(w ** 2))
+        if k_hat >= K_HAT_MAX or ess >= ESS_MIN:
             break
-        n = u.shape[0]
-        raw = np.where(finite, log_w, -np.inf)
-        log_z = float(logsumexp(raw) - math.log(n))
-        rel = np.exp(raw - logsumexp(raw))
-        log_z_err = float(math.sqrt(max(n * np.sum(rel ** 2) - 1.0, 0.0) / n))
-        best = (u[finite], w, k_hat, ess, log_z, log_z_err)
-        if k_hat < K_HAT_MAX and ess >= ESS_MIN:
-            break
-        # Adapt: the proposal's moments from the weighted draws, widened a little.
-        x = u[finite]
-        mean = w @ x
-        cov = _well_conditioned(1.2 * np.cov(x, rowvar=False, aweights=w))
-    if best is not None and best[2] < K_HAT_MAX and best[3] >= ESS_MIN:
-        x, w, k_hat, ess, log_z, log_z_err = best
-        pick = rng.choice(x.shape[0], size=DRAWS // 2, replace=True, p=w)
-        draws = model.to_params(x[pick])
-        evidence_ok = k_hat < K_HAT_EVIDENCE
-        return ShiftPosterior(model, draws, log_z if evidence_ok else math.nan,
-                              log_z_err if evidence_ok else math.nan, model.to_params(u_map),
-                              max_ll, "importance", k_hat, ess, True,
-                              () if evidence_ok else (
-                                  f"importance weights certify the posterior but not ln Z "
-                                  f"(Pareto k {k_hat:.2f})",))
-    messages.append("the importance weights did not certify the posterior (Pareto k "
-                    f"{'n/a' if best is None else f'{best[2]:.2f}'}); emcee drew it")
-    return _emcee(model, u_map, cov, max_ll, seed, tuple(messages),
-                  None if best is None or best[2] >= K_HAT_EVIDENCE else best[4:6])
+    n = u.shape[0]
+    raw = np.where(finite, log_w, -np.inf)
+    log_z = float(logsumexp(raw) - math.log(n))
+    rel = np.exp(raw - logsumexp(raw))
+    log_z_err = float(math.sqrt(max(n * np.sum(rel ** 2) - 1.0, 0.0) / n))
+    return u[finite], w, float(k_hat), ess, log_z, log_z_err
+
+
+def _from_weights(model, got, u_map, max_ll, rng, messages: tuple) -> ShiftPosterior:
+    """The posterior of certified importance weights ``got`` (:func:`_importance`); ln Z
+    where k̂ < :data:`K_HAT_EVIDENCE`."""
+    x, w, k_hat, ess, log_z, log_z_err = got
+    pick = rng.choice(x.shape[0], size=DRAWS // 2, replace=True, p=w)
+    evidence_ok = k_hat < K_HAT_EVIDENCE
+    if not evidence_ok:
+        messages += (f"importance weights certify the posterior but not ln Z "
+                     f"(Pareto k {k_hat:.2f})",)
+    return ShiftPosterior(model, model.to_params(x[pick]),
+                          log_z if evidence_ok else math.nan,
+                          log_z_err if evidence_ok else math.nan, model.to_params(u_map),
+                          max_ll, "importance", k_hat, ess, True, messages)
 
 
 def _emcee(model: SmoothMaster, u_map, cov, max_ll: float, seed: int, messages: tuple,

@@ -50,18 +50,21 @@ def loss_angle_deg(response: np.ndarray, kind: str) -> np.ndarray:
     return angle if kind == "modulus" else -angle
 
 
-def _curve(data) -> tuple[np.ndarray, np.ndarray, float]:
-    """log10 |G*| and δ [deg] of an isotherm sorted by |G*|, and the sd of its δ from the
-    second differences along frequency."""
+def _curve(data, log_vertical: float = 0.0) -> tuple[np.ndarray, np.ndarray, float]:
+    """log10 |G*| (reduced by the isotherm's vertical shift log10 b_T: a modulus times b_T,
+    a compliance divided by it) and δ [deg] of an isotherm sorted by |G*|, and the sd of its
+    δ from the second differences along frequency."""
     order = np.argsort(data.omega)
     g = data.response[order]
     x, d = np.log10(np.abs(g)), loss_angle_deg(g, data.kind)
+    x = x + (log_vertical if data.kind == "modulus" else -log_vertical)
     sd = float(np.std(np.diff(d, 2)) / math.sqrt(6.0)) if d.size >= 4 else math.nan
     by_x = np.argsort(x)
     return x[by_x], d[by_x], sd
 
 
-def van_gurp_palmen(isotherms, temperatures, *, tolerance_deg: float = TOLERANCE_DEG) -> dict:
+def van_gurp_palmen(isotherms, temperatures, *, tolerance_deg: float = TOLERANCE_DEG,
+                    log_vertical=None) -> dict:
     """The van Gurp–Palmen test of neighbouring isotherms (see the module).
 
     Parameters
@@ -71,6 +74,10 @@ def van_gurp_palmen(isotherms, temperatures, *, tolerance_deg: float = TOLERANCE
     temperatures : sequence of float
         [°C], ascending.
     tolerance_deg : float
+    log_vertical : sequence of float, optional
+        log10 b_T of each isotherm (the master curve's vertical shifts): |G*| is compared on
+        the reference's scale, δ unchanged (a vertical shift scales G′ and G″ alike). Without
+        it the isotherms are compared as measured.
 
     Returns
     -------
@@ -81,7 +88,8 @@ def van_gurp_palmen(isotherms, temperatures, *, tolerance_deg: float = TOLERANCE
         isotherm at equal |G*|), ``se_deg``, ``passes``; ``failing``: the temperature pairs
         that fail; ``untested``: those without overlap.
     """
-    curves = [_curve(d) for d in isotherms]
+    shifts = np.zeros(len(isotherms)) if log_vertical is None else np.asarray(log_vertical)
+    curves = [_curve(d, float(b)) for d, b in zip(isotherms, shifts, strict=True)]
     pairs = []
     for i in range(len(curves) - 1):
         (xa, da, sa), (xb, db, sb) = curves[i], curves[i + 1]

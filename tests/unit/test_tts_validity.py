@@ -238,3 +238,18 @@ def test_mastercurve_warns_of_isotherms_hundreds_of_degrees_apart(monkeypatch):
     with pytest.warns(DataWarning, match=r"the isotherms at 10 and 293.15 °C are 283.15 °C "
                                          r"apart"), pytest.raises(Stop):
         mastercurve(isotherms, "zener")
+
+
+@pytest.mark.parametrize("kind", ["modulus", "compliance"])
+def test_the_vertical_shifts_are_taken_out_before_the_loss_angles_are_compared(kind):
+    """A simple material whose isotherms are scaled by b_T (a modulus divided, a compliance
+    multiplied, by it): as measured, δ at equal |G*| differs between neighbours by degrees and
+    the test fails; with the vertical shifts given it passes as the unscaled material does."""
+    log_b = 0.15 * (TEMPS - 50.0) / 10.0  # ±0.75 decade across the range
+    moduli = [d.response / 10**b for d, b in zip(_isotherms(False, 1), log_b, strict=True)]
+    scaled = [FrequencyResponse(W, g if kind == "modulus" else 1 / g, kind=kind)
+              for g in moduli]
+    assert van_gurp_palmen(scaled, TEMPS)["valid"] is False
+    check = van_gurp_palmen(scaled, TEMPS, log_vertical=log_b)
+    assert check["valid"] is True and check["untested"] == []
+    assert all(abs(p["delta_deg"]) < 0.8 for p in check["pairs"])

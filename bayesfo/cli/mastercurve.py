@@ -252,6 +252,7 @@ def _print(mc, out) -> None:
     print(f"{'T [°C]':>8} {'log10 a_T':>10} {'sd':>7} {'94 % HDI':>20}"
           + (f" {'log10 b_T':>10} {'sd':>7} {'94 % HDI':>20} ({mc.vertical})" if vertical
              else ""))
+    gone = set((mc.shift_evidence or {}).get("undetermined") or [])
     for f in mc.shift_factors():
         line = f"{f['temperature']:8g}"
         for key in ("log10_aT", "log10_bT") if vertical else ("log10_aT",):
@@ -260,6 +261,8 @@ def _print(mc, out) -> None:
             a = {k: round(f[key][k], 3) + 0.0 for k in ("mean", "sd", "hdi_low", "hdi_high")}
             hdi = f"[{a['hdi_low']:.3f}, {a['hdi_high']:.3f}]"
             line += f" {a['mean']:10.3f} {a['sd']:7.3f} {hdi:>20}"
+        if f["temperature"] in gone:
+            line += "  not determined: slides along a featureless stretch"
         print(line)
     for name, law in mc.laws.items():
         text = ", ".join(f"{k} = {v['mean']:.4g} ± {v['sd']:.2g} {v['unit']}".rstrip()

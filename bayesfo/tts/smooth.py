@@ -397,6 +397,46 @@ class SmoothMaster:
                       - 0.5 * log_det_a - 0.5 * (rr / sigma ** 2 - quad))
         return np.where(inside & np.isfinite(total), total, -np.inf)
 
+    def shift_information(self, theta) -> np.ndarray:
+        """The information each isotherm's own points carry on its log10 a_T, with the noise
+        of ``theta`` (one parameter set, natural units): Σ (∂ ln G_p/∂ log10 ω)² / (σ_p² κ)
+        over its points and both parts, the slopes those of a quadratic in log10 ω fitted to
+        the isotherm's own logs, less what the fit's noise adds on average (tr(C·DᵀWD), C the
+        coefficients' covariance, D the slope's design); with free vertical shifts, what is
+        left after its log10 b_T is fitted too (the Schur complement). Near 0 where the
+        isotherm lies on a featureless stretch: its shift then rests on the smoothness prior's
+        reach across the gap to its neighbours, not on its data."""
+        th = np.atleast_2d(np.asarray(theta, float))[0]
+        m = th.size
+        weight, r, *_ = self._centred
+        n_iso = len(self.temperatures)
+        dv = math.log(10.0) * (1.0 if self.kind == "modulus" else -1.0)
+        i_aa, i_ab, i_bb = np.zeros(n_iso), np.zeros(n_iso), np.zeros(n_iso)
+        for i in range(n_iso):
+            at = self.point_isotherm == i
+            x = self.log_omega[at] - self.log_omega[at].mean()
+            for p in range(2):
+                w = weight[p][at] / th[m - 2 + p] ** 2
+                if np.count_nonzero(w) < 4:
+                    continue
+                design = np.column_stack([np.ones_like(x), x, x * x])
+                slope_design = np.column_stack([np.zeros_like(x), np.ones_like(x), 2 * x])
+                precision = design.T @ (w[:, None] * design)
+                try:
+                    cov = np.linalg.inv(precision)
+                except np.linalg.LinAlgError:
+                    continue
+                coef = cov @ (design.T @ (w * r[p][at]))
+                slope = slope_design @ coef
+                noise = float(np.trace(cov @ (slope_design.T @ (w[:, None] * slope_design))))
+                i_aa[i] += max(float(w @ slope ** 2) - noise, 0.0)
+                i_ab[i] += float(w @ slope) * dv
+                i_bb[i] += float(w.sum()) * dv ** 2
+        if self.vertical == "free":
+            with np.errstate(divide="ignore", invalid="ignore"):
+                return np.maximum(np.where(i_bb > 0, i_aa - i_ab ** 2 / i_bb, i_aa), 0.0)
+        return i_aa
+
     def gradient(self, theta) -> tuple[float, np.ndarray]:
         """ln p(data | θ) and its gradient in the sampling coordinates (logs of the
         log-uniform parameters) at one parameter set, in closed form: the envelope theorem

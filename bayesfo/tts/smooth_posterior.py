@@ -82,13 +82,23 @@ class ShiftPosterior:
         return None if self.model.vertical == "none" else self.model.log_vertical(self.draws)
 
     def undetermined(self) -> list[int]:
-        """The isotherms whose log10 a_T the data do not fix (94 % interval wider than
-        :data:`UNDETERMINED` decades)."""
+        """The isotherms whose log10 a_T the data do not fix: a 94 % interval wider than
+        :data:`UNDETERMINED` decades, or an isotherm whose own points carry too little
+        information on its shift (:meth:`SmoothMaster.shift_information`) for a normal
+        interval that narrow. The second catches an isotherm on a featureless stretch whose
+        posterior the smoothness prior holds near its neighbours: the data alone would let
+        it slide."""
         from ..inference._arviz import hdi_columns
 
         lo, hi = hdi_columns(self.shift_draws, 0.94)
+        if self.model.law == "free":
+            info = self.model.shift_information(self.map_theta)
+            with np.errstate(divide="ignore"):
+                own = 2.0 * 1.881 / np.sqrt(info)  # the 94 % normal interval's width
+        else:  # a law ties the shifts: each one's own points do not set it
+            own = np.zeros(lo.size)
         return [i for i in range(lo.size) if i != self.model.reference
-                and not (hi[i] - lo[i] <= UNDETERMINED)]
+                and not (hi[i] - lo[i] <= UNDETERMINED and own[i] <= UNDETERMINED)]
 
 
 class _TMixture:

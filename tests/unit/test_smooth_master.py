@@ -144,3 +144,34 @@ def test_the_same_seed_gives_the_same_draws():
     a = sample_shifts(model, start_of(model, truth), seed=4)
     b = sample_shifts(model, start_of(model, truth), seed=4)
     assert np.array_equal(a.draws, b.draws) and a.log_evidence == b.log_evidence
+
+
+def test_an_isotherm_on_a_featureless_stretch_is_not_determined():
+    """A Maxwell transition with a constant small loss beside it: the coldest isotherm lies
+    five decades beyond the transition, where G′ and G″ are flat to 1e-5, so its data fix its
+    shift only to 'colder than its neighbour' (the smoothness prior alone holds it near the
+    neighbour). It is reported as not determined; the others are determined to hundredths of
+    a decade, and are not."""
+    truth = np.array([6.0, 1.5, 0.0, -0.8, -1.5])
+    rng = np.random.default_rng(5)
+    omega = np.logspace(-1, 2, 15)
+    data = []
+    for t, la in zip(TEMPS, truth, strict=True):
+        wt = 1j * omega * 10.0**la
+        g = 1e6 * (1 + 0.01j) * wt / (1 + wt)
+        g = (g.real * (1 + 0.01 * rng.standard_normal(omega.size))
+             + 1j * g.imag * (1 + 0.01 * rng.standard_normal(omega.size)))
+        data.append((FrequencyResponse(omega, g, kind="modulus", units="Pa", name=f"t{t:g}"),
+                     t))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sh = smooth_shifts(_isotherms(data, 20.0), vertical="none", law="free",
+                           noise="relative_parts")
+    post = sh.posterior
+    assert post.undetermined() == [0]
+    info = post.model.shift_information(post.map_theta)
+    assert 1 / math.sqrt(info[0]) > 0.5  # its own points: a decade or more either way
+    assert np.all(1 / np.sqrt(info[1:]) < 0.01)
+    draws = post.shift_draws
+    assert np.all(draws[:, 0] > draws[:, 1])  # the prior's order holds in every draw
+    assert np.all(np.abs(draws.mean(axis=0)[1:] - truth[1:]) < 0.05)

@@ -9,7 +9,9 @@ frequency ω is modelled in logs as
 
 with s = 1 for a modulus (G_i = G_master(a_T ω)/b_T) and −1 for a compliance. A relative
 error of each part, the usual error model of a rheometer or DMA (``relative_parts``), is a
-constant error of its logarithm. The master function f_p is a cubic B-spline on equally spaced
+constant error of its logarithm. Complex noise proportional to |G| (``proportional``) gives a
+part's log the variance σ_p²κ, κ = |G|²/(2G_p²), and a mean σ_p²κ/2 below the log of the
+part's mean (to second order), which the model adds back. The master function f_p is a cubic B-spline on equally spaced
 knots (:data:`KNOT_STEP` decades apart, spanning every reduced frequency the shifts' prior
 allows) whose coefficients have a Gaussian smoothness prior: second differences with sd ρ_p
 (a P-spline, Eilers & Marx 1996; Lang & Brezger 2004 for the Bayesian form) and a weak ridge
@@ -345,7 +347,12 @@ class SmoothMaster:
         n_sets = x.shape[0]
         k0, b = _basis(x, lo, n_basis)
         w = weight[p][None, :]
-        r = np.where(w > 0, r0[p][None, :] + v, 0.0)
+        r = r0[p][None, :] + v
+        if self.noise == "proportional":
+            # A part's relative error σ√κ is not small where the part is small against |G|:
+            # the mean of its log lies σ²κ/2 below the log of its mean (to second order).
+            r = r + 0.5 * (sigma ** 2)[:, None] / w
+        r = np.where(w > 0, r, 0.0)
         bw = b * w[..., None]
         flat = np.arange(n_sets)[:, None] * n_basis + k0
         size = n_sets * n_basis
@@ -495,6 +502,8 @@ class SmoothMaster:
             grad[m - 4 + p] = (-np.sum((eig / rho ** 2) / (eig / rho ** 2 + 1 / LEVEL_SD ** 2))
                                + (tr_pen + beta @ pen @ beta) / rho ** 2)
             grad[m - 2 + p] = -n + float(e @ (w * e)) / s2 + tr_data
+            if self.noise == "proportional":  # the offset σ²κ/2 of each log moves with σ
+                grad[m - 2 + p] -= float(e.sum())
         # Shifts: each point's x moves with its isotherm's log10 a_T; its log with log10 b_T.
         n_iso = len(self.temperatures)
         per_iso_x = np.bincount(self.point_isotherm, d_x, n_iso)

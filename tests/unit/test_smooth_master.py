@@ -62,7 +62,10 @@ def _dense(model, theta):
                  if model.noise == "proportional" else np.ones(ok.sum()))
         prec = d.T @ d / theta[-4 + p] ** 2 + np.eye(n_basis) / LEVEL_SD**2
         cov = theta[-2 + p] ** 2 * np.diag(kappa) + basis[ok] @ np.linalg.inv(prec) @ basis[ok].T
-        total += multivariate_normal(np.full(ok.sum(), y[ok].mean()), cov).logpdf(y[ok] + v[ok])
+        # Under proportional noise the mean of each log lies σ²κ/2 below the log of the mean.
+        offset = 0.5 * theta[-2 + p] ** 2 * kappa if model.noise == "proportional" else 0.0
+        total += multivariate_normal(np.full(ok.sum(), y[ok].mean()), cov).logpdf(
+            y[ok] + v[ok] + offset)
     return total
 
 

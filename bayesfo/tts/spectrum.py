@@ -95,6 +95,11 @@ class Spectrum(Parametrised):
             raise InputError("the relaxation spectrum's priors cannot be overridden")
         return self
 
+    def equilibrium_modulus(self, theta) -> np.ndarray:
+        """G_e = lim G(t) as t → ∞ of each parameter set (physical units): the spectrum's
+        equilibrium modulus, every mode having relaxed."""
+        return self.moduli(np.atleast_2d(np.asarray(theta, float)))[0]
+
     def moduli(self, theta) -> tuple[np.ndarray, np.ndarray]:
         """(G_e, g) of each parameter set: shapes (n_sets,) and (n_sets, n_tau)."""
         theta = np.atleast_2d(np.asarray(theta, float))

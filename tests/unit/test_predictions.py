@@ -178,3 +178,17 @@ def test_long_time_modulus_is_where_integer_orders_relax_to():
         late = evaluate(s, theta, "relaxation_modulus", [1e3])[0, 0]
         g_e = equilibrium_modulus(s, theta)[0]
         assert late == pytest.approx(g_e, rel=1e-8, abs=1e-10), name
+
+
+def test_the_equilibrium_modulus_of_a_relaxation_spectrum_is_its_own_g_e():
+    """A spectrum master (no powers of s) gives its equilibrium modulus, which its modulus
+    approaches at low frequency: G*(ω → 0) → G_e (every mode relaxed)."""
+    from bayesfo.predictions.long_time import equilibrium_modulus
+    from bayesfo.tts.spectrum import Spectrum
+
+    spec = Spectrum.over(0.1, 100.0)
+    theta = np.r_[250.0, 5.0, np.full(len(spec.tau) - 1, -0.2)]
+    g_e = equilibrium_modulus(spec, theta[None, :])
+    assert g_e == pytest.approx([250.0])
+    low = spec.response(theta[None, :], np.array([1e-9]), kind="modulus")
+    assert np.real(low).ravel()[0] == pytest.approx(250.0, rel=1e-3)

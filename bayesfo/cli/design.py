@@ -18,7 +18,9 @@ def add_parser(subparsers):
                     "between the structure and one more measurement, under each structure's "
                     "posterior predictive and the current model probabilities), propose the "
                     "best points, and state what they would do to the leading structures' log "
-                    "Bayes factor.")
+                    "Bayes factor. Where every structure considered fails the posterior "
+                    "predictive checks, it says so and proposes instead the frequencies that "
+                    "best determine the best ranked structure's parameters together.")
     p.add_argument("directory", metavar="DIR", help="output directory of bayesfo compare")
     p.add_argument("--window", metavar="WMIN,WMAX", default=None,
                    help="the instrument's frequency window [rad/s] (default: the data's, a "
@@ -73,6 +75,21 @@ def run(args) -> int:
         s.strip() for s in args.structures.split(",") if s.strip()]
     if args.parameter is not None:
         return _parameter(result, args, window, structures)
+    from ..planning import all_inadequate
+
+    failing = all_inadequate(result, structures)
+    if failing:
+        if args.figure is not None:
+            raise InputError(f"--figure draws the design of the model choice, and every "
+                             f"structure considered ({', '.join(failing)}) fails the posterior "
+                             "predictive checks; leave it out (design then plans for the best "
+                             "one's parameters)")
+        note = (f"every structure considered ({', '.join(failing)}) fails the posterior "
+                "predictive checks: points that tell them apart would choose among "
+                "descriptions that all miss the data, so these are the frequencies that best "
+                f"determine the parameters of the best ranked, {failing[0]}, together (a "
+                "structure that describes the data is wanted first)")
+        return _parameter(result, args, window, [failing[0]], notes=(note,))
     try:
         plan = design(result, window=window, points=args.points, structures=structures,
                       cost=args.cost, seed=args.seed)
@@ -128,8 +145,9 @@ def _print(plan, figure) -> None:
         print(f"wrote {figure}")
 
 
-def _parameter(result, args, window, structures) -> int:
-    """``--parameter``: the frequencies that best determine one parameter."""
+def _parameter(result, args, window, structures, notes=()) -> int:
+    """``--parameter``: the frequencies that best determine one parameter (or, without it, all
+    parameters of the one structure together, with the ``notes`` that say why)."""
     import numpy as np
 
     from ..planning import design_parameter
@@ -142,7 +160,8 @@ def _parameter(result, args, window, structures) -> int:
     try:
         plan = design_parameter(result, args.parameter,
                                 structure=structures[0] if structures else None, window=window,
-                                points=args.points, cost=args.cost, seed=args.seed)
+                                points=args.points, cost=args.cost, seed=args.seed,
+                                notes=notes)
     except InputError as exc:
         raise InputError(str(exc).replace("argument 'window'", "--window")
                          .replace("argument 'points'", "--points")) from None
@@ -152,10 +171,18 @@ def _parameter(result, args, window, structures) -> int:
     if args.json:
         print(json.dumps(plan.to_dict(), indent=1))
         return 0
-    print(f"{plan.parameter} of {plan.structure}: posterior sd now {plan.sd_now:.4g}")
+    for n in plan.notes:
+        print(f"note: {n}")
+    if isinstance(plan.sd_now, dict):
+        print(f"all parameters of {plan.structure}; posterior sd now: "
+              + ", ".join(f"{k} {v:.4g}" for k, v in plan.sd_now.items()))
+    else:
+        print(f"{plan.parameter} of {plan.structure}: posterior sd now {plan.sd_now:.4g}")
     print(f"window {plan.window[0]:.4g}-{plan.window[1]:.4g} rad/s; proposed measurements:")
     print(f"{'#':>3} {'omega [rad/s]':>14} {'gain [nats]':>12} {'sd after':>11} {'time [s]':>9}")
     for i, p in enumerate(plan.proposed):
-        print(f"{i + 1:>3} {p['omega']:14.4g} {p['gain']:12.3f} {p['sd_after']:11.4g} "
-              f"{p['seconds']:9.0f}")
+        after = p["sd_after"]
+        shown = (", ".join(f"{k} {v:.3g}" for k, v in after.items()) if isinstance(after, dict)
+                 else f"{after:11.4g}")
+        print(f"{i + 1:>3} {p['omega']:14.4g} {p['gain']:12.3f} {shown} {p['seconds']:9.0f}")
     return 0

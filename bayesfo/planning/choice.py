@@ -348,6 +348,21 @@ def min_spacing(log_omega: np.ndarray, information: np.ndarray) -> float:
     return float(min(max(SPACING_SHARE * width, step), MAX_SPACING))
 
 
+def all_inadequate(result, structures=None) -> list[str]:
+    """The names of the structures considered (those named, else every one with a posterior,
+    best first) where every one of them fails the posterior predictive checks, else ``[]``:
+    then points that tell them apart would choose among descriptions that all miss the data,
+    and ``bayesfo design`` plans for the best one's parameters instead."""
+    ranked = [result[n] for n in result.ranking]
+    if structures is not None:
+        names = [structures] if isinstance(structures, str) else list(structures)
+        ranked = [r for r in ranked if r.name in names]
+    checked = [getattr(r.criteria, "adequacy", None) for r in ranked]
+    if not ranked or any(a is None or a.adequate for a in checked):
+        return []
+    return [r.name for r in ranked]
+
+
 def _inadequate_note(results) -> list[str]:
     """Where every structure considered fails the posterior predictive checks: points that
     tell them apart choose among descriptions that all miss the data."""

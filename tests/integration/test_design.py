@@ -164,19 +164,21 @@ def compared(tmp_path_factory):
 
 
 def test_the_command_prints_and_writes_what_the_api_gives(compared, run_cli, tmp_path):
+    # Both structures miss these data (the fixture's Zener lies outside the prior's support:
+    # 108 % in |G| at 10 rad/s), so the command plans for the best one's parameters.
+    from bayesfo.planning import all_inadequate, design_parameter
+
     result, out = compared
-    plan = design(result, points=2)
+    assert all_inadequate(result) == list(result.ranking)
+    plan = design_parameter(result, None, structure=result.ranking[0], points=2)
     status, text, err = run_cli("design", out / "run", "--points", "2", "--json")
     assert status == 0, err
     shown = json.loads(text)
     assert [p["omega"] for p in shown["proposed"]] == [p["omega"] for p in plan.proposed]
-    assert shown["structures"] == dict(zip(plan.structures, plan.probabilities, strict=True))
+    assert shown["sd_now"] == plan.sd_now and shown["parameter"] == "all"
     figure = tmp_path / "design.png"
     status, text, err = run_cli("design", out / "run", "--points", "2", "--figure", figure)
-    assert status == 0, err
-    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "proposed measurements" in text and f"wrote {figure}" in text
-    assert "2 point(s) by rules of thumb give" in text
+    assert status == 2 and "leave it out" in err
     status, text, err = run_cli("design", out / "run", "--parameter", "q", "--structures",
                                 "zener", "--points", "1", "--json")
     assert status == 0, err
@@ -312,3 +314,57 @@ def test_a_design_among_structures_that_all_fail_the_checks_says_so():
     b.criteria.adequacy = SimpleNamespace(adequate=True)
     plan = design(_make(a, b), window=(0.01, 100.0), points=2)
     assert not any("every structure considered" in n for n in plan.notes)
+
+
+def test_the_parameters_together_carry_at_least_the_information_of_each():
+    """The information about the parameter vector bounds that about any one of them, and with
+    one parameter the joint plan is the single one's."""
+    from bayesfo.planning import all_inadequate, design_parameter
+
+    a = _result("a", [1.0, 1.0, 0.5], 0.05, 0.0, n=2000, seed=5)
+    b = _result("b", [1.0, 1.0, 0.55], 0.05, -1.0, seed=6)
+    comp = _make(a, b)
+    joint = design_parameter(comp, None, window=(1e-4, 1e4), points=1)
+    assert joint.parameter == "all" and set(joint.sd_now) == {"a1", "b0", "q"}
+    for name in ("a1", "b0", "q"):
+        one = design_parameter(comp, name, window=(1e-4, 1e4), points=1)
+        assert np.all(joint.information >= one.information - 1e-9)
+        assert joint.proposed[0]["sd_after"][name] <= joint.sd_now[name]
+    assert all_inadequate(comp) == []
+    for r in (a, b):
+        r.criteria.adequacy = SimpleNamespace(adequate=False)
+    assert all_inadequate(comp) == ["a", "b"] and all_inadequate(comp, ["b"]) == ["b"]
+
+
+def test_the_command_plans_for_the_best_ones_parameters_where_every_structure_fails(
+        run_cli, tmp_path):
+    """Two relaxations 2.3 decades apart (J = 1 + 2/(1 + 10 s) + 2/(1 + 0.05 s), 1 % noise, σ
+    given) compared with single-relaxation structures only: both fail the checks, so design
+    says so and proposes where the best one's parameters are least determined."""
+    w = np.logspace(-2, 2, 20)
+    s = 1j * w
+    g = 1 + 2 / (1 + 10 * s) + 2 / (1 + 0.05 * s)
+    rng = np.random.default_rng(0)
+    sd = 0.01 * np.abs(g)
+    data = FrequencyResponse(w, g + sd / np.sqrt(2) * (rng.normal(size=20)
+                                                        + 1j * rng.normal(size=20)),
+                             sd, kind="compliance")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = bf.compare(data, "zener-int,voigt-int", seed=0, progress=False, workers=1)
+        bf.write_outputs(result, tmp_path / "run", figures=False)
+    assert not any(result[n].criteria.adequacy.adequate for n in result.ranking)
+    status, text, err = run_cli("design", tmp_path / "run", "--points", "2", "--json")
+    assert status == 0, err
+    plan = json.loads(text)
+    best = result.ranking[0]
+    assert plan["structure"] == best and plan["parameter"] == "all"
+    assert any("every structure considered" in n and "fails" in n for n in plan["notes"])
+    assert len({p["omega"] for p in plan["proposed"]}) == 2
+    last = plan["proposed"][-1]["sd_after"]
+    assert set(last) == set(plan["sd_now"]) and all(last[k] <= plan["sd_now"][k] for k in last)
+    status, text, err = run_cli("design", tmp_path / "run", "--points", "1")
+    assert status == 0 and "note: every structure considered" in text
+    assert f"all parameters of {best}" in text
+    status, _, err = run_cli("design", tmp_path / "run", "--figure", tmp_path / "d.png")
+    assert status == 2 and "leave it out" in err

@@ -129,7 +129,7 @@ def test_a_large_inconsistency_is_a_problem_of_the_data_a_small_one_is_not():
 def test_sparse_consistent_data_get_a_basis_of_one_element_per_decade():
     """12 points over 3.5 decades: the cap (n − 3)//2 gave 4 elements over the 5.5 decades of
     τ and called the bundled fractional Voigt compliance inconsistent (F = 8.6); at least one
-    element per decade (7, leaving 5 degrees of freedom or more) passes it (F = 3.1). Sparse
+    element per decade (7) passed it (F = 3.1), lin-KK's count takes 8 (F = 1.3). Sparse
     fractional compliances (8–15 points over 3–5.5 decades, 1–3 % noise): 300 Zeners flagged
     2.3 % (4.7 % with the cap; benchmarks/bench_kramers_kronig.py --sparse), here 150 of
     them below 9 (binomial p 0.023: mean 3.5, 9 or more with probability 0.01)."""
@@ -139,7 +139,7 @@ def test_sparse_consistent_data_get_a_basis_of_one_element_per_decade():
 
     pp = bf.read(Path(__file__).parents[2] / "examples" / "data" / "pp_compliance.csv")
     kk = kramers_kronig(pp)
-    assert kk.n_elements == 7 and kk.consistent and kk.chi2_per_dof < 4
+    assert kk.n_elements == 8 and kk.consistent and kk.chi2_per_dof < 2
     flagged = 0
     for seed in range(150):
         rng = np.random.default_rng(seed + 7000)
@@ -153,3 +153,74 @@ def test_sparse_consistent_data_get_a_basis_of_one_element_per_decade():
     rng = np.random.default_rng(1)
     y, _ = _noisy(ZENER.response(_zener(rng), W, "modulus"), rng)
     assert kramers_kronig(FrequencyResponse(W, y, kind="modulus")).n_elements == 11
+
+
+def _replicated(g, rng, rel, n_series=10):
+    """Replicate series of circular complex noise (rel·|G| each), averaged, σ their standard
+    error: the bundled dashpot's noise model, generated here with numpy alone."""
+    reps = g[:, None] * (1 + rel / np.sqrt(2) * (rng.normal(size=(g.size, n_series))
+                                                 + 1j * rng.normal(size=(g.size, n_series))))
+    mean = reps.mean(axis=1)
+    se = np.sqrt(np.sum(np.abs(reps - mean[:, None]) ** 2, axis=1) / (n_series - 1) / n_series)
+    return mean, se
+
+
+def test_the_dashpot_file_is_consistent():
+    """dashpot.csv is simulated from 1/(a1 s (1 + 0.1908 s)) = (1/s − 0.1908/(1 + 0.1908 s))/a1:
+    one discrete relaxation, which 6 elements over 4.5 decades of τ missed by 3 % beside 3 %
+    noise (F = 12.6, "not consistent"); lin-KK's count takes 11 elements (F 0.8)."""
+    from pathlib import Path
+
+    import bayesfo as bf
+
+    kk = kramers_kronig(bf.read(Path(__file__).parents[2] / "examples" / "data" / "dashpot.csv"))
+    assert kk.consistent and kk.noise == "given" and kk.chi2_per_dof < 2
+    assert kk.n_elements > 6 and kk.misfit_rms < 0.03
+
+
+def test_parts_of_two_dashpots_fail():
+    """The dashpot's grid and noise model (16 points over 0.03–10 rad/s, ten series of 10 %
+    noise averaged), its real part from a lag of 0.19 s and its imaginary part from one twice
+    as long: every one of 20 noise draws fails (F 14–60; before the count changed, F 19–90)."""
+    w = np.logspace(np.log10(0.03), 1, 16)
+    s = 1j * w
+    g = (1 / (s * (1 + 0.19 * s))).real + 1j * (1 / (s * (1 + 0.38 * s))).imag
+    for seed in range(20):
+        y, sd = _replicated(g, np.random.default_rng(seed), 0.10)
+        kk = kramers_kronig(FrequencyResponse(w, y, sd, kind="generic"))
+        assert not kk.consistent and kk.chi2_per_dof > 5
+
+
+def test_sparse_discrete_relaxations_rarely_raise_a_false_alarm():
+    """150 consistent discrete responses (an integrator with a lag, two Debye relaxations, two
+    with an integrator; 8–16 points over 2.5–4.5 decades; the dashpot's replicate noise, 5–15 %
+    per series), closed forms in numpy. benchmarks/bench_kramers_kronig.py --sparse, 300 sets
+    per family: flagged 2.7 %, 1.3 %, 1.3 % (9.3 %, 5.3 %, 5.0 % with the former count), so
+    at most p = 0.027 here: mean 4, and 9 or more with probability 0.02 (these seeds: 4 now,
+    9 with the former count)."""
+    flagged = 0
+    for seed in range(150):
+        rng = np.random.default_rng(seed + 300)
+        n, span, lo = int(rng.integers(8, 17)), rng.uniform(2.5, 4.5), rng.uniform(-2, 0)
+        w = np.logspace(lo, lo + span, n)
+        s = 1j * w
+        t1 = 10 ** rng.uniform(-np.log10(w[-1]), -np.log10(w[0]))
+        if seed % 3 == 0:
+            g = 1 / (s * (1 + t1 * s))
+        else:
+            t2 = t1 * 10 ** rng.uniform(0.5, 2)
+            g = 1 / (1 + t1 * s) + rng.uniform(0.2, 5) / (1 + t2 * s)
+            if seed % 3 == 2:
+                g = g + 1 / (s * t2 * rng.uniform(1, 30))
+        y, sd = _replicated(g, rng, rng.uniform(0.05, 0.15))
+        flagged += not kramers_kronig(FrequencyResponse(w, y, sd, kind="compliance")).consistent
+    assert flagged < 9
+
+
+def test_the_sign_balance_is_lin_kk_mu_for_either_sign():
+    from bayesfo.data.kramers_kronig import sign_balance
+
+    assert sign_balance(np.array([1.0, 2.0, 0.5])) == 1.0
+    assert sign_balance(-np.array([1.0, 2.0, 0.5])) == 1.0  # a negative spectrum throughout
+    assert sign_balance(np.array([3.0, -1.0])) == pytest.approx(1 - 1 / 3)
+    assert sign_balance(np.zeros(3)) == 1.0

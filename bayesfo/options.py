@@ -80,14 +80,19 @@ DEFAULT_OPTIONS = {
     "figures": True,         # per-data-set figures and report.html, as bayesfo compare
     "figure_formats": ("png",),  # their file formats
     "structure_figures": STRUCTURE_FIGURES,  # corner (trace) figures: "leading", N best, None: all
+    "sample": "needed",      # "all": sample every structure, also those the evidence bound rules out
 }
 
 #: Options added after batch directories were first written: a data set's record leaves them
 #: out at these values, so that directories written before they existed stay complete.
-LATER_OPTIONS = {k: DEFAULT_OPTIONS[k] for k in ("figure_formats", "structure_figures")}
+LATER_OPTIONS = {k: DEFAULT_OPTIONS[k] for k in ("figure_formats", "structure_figures",
+                                                  "sample")}
 
 EVIDENCE_ROUTES = ("auto", "bridge", "ladder")
 SAMPLERS = ("auto", "emcee")
+#: Which structures a comparison samples: ``"needed"`` leaves out those whose best fit bounds
+#: their ln Z far below the leader's (:mod:`bayesfo.inference.bound`); ``"all"`` samples every one.
+SAMPLE = ("needed", "all")
 
 
 NOISE_MODELS = ("auto", "known", "constant", "proportional", "relative_parts")
@@ -158,6 +163,9 @@ def check_options(options: dict, where: str) -> dict:
     if opts["sampler"] not in SAMPLERS:
         raise InputError(f"{where}: sampler must be one of {', '.join(SAMPLERS)}, "
                          f"got {opts['sampler']!r}")
+    if opts["sample"] not in SAMPLE:
+        raise InputError(f"{where}: sample must be one of {', '.join(SAMPLE)}, "
+                         f"got {opts['sample']!r}")
     if opts["noise"] not in NOISE_MODELS:
         raise InputError(f"{where}: noise must be one of {', '.join(NOISE_MODELS)}, "
                          f"got {opts['noise']!r}")
@@ -200,7 +208,7 @@ def check_options(options: dict, where: str) -> dict:
             "evidence_check": bool(opts["evidence_check"]),
             "max_steps": opts["max_steps"], "walkers": opts["walkers"],
             "models": models, "figures": bool(opts["figures"]),
-            "figure_formats": formats, "structure_figures": detail}
+            "figure_formats": formats, "structure_figures": detail, "sample": opts["sample"]}
 
 
 #: Seeds are 32-bit: every random generator in the chain (numpy, scipy, emcee) accepts them.

@@ -98,6 +98,7 @@ def run_task(task: dict) -> dict:
                                  priors=priors, progress=False,
                                  evidence=opts["evidence"], sampler=opts["sampler"],
                                  evidence_check=opts["evidence_check"],
+                                 sample=opts.get("sample", "needed"),
                                  holdout=list(opts["holdout"]) if opts["holdout"] else None,
                                  workers=1, **sampler_options(opts))
             out["compare_seconds"] = time.perf_counter() - t1

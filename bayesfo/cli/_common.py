@@ -10,6 +10,7 @@ from ..options import (
     LEADING,
     LEADING_STRUCTURES,
     NOISE_MODELS,
+    SAMPLE,
     SAMPLERS,
     STRUCTURE_FIGURES,
     VERY_STRONG,
@@ -116,6 +117,11 @@ def add_comparison_options(p, each: str = "the fit"):
     p.add_argument("--walkers", type=int, default=None, metavar="N",
                    help="emcee walkers (default max(32, 4 x parameters)); more walkers help "
                         "ridged and multimodal posteriors")
+    p.add_argument("--sample", default="needed", choices=SAMPLE,
+                   help="which structures get a posterior: needed (default) leaves out those "
+                        "whose best fit bounds ln Z more than 10 nats below the leader's "
+                        "certified ln Z (posterior probability provably below e^-10; the ranking "
+                        "shows 'ln Z <=' and 'P <='), all samples every structure")
     p.add_argument("--evidence-check", action="store_true",
                    help="also compute ln Z by dynesty nested sampling and flag disagreements")
 

@@ -73,7 +73,7 @@ def run(args) -> int:
                "sampler": args.sampler, "max_steps": args.max_steps, "walkers": args.walkers,
                "models": tuple(getattr(args, "models", None) or ()),
                "figures": not args.no_figures, "figure_formats": formats,
-               "structure_figures": detail}
+               "structure_figures": detail, "sample": args.sample}
     datasets = expand_inputs(args.inputs, manifests=args.manifest, options=options,
                              seed=args.seed, exclude=args.out)
     progress = not args.quiet and sys.stderr.isatty()

@@ -166,7 +166,7 @@ def run(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
                    evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,
-                   sampler=args.sampler)
+                   sampler=args.sampler, sample=args.sample)
     options.update(sampler_options(settings))
     options["structure_figures"] = detail
     target = Path(args.out if args.out else f"bayesfo-{Path(args.data).stem}")

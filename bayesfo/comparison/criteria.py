@@ -16,6 +16,7 @@ from ..identify.optimize import FitResult
 from ..inference import Likelihood, PosteriorResult
 from ..inference._arviz import loo as psis_loo
 from ..inference._arviz import waic as waic_of
+from ..inference.bound import model_probabilities, probability_bound
 
 PARETO_K_WARN = 0.7
 
@@ -130,7 +131,8 @@ def _model_probabilities(results, prior_odds: dict) -> list:
     """The results with what is computed across structures in their criteria: the posterior
     model probabilities (from ln Z and the prior odds) and the standard error of each
     structure's Δelpd LOO (:func:`delta_loo_se`). New objects (``dataclasses.replace``); a
-    structure without an evidence has no probability."""
+    structure without an evidence has no probability, one left out by the evidence bound the
+    upper bound of its probability (``bound["posterior_probability_bound"]``)."""
     unknown = set(prior_odds) - {r.name for r in results}
     if unknown:
         raise InputError(f"prior odds given for unknown structure '{sorted(unknown)[0]}'")
@@ -140,10 +142,19 @@ def _model_probabilities(results, prior_odds: dict) -> list:
     with_z = [r for r in results if r.error is None and r.criteria.evidence is not None]
     if not with_z:
         return list(results)
-    log_w = np.array([r.log_z + math.log(prior_odds.get(r.name, 1.0))
-                      for r in with_z])
-    p = np.exp(log_w - log_w.max())
-    p /= p.sum()
+    log_prior = [math.log(prior_odds.get(r.name, 1.0)) for r in with_z]
+    p = model_probabilities([r.log_z for r in with_z], log_prior)
     prob = {id(r): float(x) for r, x in zip(with_z, p, strict=True)}
-    return [replace(r, criteria=replace(r.criteria, posterior_probability=prob[id(r)]))
-            if id(r) in prob else r for r in results]
+    out = []
+    for r in results:
+        if id(r) in prob:
+            r = replace(r, criteria=replace(r.criteria, posterior_probability=prob[id(r)]))
+        elif r.error is None and r.criteria.bound is not None:
+            # Not sampled: its probability is at most that at its bound (ln Z ≤ max ln L).
+            upper = probability_bound(r.criteria.bound["log_evidence_bound"],
+                                      [z.log_z for z in with_z],
+                                      math.log(prior_odds.get(r.name, 1.0)), log_prior)
+            r = replace(r, criteria=replace(r.criteria, bound={
+                **r.criteria.bound, "posterior_probability_bound": upper}))
+        out.append(r)
+    return out

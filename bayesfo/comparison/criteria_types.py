@@ -72,6 +72,13 @@ class Criteria:
     posterior_probability : float or None
         Posterior model probability among the structures compared (from ln Z and the prior
         odds).
+    bound : dict or None
+        For a structure that was not sampled because its best fit bounds its ln Z
+        (:mod:`bayesfo.inference.bound`): ``log_evidence_bound`` (the highest log-likelihood
+        over the noise models considered, ln Z ≤ it), ``by_noise`` (``{noise: max ln L}``),
+        ``source`` (how those maxima were found), ``leader`` and ``leader_log_evidence`` (the
+        certified ln Z it was compared with), ``margin`` (nats), ``reason``, and
+        ``posterior_probability_bound`` (P ≤ it). None for a sampled structure.
     """
 
     max_log_likelihood: float | None = None
@@ -100,6 +107,7 @@ class Criteria:
     holdout_omega: tuple[float, ...] | None = None
     posterior_probability: float | None = None
     delta_loo_se: float | None = None
+    bound: dict | None = None
 
     def __post_init__(self):
         for name in _SEQUENCES:

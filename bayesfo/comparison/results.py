@@ -133,6 +133,19 @@ class StructureResult:
         return self.sampled_parameters
 
     @property
+    def sampled(self) -> bool:
+        """Whether the structure has a posterior: False for one the evidence bound left out
+        (``criteria.bound``; :mod:`bayesfo.inference.bound`) and for one that failed."""
+        return self.error is None and self.posterior is not None
+
+    @property
+    def log_z_bound(self) -> float | None:
+        """For a structure left out by the evidence bound, the upper bound of its ln Z (its
+        maximum log-likelihood); None otherwise."""
+        b = self.criteria.bound
+        return None if b is None else float(b["log_evidence_bound"])
+
+    @property
     def log_z(self) -> float | None:
         """ln Z, the log-evidence (None without one: a failed structure, or none computed)."""
         ev = self.criteria.evidence
@@ -178,6 +191,12 @@ class StructureResult:
         prob = self.criteria.posterior_probability
         if prob is not None:
             parts.append(f"P = {prob:.3f}")
+        bound = self.criteria.bound
+        if bound is not None:
+            parts.append(f"ln Z ≤ {number(bound['log_evidence_bound'], '.2f')}")
+            if bound.get("posterior_probability_bound") is not None:
+                parts.append(f"P ≤ {bound['posterior_probability_bound']:.2g}")
+            parts.append(bound["reason"])
         post = self.posterior
         if post is not None:
             parts.append(("certified" if post.converged else "NOT certified")
@@ -198,6 +217,16 @@ class StructureResult:
         lines = [head]
         ev = self.criteria.evidence
         prob = self.criteria.posterior_probability
+        bound = self.criteria.bound
+        if bound is not None:
+            upper = bound.get("posterior_probability_bound")
+            lines.append(f"  ln Z ≤ {number(bound['log_evidence_bound'], '.2f')}"
+                         + ("" if upper is None else f", P ≤ {upper:.2g}")
+                         + f" ({bound['reason']}); BIC = {number(self.criteria.bic, '.2f')}, "
+                         f"RMSE of the best fit {number(self.criteria.rmse, '.4g')}")
+            for w in self.criteria.warnings:
+                lines.append(f"  ! {w}")
+            return "\n".join(lines)
         lines.append(
             "  ln Z = " + ("-" if ev is None else
                            f"{number(ev.log_z, '.2f')} ± {number(ev.log_z_err, '.2f')} ({ev.method})")
@@ -250,6 +279,9 @@ class StructureResult:
         if self.error is not None:
             out["error"] = self.error
             return out
+        if self.posterior is None:
+            return out | self._bounded_dict()
+        out["sampled"] = True
         post = self.posterior
         ev = self.criteria.evidence
         check = self.criteria.evidence_check
@@ -304,15 +336,40 @@ class StructureResult:
                 k: v for k, v in self.criteria.importance.items() if k != "seconds"},
             adequacy=None if self.adequacy is None else self.adequacy.to_dict(),
             warnings=list(self.criteria.warnings),
-            optimum=None if self.fit is None else {
-                "parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
+            optimum=self._optimum(),
+        )
+        return out
+
+
+    def _bounded_dict(self) -> dict:
+        """The ``summary.json`` record of a structure the evidence bound left out: the keys of
+        a sampled one that need no posterior, those that do as null, and the bound."""
+        c, bound = self.criteria, self.criteria.bound or {}
+        out = {"sampled": False, "parameters": {}, "priors": c.priors,
+               "log_evidence": None, "log_evidence_err": None, "evidence_method": None,
+               "log_evidence_bound": bound.get("log_evidence_bound"),
+               "posterior_probability": None,
+               "posterior_probability_bound": bound.get("posterior_probability_bound"),
+               "bound_reason": bound.get("reason"), "bound": dict(bound),
+               "best_fit_source": bound.get("source"), "noise": bound.get("noise"),
+               "delta_loo_se": None}
+        for key in ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo",
+                    "loo_se", "pareto_k_max", "rmse"):
+            out[key] = getattr(c, key)
+        out.update(rhat_max=None, ess_min=None, converged=None, sampler="not sampled",
+                   adequacy=None, warnings=list(c.warnings), optimum=self._optimum())
+        return out
+
+    def _optimum(self) -> dict | None:
+        """The global optimisation's best point, as ``summary.json["structures"][i]["optimum"]``."""
+        if self.fit is None:
+            return None
+        return {"parameters": dict(zip(self.fit.param_names, map(float, self.fit.theta))),
                 "rmse": self.fit.rmse, "starts": self.fit.n_starts,
                 "starts_at_optimum": self.fit.n_at_best, "admissible": self.fit.admissible,
                 # The thesis' linear methods 1–5 at their best q, as the corner plot marks them.
                 "linear_methods": {k: dict(zip(self.fit.param_names, map(float, v)))
-                                   for k, v in self.fit.linear.items()}},
-        )
-        return out
+                                   for k, v in self.fit.linear.items()}}
 
 
 def _parent(structure) -> str | None:
@@ -349,13 +406,22 @@ def data_problems(data: FrequencyResponse) -> list[str]:
 
 @dataclass(frozen=True, eq=False)
 class Comparison:
-    """Results of :func:`compare`: the data, one :class:`StructureResult` per structure."""
+    """Results of :func:`compare`: the data, one :class:`StructureResult` per structure.
+
+    ``evidence_bound`` records the evidence bound's decisions (:mod:`bayesfo.inference.bound`):
+    ``sample`` (``"needed"`` or ``"all"``), ``margin`` (nats), ``leader`` and
+    ``leader_log_evidence`` (the certified ln Z, less twice its error, that the bounds were
+    compared with), ``bounded`` (the structures left out), ``optimiser_shortfall`` (by how
+    much the sampled structures' draws exceeded the optimiser's maximum, 0 where never) and
+    ``rechecked`` (structures sampled after all because of it). None for results made
+    before it existed."""
 
     data: FrequencyResponse
     results: tuple[StructureResult, ...]
     seed: int
     ranked_by: str = "log_evidence"
     holdout: FrequencyResponse | None = None
+    evidence_bound: dict | None = None
 
     def __post_init__(self):
         # Each result learns the kind and unit of the data, which give its parameters units,
@@ -377,14 +443,19 @@ class Comparison:
 
     @property
     def ranking(self) -> list[str]:
-        """Structure names, best first by ln Z (those without an evidence after them, by
-        PSIS-LOO); structures that failed are left out."""
+        """Structure names, best first by ln Z (those without an evidence after them: the
+        ones the evidence bound left out by their bound, then the others by PSIS-LOO);
+        structures that failed are left out."""
         ok = [r for r in self.results if r.error is None]
 
         def key(r):
             ev = r.criteria.evidence
-            value = ev.log_z if ev is not None else r.criteria.loo
-            return (ev is None, not math.isfinite(value), -value if math.isfinite(value) else 0)
+            bound = r.log_z_bound
+            value = (ev.log_z if ev is not None else bound if bound is not None
+                     else r.criteria.loo)
+            value = math.nan if value is None else value
+            return (ev is None, bound is None, not math.isfinite(value),
+                    -value if math.isfinite(value) else 0)
 
         return [r.name for r in sorted(ok, key=key)]
 
@@ -493,14 +564,18 @@ class Comparison:
         }
         if self.holdout is not None:
             summary["data"]["holdout_omega"] = self.holdout.omega.tolist()
+        if self.evidence_bound is not None:
+            summary["evidence_bound"] = self.evidence_bound
         return summary
 
     def baselines(self) -> list[dict]:
         """Each integer baseline next to its fractional parent (both run on these data).
 
         Returns one dict per pair: ``parent``, ``baseline``, ``delta_log_evidence`` (ln Z of the
-        parent minus the baseline's; > 0 favours the fractional order), ``bayes_factor`` (parent
-        over baseline), the parent's posterior order ``order`` (``q``, or ``beta`` for the
+        parent minus the baseline's; > 0 favours the fractional order) with
+        ``delta_log_evidence_relation`` (``"="``; ``">="`` where the baseline was left out by
+        the evidence bound and its bound stands in for its ln Z, ``"<="`` where the parent
+        was), ``bayes_factor`` (parent over baseline, under the same relation), the parent's posterior order ``order`` (``q``, or ``beta`` for the
         Maxwell) with ``order_mean``, ``order_hdi`` (94 %) and ``order_hdi_includes_1``: whether
         q = 1, the baseline, is inside the parent's HDI; and ``orders``, the same for every
         order the baseline fixes at 1 (``name``, ``symbol``, ``mean``, ``hdi``,
@@ -514,13 +589,22 @@ class Comparison:
                 continue
             p = done[parent]
             ev_p, ev_b = p.criteria.evidence, r.criteria.evidence
-            d = None if ev_p is None or ev_b is None else ev_p.log_z - ev_b.log_z
+            # Where one of the two was left out by the evidence bound, its bound stands in
+            # for its ln Z, and the difference is a bound too (``delta_log_evidence_relation``).
+            relation, d, err = "=", None, None
+            if ev_p is not None and ev_b is not None:
+                d, err = ev_p.log_z - ev_b.log_z, math.hypot(ev_p.log_z_err, ev_b.log_z_err)
+            elif ev_p is not None and r.log_z_bound is not None:
+                relation, d, err = ">=", ev_p.log_z - r.log_z_bound, ev_p.log_z_err
+            elif p.log_z_bound is not None and ev_b is not None:
+                relation, d, err = "<=", p.log_z_bound - ev_b.log_z, ev_b.log_z_err
             # Every order the baseline fixes at 1 (the Maxwell's α and β), the first as before.
-            fixed = [k for k in order_parameters(p.posterior.summary) if k in r.structure.fixed]
+            summary = {} if p.posterior is None else p.posterior.summary
+            fixed = [k for k in order_parameters(summary) if k in r.structure.fixed]
             order = next((k for k in ("q", "beta") if k in fixed), fixed[0] if fixed else None)
             row = {"parent": parent, "baseline": r.name, "delta_log_evidence": d,
-                   "delta_log_evidence_err": None if d is None
-                   else math.hypot(ev_p.log_z_err, ev_b.log_z_err),
+                   "delta_log_evidence_err": err,
+                   "delta_log_evidence_relation": None if d is None else relation,
                    "bayes_factor": None if d is None else math.exp(min(d, 700.0)),
                    "order": order, "orders": []}
             for k in fixed:

@@ -18,7 +18,8 @@ import numpy as np
 
 from ..data import MAX_FREQUENCIES, FrequencyResponse
 from ..errors import DataWarning, InputError
-from ..options import EVIDENCE_ROUTES, SAMPLERS, check_sampler_settings
+from ..inference.bound import BOUND_MARGIN
+from ..options import EVIDENCE_ROUTES, SAMPLE, SAMPLERS, check_sampler_settings
 from ..parallel import LazyPool, executor, runs_here, single_blas_thread
 from ..structures import resolve_structures
 from .criteria import _model_probabilities
@@ -30,7 +31,8 @@ from .steps import RunOptions
 def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: int = 0,
             priors=None, progress: bool | None = None, evidence: str = "auto",
             evidence_check: bool = False, prior_odds: dict | None = None, holdout=None,
-            workers: int = 1, pool=None, sampler: str = "auto", **sampler_kwargs) -> Comparison:
+            workers: int = 1, pool=None, sampler: str = "auto", sample: str = "needed",
+            **sampler_kwargs) -> Comparison:
     """Fit, sample and score every structure on ``data``.
 
     Parameters
@@ -43,7 +45,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         ``proportional`` and ``relative_parts`` noise (relative errors σ_rel·|Re G| and
         σ_rel·|Im G| of each part, a rheometer's, pyRheo's cost; left out where a part is
         exactly 0) and keeps the one with the largest ln Z
-        (:data:`~bayesfo.comparison.steps.SCREEN_MARGIN` lets a quick estimate set aside a
+        (:data:`~bayesfo.comparison.steps.NOISE_SCREEN_MARGIN` lets a quick estimate set aside a
         model that trails far behind); each is stated in the result
         (``criteria.noise_models``). Any other value forces that model.
     seed : int
@@ -83,6 +85,15 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         :mod:`bayesfo.inference.certified`). Sampler settings (``max_steps``, ``n_walkers``)
         or ``evidence="ladder"`` send the structures that importance sampling does not certify
         to emcee directly; ``evidence="bridge"`` implies emcee.
+    sample : {"needed", "all"}
+        ``"needed"``: a structure whose best fit (the global optimiser's maximum
+        log-likelihood under every noise model considered) lies more than
+        :data:`~bayesfo.inference.bound.BOUND_MARGIN` (10) nats below the leader's certified
+        ln Z is not sampled: ln Z ≤ max ln L under any normalised prior, so its posterior
+        probability is provably below e^-10. Its result has the best fit, RMSE, AIC, AICc and
+        BIC, and ``criteria.bound`` (the bound, P ≤ …, the source of the maximum); no
+        posterior, PSIS-LOO, WAIC or figures. Structures whose posterior importance sampling
+        promises to certify quickly are sampled anyway. ``"all"``: every structure is sampled.
     **sampler_kwargs
         Passed to :func:`~bayesfo.inference.posterior.sample_posterior` (e.g. ``max_steps``).
 
@@ -101,6 +112,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     _check_sampler_options(sampler_kwargs)
     if not structures:
         raise InputError("no structure to compare")
+    if sample not in SAMPLE:
+        raise InputError(f"sample must be one of {', '.join(SAMPLE)}, got {sample!r}")
     if sampler not in SAMPLERS:
         raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}")
     if evidence not in EVIDENCE_ROUTES:
@@ -131,7 +144,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         progress = sys.stderr.isatty()
     options = RunOptions(noise=noise, priors=priors, seed=seed, evidence=evidence,
                          evidence_check=evidence_check, sampler=sampler,
-                         sampler_kwargs=sampler_kwargs, holdout=held_out)
+                         sampler_kwargs=sampler_kwargs, holdout=held_out, sample=sample)
+    record = {"sample": sample, "margin": BOUND_MARGIN}
     bar = tqdm(total=len(structures), desc="structures", disable=not progress, leave=False)
     # One path whatever the processes (parallel.executor): the steps of every structure as
     # tasks, each with the same seed wherever it runs, so the numbers do not depend on them.
@@ -141,7 +155,7 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
         if runs_here(pool):
             stack.enter_context(single_blas_thread())
         outcomes = run_in_pool(pool, structures, data, options, bar,
-                               here=isinstance(pool, LazyPool))
+                               here=isinstance(pool, LazyPool), record=record)
     bar.close()
     results = []
     for result, caught in outcomes:
@@ -152,7 +166,8 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     if all(r.error is not None for r in results):
         raise InputError("; ".join(f"{r.name}: {r.error}" for r in results))
     results = _model_probabilities(results, prior_odds or {})
-    return Comparison(data, tuple(results), seed, holdout=held_out)
+    record["bounded"] = [r.name for r in results if r.criteria.bound is not None]
+    return Comparison(data, tuple(results), seed, holdout=held_out, evidence_bound=record)
 
 
 def _as_structures(spec) -> list:

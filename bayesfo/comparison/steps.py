@@ -61,6 +61,9 @@ class RunOptions:
         Settings passed to emcee (``max_steps``, ``n_walkers``).
     holdout : FrequencyResponse or None
         The held-out frequencies.
+    sample : str
+        ``"needed"``: a structure whose best fit bounds its ln Z far below the leader's is
+        not sampled (:mod:`bayesfo.inference.bound`); ``"all"``: every structure is.
     """
 
     noise: str = "auto"
@@ -71,6 +74,7 @@ class RunOptions:
     sampler: str = "auto"
     sampler_kwargs: dict = field(default_factory=dict)
     holdout: FrequencyResponse | None = None
+    sample: str = "needed"
 
     def priors_of(self, s: Structure, noise: str | None = None) -> dict:
         """The overrides that apply to ``s`` (and to the noise parameter of ``noise``)."""
@@ -187,8 +191,10 @@ def _exponent_intervals(run: NoiseRun) -> dict:
 #: A noise model whose quick ln Z (:func:`~bayesfo.inference.importance.screen_noise`) trails
 #: the leader's by this many nats (posterior odds above 150:1) is not sampled in full, provided
 #: its own estimate is reliable (Pareto k̂ < 0.7; a heavy-tailed estimate of the leader only
-#: understates its lead).
-SCREEN_MARGIN = 5.0
+#: understates its lead). Not a bound: an estimate of ln Z against an estimate, within one
+#: structure; the one bound margin of the package, on max ln L against a certified ln Z, is
+#: :data:`bayesfo.inference.bound.BOUND_MARGIN`.
+NOISE_SCREEN_MARGIN = 5.0
 
 
 def _quick_estimates(s, data, candidates, fit, options: RunOptions) -> dict:
@@ -210,7 +216,7 @@ def _quick_estimates(s, data, candidates, fit, options: RunOptions) -> dict:
 
 def screen(s, data, candidates, fit, options: RunOptions, quick=None) -> Screen | None:
     """The quick ln Z of each candidate noise model; those that trail the leader decisively
-    (see :data:`SCREEN_MARGIN`) are set aside. Of the rest, where every quick estimate promises
+    (see :data:`NOISE_SCREEN_MARGIN`) are set aside. Of the rest, where every quick estimate promises
     a quick posterior, all are sampled at once; where not, the one whose likelihood reaches
     highest is sampled first and the others wait (:func:`_deferral`). None when all candidates
     must be sampled at once. ``quick``: the estimates of :func:`_quick_estimates`, when already
@@ -223,7 +229,7 @@ def screen(s, data, candidates, fit, options: RunOptions, quick=None) -> Screen 
     if all(quick.get(noise) is not None for noise in candidates):
         order = sorted(candidates, key=lambda n: -quick[n]["log_z"])
         top = quick[order[0]]["log_z"]
-        aside = [n for n in order[1:] if top - quick[n]["log_z"] >= SCREEN_MARGIN
+        aside = [n for n in order[1:] if top - quick[n]["log_z"] >= NOISE_SCREEN_MARGIN
                  and quick[n]["k_hat"] < K_HAT_MAX]
     known = {n: q for n, q in quick.items() if q is not None}
     left = [n for n in candidates if n not in aside]
@@ -298,7 +304,7 @@ def _set_aside_one(s, data, deferred: Deferred, fit, options: RunOptions,
                    run: NoiseRun) -> dict | None:
     """The record (``{"log_z", "method", "intervals"}``) with which the deferred noise model
     is set aside after the leader's certified posterior ``run``, or None where it must be
-    sampled. Set aside where it trails the leader's ln Z by :data:`SCREEN_MARGIN`, by
+    sampled. Set aside where it trails the leader's ln Z by :data:`NOISE_SCREEN_MARGIN`, by
 
     1. its ln Z estimated from the leader's posterior
        (:func:`~bayesfo.inference.evidence.other_noise_evidence`), where the Pareto k̂ of that
@@ -315,12 +321,12 @@ def _set_aside_one(s, data, deferred: Deferred, fit, options: RunOptions,
                        priors=options.priors_of(s, deferred.noise))
     estimate = other_noise_evidence(other, run.lik, run.post, evidence.log_z)
     if estimate is not None and estimate["k_hat"] < K_HAT_MAX:
-        return estimate if evidence.log_z - estimate["log_z"] >= SCREEN_MARGIN else None
-    if evidence.log_z - deferred.best < SCREEN_MARGIN:
+        return estimate if evidence.log_z - estimate["log_z"] >= NOISE_SCREEN_MARGIN else None
+    if evidence.log_z - deferred.best < NOISE_SCREEN_MARGIN:
         return None
     bound = max(deferred.best, _best_log_likelihood(s, data, deferred.noise, fit, options,
                                                     search=True)[1])
-    if not (np.isfinite(bound) and evidence.log_z - bound >= SCREEN_MARGIN):
+    if not (np.isfinite(bound) and evidence.log_z - bound >= NOISE_SCREEN_MARGIN):
         return None  # (−inf: no admissible point found, no bound)
     return {"log_z": bound, "method": BOUND_METHOD, "intervals": {}}
 
@@ -584,3 +590,96 @@ def kept(name: str, caught) -> list[tuple]:
         if not issubclass(category, (DeprecationWarning, PendingDeprecationWarning)):
             kept.setdefault((category, text))
     return list(kept)
+
+
+#: How a structure's maximum log-likelihood under each noise model is found for the evidence
+#: bound (recorded as the bound's ``source``).
+BOUND_SOURCES = {
+    False: "least squares polished from the global optimisation's optima under each noise "
+           "model's weighting",
+    True: "global multi-start optimisation (random, linear-method and optima starts) under "
+          "each noise model's weighting",
+}
+
+
+def _noise_weighting(lik) -> str:
+    """The residual weights under which ``lik``'s likelihood is a sum of squares."""
+    return NOISE_WEIGHTING.get(lik.noise, "sigma")
+
+
+def best_fit(s: Structure, data: FrequencyResponse, noise: str, fit, options: RunOptions, *,
+             search: bool = False) -> float:
+    """The highest log-likelihood of ``s`` under ``noise`` (with the maximum-likelihood noise
+    scale where it is sampled) that least squares under the noise model's weighting finds,
+    started from the global optimisation ``fit`` (``search``: with random and linear-method
+    starts besides, a global optimisation of its own): an upper bound of the structure's ln Z
+    under that noise model, as good as the optimiser (:mod:`bayesfo.inference.bound`). The
+    optimum need not be admissible: the maximum over a larger set only loosens the bound.
+    -inf where no point has a finite likelihood."""
+    lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
+    known = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
+    starts = lik.structure.to_physical(known, fit.scaling)
+    weighting = _noise_weighting(lik)
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore")
+        found = (fit_structure(lik.structure, data, rng=options.seed, starts=starts,
+                               weighting=weighting, seed_methods=True) if search else
+                 fit_structure(lik.structure, data, rng=options.seed, starts=starts, n_starts=1,
+                               weighting=weighting, stop_after=None))
+        points = [found.optima if found.optima.size else np.atleast_2d(found.theta_scaled)]
+        scaling = [found.scaling]
+        points.append(known)
+        scaling.append(fit.scaling)
+        values = []
+        for theta, sc in zip(points, scaling, strict=True):
+            theta = lik.structure.to_scaled(lik.structure.to_physical(theta, sc), lik.scaling)
+            if lik.noise_param:
+                theta = np.column_stack([theta, lik.noise_estimate(theta)])
+            values.append(np.asarray(lik(theta), dtype=float))
+    values = np.concatenate(values)
+    values = values[np.isfinite(values)]
+    return float(values.max()) if values.size else -np.inf
+
+
+def best_fits(s: Structure, data: FrequencyResponse, fit, options: RunOptions, *,
+              search: bool = False) -> dict[str, float]:
+    """``{noise: highest log-likelihood}`` of ``s`` under every noise model the comparison
+    considers for it (:func:`best_fit`; the noise models by the names the posteriors give
+    them, ``known`` for ``auto`` on data with σ): the largest of them bounds the structure's
+    ln Z, which is the mean of the evidences under those noise models."""
+    out = {}
+    for noise in _noise_candidates(data, options.noise):
+        name = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise)).noise
+        out[name] = best_fit(s, data, noise, fit, options, search=search)
+    return out
+
+
+def bounded_result(s: Structure, data: FrequencyResponse, fit, best: dict[str, float],
+                   leader: str, leader_log_z: float, options: RunOptions, *,
+                   search: bool = True, margin: float | None = None) -> StructureResult:
+    """The result of a structure left out by the evidence bound: its best fit (the optimum,
+    RMSE), the maximum log-likelihood (the largest of ``best``, by noise model) with AIC, AICc
+    and BIC from it, and ``criteria.bound``; no posterior, so no PSIS-LOO, WAIC or figures."""
+    from ..inference.bound import BOUND_MARGIN, BOUND_REASON
+
+    noise = max(best, key=best.get)
+    lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
+    max_ll = float(best[noise])
+    k, n_real = lik.ndim, 2 * data.n_frequencies
+    aic = 2 * k - 2 * max_ll
+    aicc = aic + (2 * k * (k + 1) / (n_real - k - 1) if n_real - k - 1 > 0 else np.inf)
+    bic = k * np.log(n_real) - 2 * max_ll
+    margin = BOUND_MARGIN if margin is None else margin
+    shortfall = leader_log_z - max_ll
+    note = (f"{s.name}: {BOUND_REASON} (max ln L {max_ll:.2f} under {noise} noise, "
+            f"{shortfall:.1f} nats below the ln Z of {leader}, more than the margin of "
+            f"{margin:g}); run with --sample all (API: sample='all') for its posterior, "
+            "PSIS-LOO, WAIC and figures")
+    bound = {"log_evidence_bound": max_ll, "by_noise": {n: float(v) for n, v in best.items()},
+             "noise": noise, "source": BOUND_SOURCES[search], "leader": leader,
+             "leader_log_evidence": float(leader_log_z), "margin": float(margin),
+             "below_leader": float(shortfall), "reason": BOUND_REASON}
+    criteria = {"max_log_likelihood": max_ll, "aic": aic, "aicc": float(aicc), "bic": float(bic),
+                "rmse": float(fit.rmse), "priors": lik.describe_priors(), "warnings": [note],
+                "bound": bound}
+    return StructureResult(s, fit, None, Criteria.from_dict(criteria))

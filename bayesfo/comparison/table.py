@@ -148,6 +148,12 @@ def ranking_rows(structures, ranking) -> list[dict]:
             "not_determined": "; ".join(flagged_names(natural_block(s))),
             "poorly_determined": "; ".join(flagged_names(natural_block(s),
                                                          "poorly_determined")),
+            # Left out by the evidence bound (sampled false): ln Z and P are at most these.
+            "sampled": s.get("sampled", True),
+            "log_evidence_bound": s.get("log_evidence_bound"),
+            "delta_log_evidence_bound": None if s.get("log_evidence_bound") is None
+            else s["log_evidence_bound"] - best_z,
+            "posterior_probability_bound": s.get("posterior_probability_bound"),
         })
     return rows
 
@@ -160,7 +166,8 @@ RANKING_FIELDS = ("rank", "structure", "parent", "n_params", "log_evidence", "lo
                   "q_sd", "pareto_k_max", "rhat_max", "ess_min", "converged", "sampler",
                   "fits", "adequate", "adequacy_p_min", "max_phase_error_deg",
                   "max_log10_magnitude_error", "error", "physical_parameters", "delta_loo_se",
-                  "not_determined", "poorly_determined", "orders")
+                  "not_determined", "poorly_determined", "orders", "sampled",
+                  "log_evidence_bound", "delta_log_evidence_bound", "posterior_probability_bound")
 
 
 
@@ -177,18 +184,23 @@ TEXT_COLUMNS = (
     ("#", 2, lambda r: str(r["rank"])),
     ("structure", 16, lambda r: r["structure"]),
     ("k", 2, lambda r: str(r["n_params"])),
-    ("ln Z", 18, lambda r: "-" if r["log_evidence"] is None else
+    ("ln Z", 18, lambda r: (f"≤ {number(r['log_evidence_bound'])}   "
+                            if r.get("log_evidence_bound") is not None else "-")
+     if r["log_evidence"] is None else
      f"{number(r['log_evidence'])} ± {number(r['log_evidence_err'])}"
      + (" L" if r["evidence_method"] == "ladder" else "  ")),
-    ("dlnZ", 8, lambda r: "-" if r["log_evidence"] is None else
-     number(r["delta_log_evidence"])),
-    ("P", 6, lambda r: "-" if r["log_evidence"] is None else
-     number(r["posterior_probability"], ".3f")),
+    ("dlnZ", 8, lambda r: (f"≤ {number(r['delta_log_evidence_bound'])}"
+                           if r.get("delta_log_evidence_bound") is not None else "-")
+     if r["log_evidence"] is None else number(r["delta_log_evidence"])),
+    ("P", 6, lambda r: (f"≤ {r['posterior_probability_bound']:.0e}"
+                        if r.get("posterior_probability_bound") is not None else "-")
+     if r["log_evidence"] is None else number(r["posterior_probability"], ".3f")),
     ("elpd_loo", 10, lambda r: number(r["loo"])),
     ("BIC", 10, lambda r: number(r["bic"])),
     ("orders (mean)", 13, order_means),
     ("R-hat", 6, lambda r: number(r["rhat_max"], ".3f")),
-    ("ok", 3, lambda r: "yes" if r["converged"] else "NO"),
+    ("ok", 3, lambda r: "yes" if r["converged"] else "-" if r.get("sampled") is False
+     else "NO"),
     ("fits", 6, lambda r: (r["fits"] or "-").replace("no", "NO")),
 )
 
@@ -209,6 +221,11 @@ def ranking_lines(rows: list[dict]) -> list[str]:
                         for k, (v, w) in enumerate(zip(values, widths, strict=True)))
 
     lines = [line([header for header, _, _ in TEXT_COLUMNS]), *map(line, cells)]
+    if any(r.get("sampled") is False for r in ranked):
+        from ..inference.bound import BOUND_REASON
+
+        lines.append(f"≤: {BOUND_REASON} (ln Z ≤ max ln L); no PSIS-LOO, WAIC or posterior "
+                     "figures; --sample all samples it")
     for r in rows:
         if r.get("error"):
             lines.append(f"{'-':>{widths[0]}} {r['structure']:<{widths[1]}} "

@@ -31,8 +31,10 @@ BAND_PROBS = (0.05, 0.25, 0.5, 0.75, 0.95)
 
 
 def ok_results(comparison) -> list:
-    """Results without ``error``, in the order of the ranking."""
-    by_name = {r.name: r for r in comparison.results if r.error is None}
+    """Results with a posterior (neither failed nor left out by the evidence bound), in the
+    order of the ranking."""
+    by_name = {r.name: r for r in comparison.results
+               if r.error is None and r.posterior is not None}
     return [by_name[n] for n in comparison.ranking if n in by_name]
 
 

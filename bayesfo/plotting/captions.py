@@ -160,7 +160,8 @@ def _combined_caption(name: str, comparison) -> str | None:
 def _structure_caption(name: str, comparison) -> str | None:
     """The caption of a structure's corner or trace figure."""
     kind, _, stem = name.partition("_")
-    by_stem = {file_stem(r.name): r for r in comparison.results if r.error is None}
+    by_stem = {file_stem(r.name): r for r in comparison.results
+               if r.error is None and r.posterior is not None}
     result = by_stem.get(stem)
     if result is None or result.posterior is None:
         return None

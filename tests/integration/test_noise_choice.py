@@ -216,15 +216,15 @@ def test_a_noise_model_below_the_leaders_evidence_at_its_best_fit_is_not_sampled
     bound = record["models"]["proportional"]
     assert bound["evidence_method"] == steps.BOUND_METHOD
     given = auto.criteria.evidence.given_noise
-    assert given.log_z - bound["log_evidence"] >= steps.SCREEN_MARGIN
+    assert given.log_z - bound["log_evidence"] >= steps.NOISE_SCREEN_MARGIN
     assert forced.posterior.converged
     assert forced.log_z < bound["log_evidence"]
     assert forced.posterior.max_log_likelihood <= bound["log_evidence"] + 1e-6
     # The marginal ln Z: the mean over the three noise models (relative_parts as recorded).
     third = record["models"]["relative_parts"]["log_evidence"]
     every = np.logaddexp.reduce([given.log_z, forced.log_z, third]) - np.log(3)
-    assert abs(auto.log_z - every) <= np.log1p(np.exp(-steps.SCREEN_MARGIN))
-    assert record["models"]["constant"]["probability"] >= 1 / (1 + np.exp(-steps.SCREEN_MARGIN))
+    assert abs(auto.log_z - every) <= np.log1p(np.exp(-steps.NOISE_SCREEN_MARGIN))
+    assert record["models"]["constant"]["probability"] >= 1 / (1 + np.exp(-steps.NOISE_SCREEN_MARGIN))
     assert "higher by at least" in auto.posterior.noise_reason
     # A bound has no exponents' intervals: whether they depend on the noise model is unknown.
     assert bound["hdi"] == {} and record["sensitive"] is None
@@ -250,7 +250,7 @@ def test_a_noise_model_estimated_from_the_leaders_posterior_is_not_sampled():
     assert estimate["evidence_method"] == OTHER_NOISE_METHOD
     assert abs(estimate["log_evidence"] - forced.log_z) < 1.0
     given = auto.criteria.evidence.given_noise
-    assert given.log_z - estimate["log_evidence"] >= steps.SCREEN_MARGIN
+    assert given.log_z - estimate["log_evidence"] >= steps.NOISE_SCREEN_MARGIN
     # Its central 94 % interval of q lies within the posterior's, widened by 0.01, and holds
     # its median: the smoothed ratios under-represent the tail the leader's draws do not reach.
     draws = forced.posterior.samples[:, forced.posterior.param_names.index("q")]
@@ -260,7 +260,7 @@ def test_a_noise_model_estimated_from_the_leaders_posterior_is_not_sampled():
     # The marginal ln Z: the mean over the three noise models (relative_parts as recorded).
     third = record["models"]["relative_parts"]["log_evidence"]
     every = np.logaddexp.reduce([given.log_z, forced.log_z, third]) - np.log(3)
-    assert abs(auto.log_z - every) <= np.log1p(np.exp(-steps.SCREEN_MARGIN)) + 1.0
+    assert abs(auto.log_z - every) <= np.log1p(np.exp(-steps.NOISE_SCREEN_MARGIN)) + 1.0
 
 
 def _quick(log_z, k_hat=0.2):

@@ -609,7 +609,7 @@ def test_a_deferred_noise_model_waits_for_the_leaders_ln_z(monkeypatch, set_asid
     from test_noise_choice import springpot_data
 
     if not set_aside:
-        monkeypatch.setattr(steps, "SCREEN_MARGIN", np.inf)
+        monkeypatch.setattr(steps, "NOISE_SCREEN_MARGIN", np.inf)
     data, name = springpot_data(), "fractional_kelvin_voigt"
 
     def run(**kw):

@@ -112,7 +112,7 @@ def _print_undetermined(result) -> None:
     symbol = result.data.symbol
     vague, poor, modes = [], [], []
     for row in result.table():
-        if row.get("error"):
+        if row.get("error") or not row.get("sampled", True):
             continue
         r = result[row["structure"]]
         names = [parameter_label(n, symbol) for n in flagged_names(r.natural_parameters)]
@@ -216,6 +216,8 @@ def run(args) -> int:
                     continue
                 d = b["delta_log_evidence"]
                 verdict = "fractional order favoured" if d > 0 else "integer order favoured"
+                # One of the pair left out by the evidence bound: the difference is a bound.
+                relation = {">=": "≥ ", "<=": "≤ "}.get(b.get("delta_log_evidence_relation"), "")
                 hdi = ""
                 if b["orders"]:
                     parts = [f"{o['symbol']} in [{o['hdi'][0]:.3f}, {o['hdi'][1]:.3f}]"
@@ -225,7 +227,8 @@ def run(args) -> int:
                     hdi = (f"; {', '.join(parts)} (94 % HDI"
                            f"{'; includes 1: ' + ', '.join(ones) if ones else ''})")
                 print(f"   {b['parent']:<14} vs {b['baseline']:<16} ln Z difference "
-                      f"{d:+9.2f} ± {b['delta_log_evidence_err']:.2f}: {verdict}{hdi}")
+                      f"{relation}{d:+.2f} ± {b['delta_log_evidence_err']:.2f}: "
+                      f"{verdict}{hdi}")
         if result.holdout is not None:
             print("held out " + ", ".join(f"{w:.4g}" for w in result.holdout.omega) + " rad/s:")
             for row in result.table():

@@ -295,7 +295,7 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
                                    "a number from 0 to 1")
     files = {}
     for s in entries:
-        if "error" not in s:
+        if "error" not in s and s.get("sampled", True):
             files[s["name"]] = _read_netcdf(d / f"{s['name']}.nc", s["name"], s,
                                             summary["data"]["n_frequencies"])
     if not files:
@@ -322,6 +322,9 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
         if "error" in s:
             results.append(StructureResult(structure, error=s["error"]))
             continue
+        if not s.get("sampled", True):  # left out by the evidence bound: no NetCDF
+            results.append(StructureResult(structure, _fit(s, data), None, _bounded(s)))
+            continue
         path = d / f"{name}.nc"
         idata = files[name]
         if not np.array_equal(np.asarray(idata.observed_data["omega"].values), data.omega):
@@ -337,7 +340,8 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
         results.append(StructureResult(structure, _fit(s, data), post,
                                        _criteria(s, idata)))
     return Comparison(data, tuple(results), int(summary["seed"]),
-                      ranked_by=summary.get("ranked_by", "log_evidence"), holdout=holdout)
+                      ranked_by=summary.get("ranked_by", "log_evidence"), holdout=holdout,
+                      evidence_bound=summary.get("evidence_bound"))
 
 
 def _mastercurve(summary: dict, d: Path, library):
@@ -558,6 +562,19 @@ def _adequacy(block: dict | None) -> Adequacy | None:
         masked_phase_error_deg=_num(block.get("masked_phase_error_deg", 0.0)),
         masked_log10_magnitude_error=_num(block.get("masked_log10_magnitude_error", 0.0)),
         caution=block.get("caution", ""))
+
+
+def _bounded(s: dict) -> Criteria:
+    """The criteria of a structure the evidence bound left out (``"sampled": false``)."""
+    bound = s.get("bound")
+    if not isinstance(bound, dict) or not isinstance(bound.get("log_evidence_bound"),
+                                                     (int, float)):
+        raise InputError(f"structure '{s['name']}' is not sampled but has no bound of its "
+                         "ln Z: not a summary.json of bayesfo compare")
+    return Criteria.from_dict({k: _num(s[k]) for k in ("max_log_likelihood", "aic", "aicc",
+                                                        "bic", "rmse")}
+                              | {"priors": s.get("priors"), "warnings": tuple(s["warnings"]),
+                                 "bound": bound})
 
 
 def _criteria(s: dict, idata) -> Criteria:

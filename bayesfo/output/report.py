@@ -178,9 +178,18 @@ def _ranking_table(comparison) -> str:
                         f'failed: {_e(row.get("error"))}</td></tr>')
             continue
         cells = [f'<td>{row["rank"]}</td>', _text_cell(name), f'<td>{row["n_params"]}</td>']
+        sampled = row.get("sampled", True)
         for key, _, fmt in cols:
             v = row.get(key)
-            if key == "posterior_probability":
+            bound = {"log_evidence": "log_evidence_bound",
+                     "delta_log_evidence": "delta_log_evidence_bound",
+                     "posterior_probability": "posterior_probability_bound"}.get(key)
+            if not sampled and bound is not None and row.get(bound) is not None:
+                # Left out by the evidence bound: ln Z and P are at most these.
+                b = row[bound]
+                cells.append(_cell(b, text="≤ " + (f"{b:.0e}" if key == "posterior_probability"
+                                                   else _num(b, fmt))))
+            elif key == "posterior_probability":
                 cells.append(_cell(v, text=_prob(v)))
             elif key == "log_evidence" and _finite(v) and row.get("evidence_method") == "ladder":
                 cells.append(_cell(v, text=f"{_num(v, fmt)} L"))
@@ -190,7 +199,10 @@ def _ranking_table(comparison) -> str:
                 cells.append(_cell(v, fmt))
         cells.append(_text_cell(row.get("orders") or "–"))
         ok = row["converged"]
-        cells.append(f'<td class="text{"" if ok else " flag"}">{"yes" if ok else "NO"}</td>')
+        if not sampled:
+            cells.append('<td class="text">not sampled</td>')
+        else:
+            cells.append(f'<td class="text{"" if ok else " flag"}">{"yes" if ok else "NO"}</td>')
         fits = row.get("fits")  # the posterior predictive checks, as the terminal says them
         cells.append(f'<td class="text{" flag" if fits == "no" else ""}">'
                      f'{_e((fits or "–").replace("no", "NO"))}</td>')
@@ -206,6 +218,16 @@ def _ranking_table(comparison) -> str:
             "fractional order by its symbol, posterior mean and 94 % HDI; fits: whether the "
             "posterior predictive checks pass (small: a systematic misfit within 2° and "
             "3.5 %; partly: they pass, but the fitted noise swamps points the fit misses).</p>")
+    if any(not r.get("sampled", True) for r in comparison.table() if r.get("rank")):
+        from ..inference.bound import BOUND_MARGIN, BOUND_REASON
+
+        note += (f"<p class='small'>≤: {_e(BOUND_REASON)}. Its maximum log-likelihood (the "
+                 "global optimiser's, under every noise model) is an upper bound of ln Z under "
+                 f"any normalised prior and lies more than {BOUND_MARGIN:g} nats below the "
+                 "leader's certified ln Z, so its posterior probability is below "
+                 f"e^-{BOUND_MARGIN:g}; AIC, AICc, BIC and RMSE are those of that best fit; it "
+                 "has no PSIS-LOO, WAIC, posterior or figures. <code>--sample all</code> "
+                 "samples it.</p>")
     return f"<table>{head}{''.join(body)}</table>{note}"
 
 
@@ -278,6 +300,8 @@ def _parameters_section(comparison) -> str:
         units = getattr(r, "units", {}) or {}
         judged = r.sampled_parameters
         rows = []
+        if r.posterior is None:  # left out by the evidence bound: no posterior
+            continue
         for p, s in r.posterior.summary.items():
             flags = _flags(judged.get(p, {})) + (["multimodal"] if s.multimodal else [])
             rows.append(
@@ -383,6 +407,12 @@ def _diagnostics_section(comparison) -> str:
                          f"{_e(r.error)}</li>")
             continue
         post = r.posterior
+        if post is None:
+            bound = r.criteria.bound or {}
+            items.append(f"<li><b>{_e(r.name)}</b>: not sampled: ln Z ≤ "
+                         f"{_num(bound.get('log_evidence_bound'))} (max ln L from the "
+                         f"{_e(bound.get('source', 'optimiser'))})</li>")
+            continue
         status = ("converged" if post.converged
                   else "<span class='flag'>not converged</span>")
         tau = max(post.tau) if len(post.tau) else float("nan")
@@ -505,7 +535,8 @@ def _without_corner(figures: dict, comparison) -> str:
     """A note naming the structures that have no corner figure among ``figures``, if any."""
     from ..plotting.captions import file_stem
 
-    missing = [n for n in comparison.ranking if f"corner_{file_stem(n)}" not in figures]
+    missing = [n for n in comparison.ranking if f"corner_{file_stem(n)}" not in figures
+               and comparison[n].posterior is not None]
     if not missing:
         return ""
     return (f"<p class='small'>No corner figure of {_e(', '.join(missing))}: by default only "

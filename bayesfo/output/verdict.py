@@ -132,7 +132,11 @@ def verdict(comparison) -> list[tuple[str, bool]]:
         determined order, parameters the data do not determine, an evidence difference within
         its error).
     """
-    rows = [r for r in comparison.table() if r.get("rank") is not None]
+    table = [r for r in comparison.table() if r.get("rank") is not None]
+    # Structures the evidence bound left out have no posterior: the sentences on posteriors
+    # are of the sampled ones, and one sentence says which were left out and why.
+    rows = [r for r in table if r.get("sampled", True)]
+    bounded = [r for r in table if not r.get("sampled", True)]
     failed = [r for r in comparison.results if r.error is not None]
     out: list[tuple[str, bool]] = [(f"Data: {w.split(': ', 1)[1]}.", True)
                                    for w in comparison.data_warnings]
@@ -173,6 +177,16 @@ def verdict(comparison) -> list[tuple[str, bool]]:
             if d < 2 * err:
                 out.append((f"The difference from {second['structure']} is within twice its "
                             "estimation error: the evidence does not separate the two.", True))
+    if bounded:
+        from ..inference.bound import BOUND_MARGIN
+
+        listed = _join([f"{r['structure']} (ln Z ≤ {r['log_evidence_bound']:.2f})"
+                        for r in bounded])
+        out.append((f"Not sampled: {listed}: the best fit of each (the global optimiser's "
+                    "maximum log-likelihood, an upper bound of ln Z under any normalised prior) "
+                    f"lies more than {BOUND_MARGIN:g} nats below the log-evidence of {name}, so "
+                    f"its posterior probability is below e^-{BOUND_MARGIN:g}; they have no "
+                    "PSIS-LOO, WAIC or posterior figures (--sample all samples them).", False))
     if len(rows) > 1:
         agree = [c for c in CRITERIA if best.get(f"rank_{c}") == 1]
         disagree = {}

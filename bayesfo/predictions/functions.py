@@ -360,7 +360,9 @@ def _weights(result, average: str) -> tuple[dict, list]:
     if average not in AVERAGES:
         raise InputError(f"predict: average must be one of {', '.join(AVERAGES)}, got "
                          f"{average!r}")
-    ranked = [result[n] for n in result.ranking]
+    # Structures the evidence bound left out have no posterior and weigh below e^-10 against
+    # the leader: they take no part (their weight in Bayesian model averaging is negligible).
+    ranked = [result[n] for n in result.ranking if result[n].posterior is not None]
     if len(ranked) < 2:
         raise InputError("predict: an average needs two or more structures with a posterior")
     bma = {r.name: r.probability for r in ranked}

@@ -68,7 +68,7 @@ AUTO_LAWS_MIN = 4
 #: probability is below e^-LAW_BOUND_MARGIN, and certifying a posterior that far behind (often
 #: by the tempered ladder: the law pulls its parameters against their bounds) would cost more
 #: than all the rest.
-LAW_BOUND_MARGIN = 10.0
+LAW_BOUND_MARGIN = BOUND_MARGIN  # the one bound margin (bayesfo.inference.bound)
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..inference.bound import BOUND_MARGIN  # the one bound margin (10 nats)
 from .isotherms import _seed_shifts, _vertical_seeds
 from .model import SHIFT_MARGIN, SHIFT_RANGE, VERTICAL_RANGE
 from .smooth import NOISE, SmoothMaster
@@ -27,8 +28,6 @@ from .smooth_posterior import (
 #: The vertical shifts that ``vertical="auto"`` chooses among, and the laws of ``law="auto"``.
 VERTICALS = ("none", "density", "free")
 LAWS = ("free", "wlf", "arrhenius")
-#: A model whose best fit lies this many nats below the leader's ln Z is not sampled.
-BOUND_MARGIN = 10.0
 #: Isotherms from which ``law="auto"`` also weighs the laws (fewer: WLF has as many
 #: constants as there are shifts to test it).
 AUTO_LAWS_MIN = 4

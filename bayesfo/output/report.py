@@ -535,8 +535,10 @@ def _without_corner(figures: dict, comparison) -> str:
     """A note naming the structures that have no corner figure among ``figures``, if any."""
     from ..plotting.captions import file_stem
 
+    # Structures left out by the evidence bound have no posterior to draw (the table says so).
+    unsampled = {r.name for r in comparison.results if getattr(r, "posterior", True) is None}
     missing = [n for n in comparison.ranking if f"corner_{file_stem(n)}" not in figures
-               and comparison[n].posterior is not None]
+               and n not in unsampled]
     if not missing:
         return ""
     return (f"<p class='small'>No corner figure of {_e(', '.join(missing))}: by default only "

@@ -34,7 +34,7 @@ def ok_results(comparison) -> list:
     """Results with a posterior (neither failed nor left out by the evidence bound), in the
     order of the ranking."""
     by_name = {r.name: r for r in comparison.results
-               if r.error is None and r.posterior is not None}
+               if r.error is None and getattr(r, "posterior", True) is not None}
     return [by_name[n] for n in comparison.ranking if n in by_name]
 
 

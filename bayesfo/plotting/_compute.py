@@ -63,6 +63,10 @@ def select_results(comparison, structures, default_n: int | None = DEFAULT_N_STR
             )
         if known[n].error is not None:
             raise InputError(f"argument 'structures': structure '{n}' failed: {known[n].error}")
+        if getattr(known[n], "posterior", True) is None:
+            raise InputError(f"argument 'structures': structure '{n}' was not sampled (its best "
+                             "fit bounds its ln Z far below the leader's); compare with "
+                             "sample='all' to draw it")
         out.append(known[n])
     if not out:
         raise InputError("argument 'structures' is empty")

@@ -236,10 +236,12 @@ def test_once_the_workers_have_started_every_step_still_to_come_goes_to_them(mon
     before they started, and every later step then run in the workers, with the numbers and
     warnings of the serial path."""
     _no_promise_for(monkeypatch, "zener-int")
+    # Step (1) runs as schedule._probe (fit_and_probe, here the pessimistic stand-in, with the
+    # best fits of the evidence bound).
     assert _steps_in_pool(_StartingRecorder()) == [
+        ("_probe", "maxwell-int", None),
         ("conclude", "maxwell-int", None),
         ("conclude", "zener-int", None),
-        ("pessimistic", "maxwell-int", None),
         *(("sample_held", s, n) for s in ("maxwell-int", "zener-int") for n in SAMPLED[s])]
 
 
@@ -597,7 +599,7 @@ def test_workers_that_overtake_the_early_optimisations_end_them():
     assert prepared == [0]
     assert taken == [("zener-int", True, True), ("maxwell-int", False, False)]
     assert here == ["maxwell-int"]  # by the (here: in-process) worker
-    assert same and ("<lambda>", "maxwell-int", None) in ran
+    assert same and ("_probe", "maxwell-int", None) in ran
 
 
 @pytest.mark.parametrize("set_aside, recorder", [(True, _LazyRecorder), (False, _Recorder)])

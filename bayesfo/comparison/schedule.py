@@ -59,6 +59,8 @@ import queue
 import warnings
 from concurrent.futures.process import BrokenProcessPool
 
+import numpy as np
+
 from ..errors import InputError
 from ..inference._arviz import preload
 from ..inference.bound import BOUND_MARGIN, bounded
@@ -122,7 +124,10 @@ def _bound_of(s, data, fit, options, quick: bool) -> dict | None:
     posterior then costs less than the bound)."""
     if options.sample == "all" or quick:
         return None
-    return best_fits(s, data, fit, options)
+    try:
+        return best_fits(s, data, fit, options)
+    except (InputError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return None  # no bound: the structure is sampled, as without the rule
 
 
 def _guess(screened) -> float | None:
@@ -267,7 +272,10 @@ def run_in_pool(pool, structures, data, options, bar, *, here: bool = False,
         if not bounded(max(bests[i].values()) + widen, lead[1]):
             return False
         if i not in confirmed:
-            found = best_fits(structures[i], data, fits[i], options, search=True)
+            try:
+                found = best_fits(structures[i], data, fits[i], options, search=True)
+            except (InputError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+                found = {k: math.inf for k in bests[i]}  # not confirmed: sampled
             confirmed[i] = {k: max(v, bests[i].get(k, -math.inf)) for k, v in found.items()}
         return bounded(max(confirmed[i].values()) + widen, lead[1])
 

@@ -357,7 +357,9 @@ class StructureResult:
                     "loo_se", "pareto_k_max", "rmse"):
             out[key] = getattr(c, key)
         out.update(rhat_max=None, ess_min=None, converged=None, sampler="not sampled",
-                   adequacy=None, warnings=list(c.warnings), optimum=self._optimum())
+                   # The posterior predictive checks with the best fit for the posterior.
+                   adequacy=None if self.adequacy is None else self.adequacy.to_dict(),
+                   adequacy_of="best fit", warnings=list(c.warnings), optimum=self._optimum())
         return out
 
     def _optimum(self) -> dict | None:

@@ -616,6 +616,12 @@ def best_fit(s: Structure, data: FrequencyResponse, noise: str, fit, options: Ru
     under that noise model, as good as the optimiser (:mod:`bayesfo.inference.bound`). The
     optimum need not be admissible: the maximum over a larger set only loosens the bound.
     -inf where no point has a finite likelihood."""
+    return _best_point(s, data, noise, fit, options, search=search)[0]
+
+
+def _best_point(s, data, noise, fit, options: RunOptions, *, search: bool = False):
+    """(value, point on the scaled problem with its noise scale, likelihood) of
+    :func:`best_fit`; the point is None where no point has a finite likelihood."""
     lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
     known = fit.optima if fit.optima.size else np.atleast_2d(fit.theta_scaled)
     starts = lik.structure.to_physical(known, fit.scaling)
@@ -626,19 +632,49 @@ def best_fit(s: Structure, data: FrequencyResponse, noise: str, fit, options: Ru
                                weighting=weighting, seed_methods=True) if search else
                  fit_structure(lik.structure, data, rng=options.seed, starts=starts, n_starts=1,
                                weighting=weighting, stop_after=None))
-        points = [found.optima if found.optima.size else np.atleast_2d(found.theta_scaled)]
-        scaling = [found.scaling]
-        points.append(known)
-        scaling.append(fit.scaling)
-        values = []
-        for theta, sc in zip(points, scaling, strict=True):
-            theta = lik.structure.to_scaled(lik.structure.to_physical(theta, sc), lik.scaling)
+        points = [(found.optima if found.optima.size else np.atleast_2d(found.theta_scaled),
+                   found.scaling), (known, fit.scaling)]
+        thetas = []
+        for theta, scaling in points:
+            theta = lik.structure.to_scaled(lik.structure.to_physical(theta, scaling), lik.scaling)
             if lik.noise_param:
                 theta = np.column_stack([theta, lik.noise_estimate(theta)])
-            values.append(np.asarray(lik(theta), dtype=float))
-    values = np.concatenate(values)
-    values = values[np.isfinite(values)]
-    return float(values.max()) if values.size else -np.inf
+            thetas.append(theta)
+        thetas = np.vstack(thetas)
+        values = np.asarray(lik(thetas), dtype=float)
+    values = np.where(np.isfinite(values), values, -np.inf)
+    if not np.isfinite(values).any():
+        return -np.inf, None, lik
+    best = int(np.argmax(values))
+    return float(values[best]), thetas[best], lik
+
+
+def best_fit_adequacy(s: Structure, data: FrequencyResponse, noise: str, fit,
+                      options: RunOptions):
+    """The posterior predictive checks (:func:`~bayesfo.inference.adequacy.check_adequacy`)
+    with the best fit under ``noise`` (and its maximum-likelihood noise scale) standing in
+    for the posterior: whether the best the structure can do describes the data. None where
+    no point has a finite likelihood or the checks cannot be made."""
+    from ..inference import PosteriorResult
+
+    _, theta, lik = _best_point(s, data, noise, fit, options)
+    if theta is None:
+        return None
+    physical = lik.to_physical(theta[None, :])
+    stand_in = PosteriorResult(
+        structure=s.name, param_names=tuple(lik.param_names), noise=lik.noise,
+        noise_reason="", samples=physical, samples_scaled=theta[None, :],
+        log_likelihood=np.asarray(lik(theta[None, :]), dtype=float), summary={},
+        map_theta=physical[0], max_log_likelihood=float(lik(theta[None, :])[0]),
+        tau=np.zeros(lik.ndim), n_steps=0, burn=0, thin=1, n_walkers=1, acceptance=np.nan,
+        rhat_max=np.nan, ess_bulk_min=np.nan, ess_tail_min=np.nan, converged=False,
+        sampler="best fit")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return check_adequacy(lik, stand_in, seed=options.seed)
+    except (InputError, ValueError, ArithmeticError):
+        return None
 
 
 def best_fits(s: Structure, data: FrequencyResponse, fit, options: RunOptions, *,
@@ -681,5 +717,7 @@ def bounded_result(s: Structure, data: FrequencyResponse, fit, best: dict[str, f
              "below_leader": float(shortfall), "reason": BOUND_REASON}
     criteria = {"max_log_likelihood": max_ll, "aic": aic, "aicc": float(aicc), "bic": float(bic),
                 "rmse": float(fit.rmse), "priors": lik.describe_priors(), "warnings": [note],
-                "bound": bound}
+                "bound": bound,
+                # Whether the best fit describes the data (the checks with it for the posterior).
+                "adequacy": best_fit_adequacy(s, data, noise, fit, options)}
     return StructureResult(s, fit, None, Criteria.from_dict(criteria))

@@ -574,7 +574,7 @@ def _bounded(s: dict) -> Criteria:
     return Criteria.from_dict({k: _num(s[k]) for k in ("max_log_likelihood", "aic", "aicc",
                                                         "bic", "rmse")}
                               | {"priors": s.get("priors"), "warnings": tuple(s["warnings"]),
-                                 "bound": bound})
+                                 "bound": bound, "adequacy": _adequacy(s.get("adequacy"))})
 
 
 def _criteria(s: dict, idata) -> Criteria:

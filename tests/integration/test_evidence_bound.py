@@ -58,6 +58,8 @@ def test_a_structure_whose_best_fit_bounds_its_evidence_is_not_sampled(needed):
     c = out.criteria
     assert all(math.isfinite(getattr(c, k)) for k in ("aic", "aicc", "bic", "rmse"))
     assert c.loo is None and c.waic is None
+    # The posterior predictive checks with the best fit standing in for the posterior.
+    assert out.adequacy is not None and out.adequacy.n_draws == 1 and out.fits == "no"
     assert needed.ranking == ["fractional_kelvin_voigt", "maxwell"]
     assert needed.evidence_bound["bounded"] == ["maxwell"]
     text = needed.summary()
@@ -87,6 +89,7 @@ def test_summary_and_load_round_trip_a_bounded_structure(needed, tmp_path):
     assert record["log_evidence_bound"] == pytest.approx(needed["maxwell"].log_z_bound)
     assert record["posterior_probability_bound"] < math.exp(-BOUND_MARGIN)
     assert "global multi-start" in record["best_fit_source"]
+    assert record["adequacy_of"] == "best fit" and record["adequacy"]["adequate"] is False
     assert summary["evidence_bound"]["margin"] == BOUND_MARGIN
     lead = next(s for s in summary["structures"] if s["name"] == "fractional_kelvin_voigt")
     assert lead["sampled"] is True

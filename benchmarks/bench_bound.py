@@ -56,7 +56,10 @@ def _check(key: str, variant: str, bound: dict, every: dict) -> list[str]:
     lines.append(f"{key} ({variant}): ranking order of the sampled structures the same: "
                  f"{same_order}; ln Z of every sampled structure the same: {same_z}"
                  + ("" if same_order and same_z else "   <-- DISAGREE"))
-    leader = bound.get("evidence_bound", {}).get("leader_log_evidence")
+    record = bound.get("evidence_bound", {})
+    leader = record.get("leader_log_evidence")
+    lines.append(f"   optimiser shortfall {record.get('optimiser_shortfall')}; re-checked and "
+                 f"sampled: {record.get('rechecked', [])}")
     for s in bound["structures"]:
         if s.get("sampled", True):
             continue

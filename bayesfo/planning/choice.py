@@ -353,7 +353,8 @@ def all_inadequate(result, structures=None) -> list[str]:
     best first) where every one of them fails the posterior predictive checks, else ``[]``:
     then points that tell them apart would choose among descriptions that all miss the data,
     and ``bayesfo design`` plans for the best one's parameters instead."""
-    ranked = [result[n] for n in result.ranking]
+    # Structures left out by the evidence bound have no posterior to plan with.
+    ranked = [result[n] for n in result.ranking if result[n].posterior is not None]
     if structures is not None:
         names = [structures] if isinstance(structures, str) else list(structures)
         ranked = [r for r in ranked if r.name in names]
@@ -414,7 +415,8 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
     lo_d, hi_d = float(data.omega.min()), float(data.omega.max())
     w_lo, w_hi = _checked(data, window, points, cost)
     w_lo, w_hi, cut = capped_window(data, w_lo, w_hi)
-    ranked = [result[n] for n in result.ranking]
+    # Structures left out by the evidence bound have no posterior to plan with.
+    ranked = [result[n] for n in result.ranking if result[n].posterior is not None]
     notes = [] if cut is None else [cut]
     if structures is not None:
         names = [structures] if isinstance(structures, str) else list(structures)

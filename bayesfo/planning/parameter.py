@@ -119,7 +119,7 @@ def design_parameter(result, parameter: str | None, *, structure: str | None = N
 
         warnings.warn(cut, DataWarning, stacklevel=2)
     name = structure or (result.ranking[0] if result.ranking else None)
-    if name not in result.ranking:
+    if name not in result.ranking or result[name].posterior is None:
         raise InputError(f"design: no structure '{name}' with a posterior in the comparison; it "
                          f"has {', '.join(result.ranking)}")
     r = result[name]

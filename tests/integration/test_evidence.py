@@ -157,7 +157,7 @@ def test_routes_agree_on_the_thesis_set_up():
         warnings.simplefilter("ignore")
         result = compare(data, resolve_structures("voigt,zener,voigt-int,zener-int,max-n1m0,"
                                                   "max-n1m1"), seed=0, progress=False,
-                         evidence_check=True, workers=2)
+                         evidence_check=True, workers=2, sample="all")
     for r in result.results:
         bridge, nested = r.criteria.evidence, r.criteria.evidence_check
         assert abs(bridge.log_z - nested.log_z) < 0.3, r.name
@@ -199,7 +199,7 @@ def test_ladder_evidence_of_unconverged_posteriors_on_the_thesis_set_up():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = compare(g_spec_data(0), resolve_structures(",".join(NESTED_REFERENCE)), seed=0,
-                         progress=False, workers=2)
+                         progress=False, workers=2, sample="all")
     for r in result.results:
         ev = r.criteria.evidence
         ref, ref_err, _ = NESTED_REFERENCE[r.name]

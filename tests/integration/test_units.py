@@ -161,7 +161,8 @@ def test_ranking_csv_keeps_its_columns_and_adds_the_physical_parameters(zener_ru
     result, out = zener_run
     assert RANKING_FIELDS[: len(OLD_RANKING_FIELDS)] == OLD_RANKING_FIELDS
     assert RANKING_FIELDS[len(OLD_RANKING_FIELDS):] == (
-        "physical_parameters", "delta_loo_se", "not_determined", "poorly_determined", "orders")
+        "physical_parameters", "delta_loo_se", "not_determined", "poorly_determined", "orders",
+        "sampled", "log_evidence_bound", "delta_log_evidence_bound", "posterior_probability_bound")
     with (out / "ranking.csv").open(newline="") as fh:
         (row,) = list(csv.DictReader(fh))
     text = row["physical_parameters"]

@@ -216,8 +216,12 @@ def run(args) -> int:
                     continue
                 d = b["delta_log_evidence"]
                 verdict = "fractional order favoured" if d > 0 else "integer order favoured"
-                # One of the pair left out by the evidence bound: the difference is a bound.
+                # One of the pair left out by the evidence bound: the difference is a bound,
+                # which decides only where it lies on the side of its sign.
                 relation = {">=": "≥ ", "<=": "≤ "}.get(b.get("delta_log_evidence_relation"), "")
+                if (relation == "≥ " and d <= 0) or (relation == "≤ " and d >= 0):
+                    left = b["baseline"] if relation == "≥ " else b["parent"]
+                    verdict = f"not decided ({left} not sampled: its best fit bounds ln Z)"
                 hdi = ""
                 if b["orders"]:
                     parts = [f"{o['symbol']} in [{o['hdi'][0]:.3f}, {o['hdi'][1]:.3f}]"
@@ -236,8 +240,8 @@ def run(args) -> int:
                     print(f"   {row['structure']:<16} log predictive density {row['holdout_lpd']:10.2f}, "
                           f"RMSE {row['holdout_rmse']:.4g} (in-sample RMSE {row['rmse']:.4g})")
         if args.no_figures:
-            print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per structure")
+            print(f"wrote {out}/summary.json, ranking.csv and one NetCDF per sampled structure")
         else:
             print(f"report: {out / 'report.html'} (figures in {out / 'figures'}; summary.json, "
-                  "ranking.csv and one NetCDF per structure beside it)")
+                  "ranking.csv and one NetCDF per sampled structure beside it)")
     return 0

@@ -4,7 +4,7 @@ be (:func:`netcdf_for`).
 
 ``summary.json`` holds every number of the contract; each ``<structure>.nc`` holds the draws,
 the pointwise log-likelihood, the posterior predictive and the data. Besides arviz' groups, each
-NetCDF carries these attributes (format :data:`NETCDF_FORMAT`):
+NetCDF carries these attributes (format :data:`~bayesfo.inference.results.NETCDF_FORMAT`):
 
 ``posterior``
     ``bayesfo_format``; the sampler's ``n_steps``, ``burn``, ``thin``, ``acceptance`` and
@@ -33,13 +33,10 @@ from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.adequacy import Adequacy
 from ..inference.evidence import Evidence
-from ..inference.results import ParameterSummary, draws_digest
+from ..inference.results import NETCDF_FORMAT, ParameterSummary, draws_digest
 from ..structures import Scaling
 from .criteria_types import Criteria
 from .results import Comparison, StructureResult
-
-#: Version of the attributes :func:`netcdf_for` adds (``posterior.attrs["bayesfo_format"]``).
-NETCDF_FORMAT = 1
 
 #: Criteria that summary.json holds as plain numbers (null where not finite).
 _NUMBERS = ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",

@@ -394,6 +394,11 @@ def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kep
     return idata
 
 
+#: Version of the attributes that a NetCDF of bayesfo carries (``posterior.attrs["bayesfo_format"]``),
+#: the same for a comparison's structures and a master curve's joint posterior.
+NETCDF_FORMAT = 1
+
+
 def _netcdf_bytes_needed(idata) -> int:
     """An upper bound of the size of ``idata`` as NetCDF: its arrays uncompressed, plus the
     HDF5 headers of every variable and group."""

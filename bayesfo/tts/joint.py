@@ -152,7 +152,7 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         raise InputError(f"law must be one of auto, {', '.join(LAWS)}, got {law!r}")
     if shifts not in SHIFTS_FROM:
         raise InputError(f"shifts must be one of {', '.join(SHIFTS_FROM)}, got {shifts!r}")
-    names = _master_names(structures)
+    names = master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
     _warn_negative_loss(iso)
     _warn_temperature_gap(iso)
@@ -447,7 +447,7 @@ def _warn_temperature_gap(iso) -> None:
                           "(write '293.15 K', not '293.15')", DataWarning, stacklevel=3)
 
 
-def _master_names(structures) -> list:
+def master_names(structures) -> list:
     """The master functions asked for: structures of the library (names resolved as
     ``compare`` resolves them) and ``"spectrum"`` (:mod:`bayesfo.tts.spectrum`)."""
     from ..structures import resolve_structures

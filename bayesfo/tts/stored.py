@@ -8,7 +8,7 @@ Prony series follow from it as from a comparison.
     The joint posterior of the chosen master structure, as ``compare`` writes a structure's
     (draws of the master parameters, of every ``log10_aT_*`` and ``log10_bT_*`` and of the
     noise; the pointwise log-likelihood; the posterior predictive; the joint data) with the
-    attributes ``compare`` adds (:data:`NETCDF_FORMAT`), and in ``observed_data``:
+    attributes ``compare`` adds (:data:`~bayesfo.inference.results.NETCDF_FORMAT`), and in ``observed_data``:
     ``point_isotherm`` (the isotherm of each point, indexing ``summary.json["isotherms"]``) and
     ``sigma`` where the data carry σ.
 
@@ -23,8 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Version of the attributes the NetCDF carries (the same as ``compare``'s).
-NETCDF_FORMAT = 1
+from ..inference.results import NETCDF_FORMAT
 
 
 def netcdf_of(mc):

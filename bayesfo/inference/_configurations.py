@@ -10,7 +10,8 @@ configuration; the importance proposal and the guide of the tempered ladder are 
 and a ladder whose particles leave the plateau at one rung does not regain it: the
 differential-evolution moves cannot reach a region that no particle occupies, and the
 independence moves propose from mixtures fitted to where the particles already are. Two runs
-that agree can then both miss a tenth of the posterior (BENCHMARKS.md, "Nineteenth session").
+that agree can then both miss a tenth of the posterior (BENCHMARKS.md, "A region of the
+posterior that no optimum seeds").
 
 :func:`vanishing_slabs` looks for each such configuration from the highest optima: the
 coefficient held near its lower prior bound, the others maximised (a profile point, as the
@@ -150,7 +151,7 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
             # Where two springpots exchange roles (one vanishes, the other takes over with
             # nearly the same order), the profile's Newton and L-BFGS-B steps can stall in a
             # narrow curved valley, far below the valley's highest point: Nelder-Mead from where
-            # they ended (BENCHMARKS.md, "Nineteenth session": 112 nats below, then found).
+            # they ended (BENCHMARKS.md, "A region of the posterior that no optimum seeds").
             u, height, cross = _retried(log_prob, u, j, value, lo, hi)
         cross = _kept(log_prob, u, height, cross, j, lo, hi, top)
         if cross is None:

@@ -279,7 +279,7 @@ def _ladder_first(lik, seed: int, guide=None, slabs=(), reach: float = -math.inf
     of two runs whose particles share ancestors scatters enough on a broad posterior that two
     runs of the same posterior can fail the test by chance, and emcee, the next route, costs
     many times as much on the posteriors that reach it (undetermined orders; BENCHMARKS.md,
-    "Eighteenth session").
+    "The demo's Maxwell: a second pair of ladder runs").
 
     Returns (posterior, evidence, None, note), or (None, None, reason, None) when the runs
     disagree or the ladder fails: emcee then runs, and a ladder guided by its walkers. ``note``
@@ -350,7 +350,8 @@ def _shortfall(reach: float, ev: Evidence, what: str) -> str | None:
 #: draws on some parameter, beyond the share expected of draws from the same posterior
 #: (:func:`_expected_outside`), before the ladder's particles replace them. Ladders beside
 #: importance draws of the same posterior left about 1 % outside; importance posteriors that
-#: missed a configuration of the springpots left 13-45 % (BENCHMARKS.md, "Fifteenth session").
+#: missed a configuration of the springpots left far more (BENCHMARKS.md, "The ladder run for
+#: ln Z checks the importance draws").
 LADDER_MISSED = 0.03
 
 

@@ -15,7 +15,8 @@ leaves the box; the weights are then the posterior density in z (the density in 
 Jacobian |du/dz|) over the proposal's, so that their mean is still the evidence. The proposal
 stays in u wherever it keeps its draws: a coordinate that leans on a bound along a ridge is
 covered better there, by a component cut at the bound, than in z, where the curvature at the
-mode does not reach along the ridge (BENCHMARKS.md, twelfth session). An optimum on the edge
+mode does not reach along the ridge (BENCHMARKS.md, "the importance proposal in unbounded
+coordinates"). An optimum on the edge
 of the support inside the box (a coefficient at 0 where its element vanishes, two orders that
 meet) has no difference stencil around it: the curvature is taken a few (smaller) steps
 inside (:func:`~._peaks._inward`), and the component spills part of its draws over the edge,
@@ -105,7 +106,8 @@ NEWTON = 4
 #: The third round (:func:`_fitted`): draws resampled from the certified weights to fit the
 #: mixture to (k ≤ 4 components by BIC), and the scale of its Student-t components relative
 #: to the fitted covariances (broad: on misfitting structures of real isotherms, 1.6 gave
-#: k̂ < 0.5 where 1.0 and 1.3 often did not; BENCHMARKS.md, fourteenth session).
+#: k̂ < 0.5 where 1.0 and 1.3 often did not; BENCHMARKS.md, "ln Z where the first round's
+#: weights are heavy-tailed").
 FIT_DRAWS = 4000
 FIT_SCALE = 1.6
 SCALE = 1.5     # proposal scale relative to the Laplace covariance

@@ -185,7 +185,7 @@ def unique_rows(x: np.ndarray) -> np.ndarray:
     """The distinct rows of ``x`` (finite values) in lexicographic order: ``np.unique(x,
     axis=0)``, by a lexicographic sort of the columns instead of a sort of the rows as
     records, which is faster on the ladder's particles and guide draws (BENCHMARKS.md,
-    "Twenty-third session")."""
+    "The ladder's distinct rows")."""
     x = np.asarray(x)
     if len(x) < 2:
         return x.copy()

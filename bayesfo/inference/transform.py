@@ -41,7 +41,7 @@ class _Transform:
         """Rows of ``u`` (2-D) inside the prior box: the whole comparison at once for the
         small batches of the optimisers and certificates (fewer calls), column by column for
         a sampler's thousands of rows (fewer temporaries); the same decisions (BENCHMARKS.md,
-        "Twenty-fifth session")."""
+        "The constraint checks of small batches")."""
         if u.shape[0] <= BOX_ROWS:
             return ((u >= self.lo_u) & (u <= self.hi_u)).all(axis=1)
         ok = np.ones(u.shape[0], dtype=bool)

@@ -74,8 +74,8 @@ def _without_distributed():
     """Inside the block, dask's ``distributed`` cannot be imported unless it already was.
 
     xarray's ``to_netcdf`` asks dask which scheduler is active, and dask imports ``distributed``
-    (when installed) to look for a ``Client`` (about 0.2 s on a quiet machine, 1 s on a busy
-    one, in every command that writes NetCDF). A ``Client`` cannot exist in a process that never
+    (when installed) to look for a ``Client``, an import that costs every command that writes
+    NetCDF noticeable time. A ``Client`` cannot exist in a process that never
     imported the package, so the answer is the same without it: the import fails at once
     (``sys.modules`` entries ``None``) and xarray takes the scheduler for a local one. A process
     that has imported it (a batch on a Dask cluster) is left alone.

@@ -186,7 +186,7 @@ def density_1d(samples: np.ndarray, lo: float, hi: float, n_grid: int = 400):
     # Reflection keeps the mass that a kernel puts beyond a hard prior bound. Points farther
     # than KDE_REACH bandwidths from every draw get 0: each kernel is below exp(-50) of its
     # peak there. A narrow posterior on a wide prior leaves most of the even grid and of its
-    # reflections there (the q figure of two structures: 0.34 s → 0.06 s of kernel sums).
+    # reflections there, whose kernel sums are then skipped.
     points = np.concatenate([grid, 2 * lo - grid, 2 * hi - grid])
     near = (points >= x.min() - KDE_REACH * bw) & (points <= x.max() + KDE_REACH * bw)
     values = np.zeros(points.size)

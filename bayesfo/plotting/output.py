@@ -57,8 +57,8 @@ def save_figure(fig, path, *, close: bool = False, named: bool = False) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
-        # zlib level 1 for PNG: a quarter of the saving time less, files 8 % larger
-        # (BENCHMARKS.md, "Thirteenth session").
+        # zlib level 1 for PNG: less saving time for slightly larger files (BENCHMARKS.md,
+        # "PNG figures at zlib level 1").
         extra = {"pil_kwargs": {"compress_level": 1}} if path.suffix.lower() == ".png" else {}
         fig.savefig(tmp, dpi=200, **extra)
         publish(tmp, path)

@@ -130,7 +130,7 @@ MAX_TEXT_BYTES = 256 * 1024 * 1024
 # Invisible characters that no text data file holds: C0 and C1 control characters other than
 # tab, line feed and carriage return, DEL, and a byte-order mark after the start of the file
 # (files joined together). A NUL byte is the usual sign of a UTF-16 or binary file.
-_INVISIBLE = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ufeff]")
+INVISIBLE = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ufeff]")
 _LINE_BREAK = re.compile(r"\r\n|\r|\n")
 
 
@@ -187,7 +187,7 @@ def read_text_file(path: str | os.PathLike, what: str = "file",
         hint = " (it looks like UTF-16)" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else ""
         raise InputError(f"{where} is not a UTF-8 text file{hint}: undecodable byte at line "
                          f"{line}; save it as UTF-8 text") from None
-    bad = _INVISIBLE.search(text)
+    bad = INVISIBLE.search(text)
     if bad:
         line, char = text_position(text, bad.start())
         code = ord(bad.group())

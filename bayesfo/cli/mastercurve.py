@@ -139,13 +139,12 @@ def run(args) -> int:
     from ..options import parse_floats
     from ..outdir import check_output_directory
     from ..output import write_mastercurve
+    from ..parallel import check_workers
     from ..tts import mastercurve
     from ..tts.joint import master_names
     from ._libraries import load_libraries
 
-    if args.workers < 0:
-        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got "
-                         f"{args.workers}")
+    check_workers(args.workers)
     structures = master_names(args.structures)  # an unknown name fails before reading
     temperatures = (parse_floats(args.temperatures, "--temperatures")
                     if args.temperatures is not None else None)

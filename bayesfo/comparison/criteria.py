@@ -14,8 +14,8 @@ from ..data import FrequencyResponse
 from ..errors import InputError, PredictiveWarning
 from ..identify.optimize import FitResult
 from ..inference import Likelihood, PosteriorResult
-from ..inference._arviz import loo as psis_loo
-from ..inference._arviz import waic as waic_of
+from ..inference import loo as psis_loo
+from ..inference import waic as waic_of
 
 PARETO_K_WARN = 0.7
 

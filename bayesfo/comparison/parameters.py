@@ -44,7 +44,7 @@ def summarise_draws(values, map_value, unit: str) -> dict:
     the posterior summarises its parameters (94 % HDI by arviz). A draw at ±inf (an order at
     its bound makes a time overflow) leaves mean and sd undefined (NaN, null in JSON); the HDI
     and the median are those of all draws."""
-    from ..inference._arviz import hdi
+    from ..inference import hdi
 
     x = np.asarray(values, dtype=float).ravel()
     x = x[~np.isnan(x)]
@@ -187,7 +187,7 @@ def shown_hdi(summary: dict) -> tuple[float, float]:
 
 
 def _hdi(x):
-    from ..inference._arviz import hdi
+    from ..inference import hdi
 
     with np.errstate(invalid="ignore"):  # inf - inf among the candidate widths
         return hdi(x, HDI_PROB)

@@ -15,6 +15,7 @@ from ..errors import StructureError
 from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.results import HDI_PROB, draws_digest
+from ..predictions.draws import Draws, comparison_draws
 from ..structures import Structure
 from .criteria_types import Criteria
 from .parameters import (  # noqa: F401  (re-exported: the names results offered before)
@@ -402,6 +403,20 @@ class Comparison:
         return (f"ln Z treats the noise model as a nuisance (the mean of the evidences under "
                 f"{listed} noise, equal prior weights), so every structure is ranked on one "
                 "footing; each posterior is under its most probable noise model")
+
+    def draws(self, structure: str | None = None, average: str | None = None, *,
+              seed: int = 0, temperature: float | None = None) -> Draws:
+        """The posterior draws that predictions, Prony series and long-time moduli evaluate:
+        :data:`~bayesfo.predictions.draws.MAX_DRAWS` of ``structure`` (default the best
+        ranked), or of the ``average`` (``"bma"`` or ``"stacking"``) of the ranked structures.
+
+        Raises
+        ------
+        InputError
+            An unknown structure or average, both given, a structure without a posterior, or
+            a ``temperature`` (a comparison's draws are at the data's own).
+        """
+        return comparison_draws(self, structure, average, seed=seed, temperature=temperature)
 
     def predict(self, quantity: str, x, *, structure: str | None = None,
                 average: str | None = None, seed: int = 0):

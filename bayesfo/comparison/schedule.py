@@ -59,7 +59,7 @@ import warnings
 from concurrent.futures.process import BrokenProcessPool
 
 from ..errors import InputError
-from ..inference._arviz import preload
+from ..inference import preload_arviz
 from ..parallel import settle_worker
 from .early import EarlyFits
 from .results import StructureResult
@@ -70,7 +70,7 @@ def _task(step, *args):
     """One step in a worker: (value, InputError message or None, warnings as (category,
     message)). A worker process of a pool loads the ArviZ libraries at its first step and
     freezes its objects out of the garbage collector (:func:`~bayesfo.parallel.settle_worker`)."""
-    settle_worker(preload)
+    settle_worker(preload_arviz)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:

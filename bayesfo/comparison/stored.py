@@ -184,7 +184,7 @@ def _read_netcdf(path: Path, name: str, s: dict | None = None, n_frequencies=Non
     files (HDF5 external or virtual storage) is refused."""
     import stat
 
-    from ..inference._arviz import external_storage, group_names, open_tree
+    from ..inference import external_storage, group_names, open_tree
 
     try:
         info = path.stat()

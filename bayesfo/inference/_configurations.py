@@ -117,9 +117,9 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
     noise parameter where ``lik`` has one); ``guide_u``: draws that already cover the posterior
     as far as they reach (a configuration whose plateau holds :data:`COVERED` of them gives no
     slab). Deterministic: no random step."""
-    from .transform import _log_prob_fn, _Transform
+    from .transform import Transform, _log_prob_fn
 
-    tr = _Transform(lik)
+    tr = Transform(lik)
     log_prob = _log_prob_fn(lik, tr)
     modes_u = np.atleast_2d(np.asarray(modes_u, dtype=float))
     heights = log_prob(modes_u)
@@ -299,7 +299,7 @@ def configurations(lik, modes_scaled, guide_u=None) -> list:
     where ``lik`` has one); [] where the search fails numerically, and for posteriors of more
     than :data:`~._ridge.PROBE_MAX_DIM` parameters (each profile point maximises over all the
     others, as the ridge probe's: the joint master-curve posteriors are not searched)."""
-    from .transform import _Transform
+    from .transform import Transform
 
     modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
     if modes.size == 0 or lik.ndim > PROBE_MAX_DIM:
@@ -308,7 +308,7 @@ def configurations(lik, modes_scaled, guide_u=None) -> list:
         modes = np.column_stack([modes, lik.noise_estimate(modes)])
     try:
         with np.errstate(all="ignore"):
-            return vanishing_slabs(lik, _Transform(lik).to_u(modes), guide_u)
+            return vanishing_slabs(lik, Transform(lik).to_u(modes), guide_u)
     except (np.linalg.LinAlgError, FloatingPointError, ValueError):
         return []
 
@@ -334,10 +334,10 @@ def missed_share(lik, slabs, draws_u: np.ndarray, log_z_support: float, seed: in
     they represent it."""
     from scipy.special import logsumexp
 
-    from .transform import _log_prob_fn, _Transform
+    from .transform import Transform, _log_prob_fn
 
     rng = np.random.default_rng([seed, 19])
-    log_prob = _log_prob_fn(lik, _Transform(lik))
+    log_prob = _log_prob_fn(lik, Transform(lik))
     n = len(slabs)
     which = rng.integers(n, size=MISSED_DRAWS)
     x = np.empty((MISSED_DRAWS, draws_u.shape[1]))

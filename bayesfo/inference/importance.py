@@ -193,11 +193,11 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
     """
     from .evidence import Evidence, log_support_fraction
     from .results import result_from_draws
-    from .transform import _Transform
+    from .transform import Transform
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)
     if isinstance(out, dict):
         return None, None, out
@@ -540,10 +540,10 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
     :data:`UNDETERMINED`; "" if none), for which the importance route will not certify the
     posterior whatever k̂.
     """
-    from .transform import _Transform
+    from .transform import Transform
 
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)
     if isinstance(out, dict):
         return None

@@ -50,7 +50,7 @@ from scipy.special import logsumexp
 from ..errors import InputError
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
-from .transform import _log_parts_fn, _Transform
+from .transform import Transform, _log_parts_fn
 
 #: A rung whose moves leave fewer distinct particles than this many per dimension (of the
 #: 1000) ends the run with an error: the population has collapsed (see :func:`ladder_run`).
@@ -89,7 +89,7 @@ class _Target:
 
     def __init__(self, lik: Likelihood):
         self.lik = lik
-        self.tr = _Transform(lik)
+        self.tr = Transform(lik)
         self._parts = _log_parts_fn(lik, self.tr)
         self._box_parts = _log_parts_fn(lik, self.tr, constraints=False)
 

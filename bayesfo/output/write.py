@@ -119,7 +119,7 @@ def preload(formats=()) -> None:
     import scipy.special  # noqa: F401
     import scipy.stats  # noqa: F401
 
-    from ..inference._arviz import preload as preload_arviz
+    from ..inference import preload_arviz
 
     preload_arviz()
     if formats:

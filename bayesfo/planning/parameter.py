@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..tts.result import MasterCurve
 from .choice import (
     N_CANDIDATES,
     N_DRAWS,
@@ -112,7 +113,7 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
     if parameter not in post.param_names[: r.structure.n_params]:
         raise InputError(f"design: structure {name} has no parameter '{parameter}'; its "
                          f"parameters are {', '.join(post.param_names[: r.structure.n_params])}")
-    if hasattr(result, "shift_draws"):
+    if isinstance(result, MasterCurve):
         raise InputError("design: a master curve is not a comparison of structures; design "
                          "on a comparison (e.g. of the master curve's master_data())")
     data = result.data

@@ -7,6 +7,8 @@ import numpy as np
 
 from ..data.symbols import parts as parts_of
 from ..data.symbols import response_symbol
+from ..predictions import evaluate
+from ..structures import get_structure
 from ..structures.physical import in_brackets
 from ._base import Drawn, new_figure
 from .style import temperature_colormap
@@ -27,8 +29,6 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     """
     import matplotlib as mpl
 
-    from ..predictions import evaluate
-    from ..structures import get_structure
 
     fig = new_figure(fig, (11.0, 3.8))
     axes = fig.subplots(1, 3)
@@ -177,8 +177,6 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
     """
     import matplotlib as mpl
 
-    from ..predictions.functions import _evaluate
-    from ..structures import get_structure
     from ..tts.joint import ISOTHERM_MISFIT
 
     fig = new_figure(fig, (11.0, 3.6))
@@ -201,7 +199,7 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
         shifts = mc.shift_draws[rows, i]
         w = d.omega[None, :] * 10.0 ** shifts[:, None]
         quantity = ("storage", "loss") if modulus else ("storage_compliance", "loss_compliance")
-        parts = [_evaluate(structure, theta, q, w) for q in quantity]
+        parts = [evaluate(structure, theta, q, w) for q in quantity]
         if vertical is not None:  # the model of the isotherm: the master divided by b_T
             scale = 10.0 ** (-vertical[:, i] if modulus else vertical[:, i])
             parts = [p * scale[:, None] for p in parts]

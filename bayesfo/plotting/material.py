@@ -55,7 +55,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
     InputError
         For generic (transfer-function) data, or an unknown or failed structure.
     """
-    from ..predictions.functions import _unit, evaluate_together
+    from ..predictions.functions import evaluate_together, quantity_unit
 
     data = comparison.data
     if data.kind not in ("modulus", "compliance"):
@@ -89,7 +89,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
         for ax, q in zip(axes, quantities, strict=True):
             ax.set_xscale("log")
             ax.set_yscale("log")
-            u = _unit(q, data) if data.units else ""
+            u = quantity_unit(q, data) if data.units else ""
             ax.set_ylabel(symbols[q] + (f" [{u}]" if u else ""))
             lo, hi = t[0], t[-1]
             ax.axvspan(lo, window[0], **EXTRAPOLATED)

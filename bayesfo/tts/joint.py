@@ -522,8 +522,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
 
     from ..identify.optimize import fit_structure
     from ..inference import Likelihood, certified_posterior
-    from ..inference._arviz import preload
-    from ..inference.transform import _Transform
+    from ..inference import preload_arviz as preload
+    from ..inference.transform import Transform as _Transform
     from ..parallel import settle_worker
     from ..structures import Scaling, get_structure
     from ..structures.response import dissipation_grid

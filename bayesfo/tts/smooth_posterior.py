@@ -80,7 +80,7 @@ class ShiftPosterior:
     def undetermined(self) -> list[int]:
         """The isotherms whose log10 a_T the data do not fix (94 % interval wider than
         :data:`UNDETERMINED` decades)."""
-        from ..inference._arviz import hdi_columns
+        from ..inference import hdi_columns
 
         lo, hi = hdi_columns(self.shift_draws, 0.94)
         return [i for i in range(lo.size) if i != self.model.reference
@@ -252,7 +252,7 @@ def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
     from scipy.special import logsumexp
     from scipy.stats import multivariate_t
 
-    from ..inference._arviz import psis
+    from ..inference import psis
 
     rng = np.random.default_rng(seed)
     bounds = model.bounds
@@ -318,7 +318,7 @@ def _emcee(model: SmoothMaster, u_map, cov, max_ll: float, seed: int, messages: 
     """The posterior by emcee (vectorised), walkers started around the maximum."""
     import emcee
 
-    from ..inference._arviz import ess_min, rhat_max
+    from ..inference import ess_min, rhat_max
 
     rng = np.random.default_rng(seed)
     bounds = model.bounds

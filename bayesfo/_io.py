@@ -11,6 +11,8 @@ import stat
 import tempfile
 from pathlib import Path
 
+from .errors import InputError
+
 
 def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8", *,
                       named: bool = False) -> Path:
@@ -144,8 +146,6 @@ def read_text_file(path: str | os.PathLike, what: str = "file",
     tab and line breaks, or a byte-order mark after the start); the first such character is named
     by line and character position.
     """
-    from .errors import InputError
-
     where = f"{what} '{path}'"
     try:
         info = os.stat(path)
@@ -220,8 +220,6 @@ def csv_cells(line: str, where: str, lineno: int, delimiter: str = ",",
               delimiter_name: str = "comma") -> list[str]:
     """The cells of one delimited line (comma-separated by default), or an InputError naming the
     file and line."""
-    from .errors import InputError
-
     try:
         return next(csv.reader([line], delimiter=delimiter), [])
     except csv.Error as exc:

@@ -10,7 +10,7 @@ from concurrent.futures import FIRST_COMPLETED, wait
 
 from ..errors import InputError, OutputError
 from ..outdir import check_output_directory
-from ..parallel import check_workers
+from ..parallel import check_workers, new_pool, terminate, worker_environment
 from .store import BatchResult, Outcome, _lost, _store, _stored_rows, write_batch_outputs
 from .task import INPUT_ERROR, OK, run_task
 
@@ -29,7 +29,6 @@ def _run_pool(todo, workers, on_result, task=run_task) -> list:
     exception."""
     from concurrent.futures.process import BrokenProcessPool
 
-    from ..parallel import new_pool, terminate, worker_environment
 
     broken = []
     with worker_environment():  # processes are spawned while tasks are submitted

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..data import MAX_FREQUENCIES, FrequencyResponse
 from ..errors import DataWarning, InputError
+from ..inference.posterior import sample_posterior
 from ..options import check_prior_names, check_routes, check_sampler_settings
 from ..parallel import LazyPool, check_workers, executor, runs_here, single_blas_thread
 from ..structures import resolve_structures
@@ -165,7 +166,6 @@ def _check_sampler_options(options: dict) -> None:
     """A misspelt sampler option fails here, before any work, not inside a worker."""
     import inspect
 
-    from ..inference.posterior import sample_posterior
 
     known = [n for n, p in inspect.signature(sample_posterior).parameters.items()
              if p.kind is p.KEYWORD_ONLY and n not in ("seed", "progress")]

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .._io import INVISIBLE, csv_cells, parse_number, read_text_file, show, text_position
-from ..errors import InputError
+from ..errors import DataWarning, InputError
 from .units import looks_like_unit
 
 #: Delimiters the reader recognises, with the names it reports.
@@ -393,7 +393,6 @@ def _openpyxl_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
 
     import openpyxl
 
-    from ..errors import DataWarning
 
     try:
         book = openpyxl.load_workbook(path, read_only=True, data_only=True)

@@ -37,7 +37,10 @@ from functools import cached_property
 
 import numpy as np
 
+from ._mixture import _GaussianMixture
+from ._peaks import _hessian
 from ._ridge import PROBE_MAX_DIM, _profile_point
+from .transform import Transform, _log_prob_fn
 
 #: Where a coefficient is held to find the configuration in which its element vanishes: this
 #: share of its prior range (in the sampling coordinates) above its lower bound.
@@ -117,8 +120,6 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
     noise parameter where ``lik`` has one); ``guide_u``: draws that already cover the posterior
     as far as they reach (a configuration whose plateau holds :data:`COVERED` of them gives no
     slab). Deterministic: no random step."""
-    from .transform import Transform, _log_prob_fn
-
     tr = Transform(lik)
     log_prob = _log_prob_fn(lik, tr)
     modes_u = np.atleast_2d(np.asarray(modes_u, dtype=float))
@@ -191,8 +192,6 @@ def _cross_section(log_prob, u: np.ndarray, j: int, lo, hi):
     curvature (the order of the element that vanished, which the data no longer see) get a
     variance that spreads over the prior box, as in the importance route's Laplace
     approximations. None where the difference stencil leaves the support."""
-    from ._peaks import _hessian
-
     rest = np.delete(np.arange(u.size), j)
     span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u))[rest]
     h = 1e-4 * span
@@ -255,8 +254,6 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
     :data:`SLAB_SCALE`) and the step along the crest; weighted by their Laplace masses. A
     :class:`~bayesfo.inference._mixture._GaussianMixture`, or None where no point is within
     :data:`DEPTH` of ``top`` or the way is empty."""
-    from ._mixture import _GaussianMixture
-
     if not mode[j] > end:
         return None
     d = start.size
@@ -299,8 +296,6 @@ def configurations(lik, modes_scaled, guide_u=None) -> list:
     where ``lik`` has one); [] where the search fails numerically, and for posteriors of more
     than :data:`~._ridge.PROBE_MAX_DIM` parameters (each profile point maximises over all the
     others, as the ridge probe's: the joint master-curve posteriors are not searched)."""
-    from .transform import Transform
-
     modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
     if modes.size == 0 or lik.ndim > PROBE_MAX_DIM:
         return []
@@ -334,7 +329,6 @@ def missed_share(lik, slabs, draws_u: np.ndarray, log_z_support: float, seed: in
     they represent it."""
     from scipy.special import logsumexp
 
-    from .transform import Transform, _log_prob_fn
 
     rng = np.random.default_rng([seed, 19])
     log_prob = _log_prob_fn(lik, Transform(lik))

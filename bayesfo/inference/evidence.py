@@ -35,7 +35,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
-from ._arviz import psis
+from ._arviz import ess_draws, psis
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .results import PosteriorResult, exponent_intervals
@@ -153,8 +153,6 @@ def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_
 
 def _ess(x: np.ndarray) -> float:
     """Effective size of the draws (walker-major rows) of a scalar, by arviz."""
-    from ._arviz import ess_draws
-
     return ess_draws(x)
 
 

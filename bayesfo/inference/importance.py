@@ -74,11 +74,13 @@ from scipy.special import logsumexp
 
 from ..errors import InputError
 from ._arviz import psis
+from ._mixture import _GaussianMixture
 from ._peaks import DF, _laplace, _mixture_log_pdf, _polished
 from ._ridge import PROBE_MAX_DIM, PROBE_MISSED, _ridge_probe
+from .evidence import Evidence, log_support_fraction
 from .likelihood import Likelihood
-from .results import exponent_intervals
-from .transform import _Unbounded
+from .results import exponent_intervals, result_from_draws
+from .transform import Transform, _log_prob_fn, _Unbounded
 
 #: Certificate of the importance weights: Pareto k̂ below this (Vehtari et al.'s threshold of
 #: reliable estimates) and at least this many effective draws.
@@ -191,10 +193,6 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
         where its k̂ < 0.5 (see :data:`K_HAT_EVIDENCE`; else the evidence is None). The
         posterior's ESS is that of the resampled draws, 1/(1/ESS_weights + 1/n_draws).
     """
-    from .evidence import Evidence, log_support_fraction
-    from .results import result_from_draws
-    from .transform import Transform
-
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
     tr = Transform(lik)
@@ -369,8 +367,6 @@ def _weights(lik: Likelihood, tr, modes_scaled, n_proposals: int, rng: np.random
     of the box, such as an order at 0, spills half of its component over it), it is built again
     in the unbounded coordinates of :class:`~.transform._Unbounded`, from new draws, with the
     weights in those coordinates (see :func:`_proposal`)."""
-    from .transform import _log_prob_fn
-
     log_prob = _log_prob_fn(lik, tr)
     modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
     if modes.size == 0:
@@ -460,8 +456,6 @@ def _fitted(assessed, n_proposals: int, rng: np.random.Generator):
     :data:`FIT_SCALE` times the component's covariance, in the coordinates of the certified
     round's proposal. The mixture follows a skewed or curved posterior that one Laplace
     approximation or one matched component does not. None where the fit fails."""
-    from ._mixture import _GaussianMixture
-
     out, _, _, w, _ = assessed
     _, _, finite, n_modes, prop = out
     zs = prop["z"][finite]
@@ -518,8 +512,6 @@ def _adapted(first, n_proposals: int, rng: np.random.Generator):
 
 
 def _log_support(lik, rng):
-    from .evidence import log_support_fraction
-
     return log_support_fraction(lik, rng, n=5000, max_draws=5000)
 
 
@@ -540,8 +532,6 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
     :data:`UNDETERMINED`; "" if none), for which the importance route will not certify the
     posterior whatever k̂.
     """
-    from .transform import Transform
-
     rng = np.random.default_rng(seed)
     tr = Transform(lik)
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)

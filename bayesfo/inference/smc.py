@@ -48,6 +48,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
+from ..parallel import Helper, SpareCPU
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .transform import Transform, _log_parts_fn
@@ -308,8 +309,6 @@ def _drive(target: _Target, runs: list) -> list:
     their results back; a run's result does not depend on the runs it is advanced with, so the
     numbers are the same. Where the helper fails, the runs go on here from where it took them.
     """
-    from ..parallel import Helper, SpareCPU
-
     out = [None] * len(runs)
     pending = {}
 

@@ -19,7 +19,7 @@ from .._io import atomic_write_text
 from ..comparison.results import Comparison
 from ..comparison.stored import netcdf_for
 from ..comparison.table import RANKING_FIELDS
-from ..inference import save_netcdf
+from ..inference import preload_arviz, save_netcdf
 from ..options import STRUCTURE_FIGURES
 from ..outdir import final_path, staged_run
 from ..tts.result import MasterCurve
@@ -119,7 +119,6 @@ def preload(formats=()) -> None:
     import scipy.special  # noqa: F401
     import scipy.stats  # noqa: F401
 
-    from ..inference import preload_arviz
 
     preload_arviz()
     if formats:

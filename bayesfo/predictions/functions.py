@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.symbols import in_symbol
 from ..errors import InputError
 from . import laplace
 from .draws import AVERAGES, MAX_DRAWS, Draws  # noqa: F401  (AVERAGES, MAX_DRAWS: named here too)
@@ -448,8 +449,6 @@ def _outside(x, domain: str, omega) -> np.ndarray:
 
 def _symbol(quantity: str, data) -> str:
     """The quantity's symbol in the data's letters (E′ for a tensile modulus)."""
-    from ..data.symbols import in_symbol
-
     return in_symbol(QUANTITIES[quantity][1], getattr(data, "symbol", "G"))
 
 

@@ -46,6 +46,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..data.symbols import modulus_symbol
 from ..errors import InputError
 from .decks import (  # noqa: F401  (the formats and constants of the decks, named here too)
     DIGITS,
@@ -164,8 +165,6 @@ class Prony:
         return bool(self.band_fraction <= 1.0)
 
     def __repr__(self) -> str:
-        from ..data.symbols import modulus_symbol
-
         e = modulus_symbol(self.symbol)
         unit = unit_suffix(self.unit)
         band = ("inside" if self.inside_band else "outside") if not math.isnan(
@@ -211,8 +210,6 @@ class Prony:
 
     def error_text(self) -> list[str]:
         """The stated errors, each named for what it measures, and the band."""
-        from ..data.symbols import modulus_symbol
-
         e = modulus_symbol(self.symbol)
         error = max(self.max_rel_error_modulus, self.max_rel_error_relaxation)
         lines = [f"max_rel_error = {error:.3g}: the larger of max |d{e}(t)|/{e}(t) and "
@@ -270,8 +267,6 @@ class Prony:
         more than :data:`EXTRAPOLATED` times above the largest measured |G*|; empty otherwise."""
         if not self.g_0 > EXTRAPOLATED * self.measured_max:
             return []
-        from ..data.symbols import modulus_symbol
-
         e = modulus_symbol(self.symbol)
         return [f"{e}0 is the model's modulus {TAU_MARGIN} decades past the highest measured "
                 f"frequency, {self.g_0 / self.measured_max:.3g} x the largest measured |{e}*| "

@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._io import show
+from ..data.symbols import parameter_label
 from ..errors import StructureError
 from .expressions import Expr
 from .network import Network
@@ -222,8 +223,6 @@ def display_name(name: str, symbol: str = "G") -> str:
     >>> display_name("G_m", "E"), display_name("G_m", "G"), display_name("c_q", "E")
     ('E_m', 'G_m', 'c_q')
     """
-    from ..data.symbols import parameter_label
-
     return parameter_label(name, symbol)
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..inference.results import NETCDF_FORMAT
+from .spectrum import Spectrum
 
 
 def netcdf_of(mc):
@@ -46,8 +47,6 @@ def netcdf_of(mc):
 def summary_fields(mc) -> dict:
     """The blocks of ``summary.json`` that restore the master curve: ``"isotherms"`` and
     ``"posterior"``."""
-    from .spectrum import Spectrum
-
     post = mc.posterior
     out = {"isotherms": [{"temperature": t, "name": d.label, "n_frequencies": d.n_frequencies}
                          for t, d in zip(mc.temperatures, mc.isotherms, strict=True)],

@@ -130,3 +130,64 @@ def test_every_layer_imports_only_the_layers_before_it():
             if other != top and rank[other] > rank[top]:
                 upward.append(f"{module} ({top}) imports {target} ({other})")
     assert upward == []
+
+
+#: Most imports of the package's own modules inside functions, outside the package face
+#: (``bayesfo/__init__.py``, which loads its names on first use) and the command line (which
+#: imports the computing modules when a command runs). The rest load at the top of their
+#: module; those left inside functions each load libraries that their module does not (scipy's
+#: optimisers, ArviZ, matplotlib for figures), or are in the master-curve modules being
+#: rewritten (tts.joint, tts.conditional, tts.smooth_posterior, tts.shifts: 30 of them). The
+#: goal is under 40.
+MAX_FUNCTION_LEVEL_IMPORTS = 70
+
+
+def _lazy_allowed(module: str) -> bool:
+    return module == "bayesfo" or module == "bayesfo.cli" or module.startswith("bayesfo.cli.")
+
+
+def _inside_functions():
+    """(module, line, the module imported) of every import of a package module inside a
+    function, and (module, name imported, from) of every private name or private module
+    imported from another top-level package (``bayesfo.inference._arviz`` from
+    ``bayesfo.tts``; the root's ``_io``, ``_text`` and ``_signals`` are modules of every
+    layer, their private names are not)."""
+    inside, private = [], []
+    for name, path in MODULES.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+
+        def visit(node, in_function):
+            for child in ast.iter_child_nodes(node):
+                function = in_function or isinstance(child, (ast.FunctionDef,
+                                                             ast.AsyncFunctionDef))
+                if isinstance(child, ast.If) and getattr(child.test, "id", "") == "TYPE_CHECKING":
+                    continue
+                if isinstance(child, ast.ImportFrom) and (child.level or (child.module or "")
+                                                          .startswith("bayesfo")):
+                    base = child.module or ""
+                    if child.level:
+                        up = package.split(".")[: len(package.split(".")) - child.level + 1]
+                        base = ".".join(up + ([child.module] if child.module else []))
+                    if in_function and not _lazy_allowed(name):
+                        inside.append((name, child.lineno, base))
+                    other = _top(base)
+                    if other and other != _top(name):
+                        for alias in child.names:
+                            hidden = alias.name.startswith("_") and not alias.name.startswith("__")
+                            if hidden or any(p.startswith("_") for p in base.split(".")[2:]):
+                                private.append((name, f"{base}.{alias.name}"))
+                visit(child, function)
+
+        visit(ast.parse(path.read_text()), False)
+    return inside, private
+
+
+INSIDE, PRIVATE = _inside_functions()
+
+
+def test_the_package_modules_are_imported_at_the_top_of_a_module():
+    assert len(INSIDE) <= MAX_FUNCTION_LEVEL_IMPORTS, sorted(INSIDE)
+
+
+def test_no_private_name_is_imported_from_another_package():
+    assert PRIVATE == []

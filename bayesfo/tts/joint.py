@@ -39,6 +39,7 @@ import numpy as np
 
 from ..data import FrequencyResponse
 from ..errors import InputError
+from ..parallel import check_workers
 from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F401
 from .laws import _fit_laws
 from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
@@ -143,8 +144,10 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     ------
     InputError
         Fewer than two isotherms, a missing or repeated temperature, isotherms of different
-        kinds or units, a reference temperature without an isotherm.
+        kinds or units, a reference temperature without an isotherm, an unknown option, or
+        ``workers`` not a non-negative integer.
     """
+    check_workers(workers)  # before the isotherms are read and the model-free master runs
     if vertical not in ("auto", *VERTICAL):
         raise InputError(f"vertical must be one of auto, {', '.join(VERTICAL)}, got "
                          f"{vertical!r}")

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..data import MAX_FREQUENCIES, FrequencyResponse
 from ..errors import DataWarning, InputError
+from ..inference.likelihood import zero_part
 from ..inference.posterior import sample_posterior
 from ..options import check_prior_names, check_routes, check_sampler_settings
 from ..parallel import LazyPool, check_workers, executor, runs_here, single_blas_thread
@@ -116,7 +117,6 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
                          "has no scale; remove the point or give sigma")
     if noise == "relative_parts":
         # The relative error of a real or imaginary part that is exactly 0 has no scale either.
-        from ..inference.likelihood import zero_part
         if (why := zero_part(data)) is not None:
             raise InputError(why)
     held_out = None

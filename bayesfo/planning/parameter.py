@@ -4,11 +4,12 @@
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import DataWarning, InputError
 from ..tts.result import MasterCurve
 from .choice import (
     N_CANDIDATES,
@@ -99,10 +100,6 @@ def design_parameter(result, parameter: str, *, structure: str | None = None, wi
     w_lo, w_hi = _checked(result.data, window, points, cost)
     w_lo, w_hi, cut = capped_window(result.data, w_lo, w_hi)
     if cut is not None:
-        import warnings
-
-        from ..errors import DataWarning
-
         warnings.warn(cut, DataWarning, stacklevel=2)
     name = structure or (result.ranking[0] if result.ranking else None)
     if name not in result.ranking:

@@ -72,6 +72,10 @@ class ShiftPosterior:
     ess: float
     converged: bool
     messages: tuple[str, ...] = ()
+    #: What each isotherm's own points tell of its shift, where it was not ``model``'s
+    #: (:meth:`SmoothMaster.shift_information`; a posterior averaged over vertical options
+    #: takes the heaviest option's).
+    information: np.ndarray | None = None
 
     @property
     def shift_draws(self) -> np.ndarray:
@@ -92,7 +96,8 @@ class ShiftPosterior:
 
         lo, hi = hdi_columns(self.shift_draws, 0.94)
         if self.model.law == "free":
-            info = self.model.shift_information(self.map_theta)
+            info = (self.model.shift_information(self.map_theta) if self.information is None
+                    else self.information)
             with np.errstate(divide="ignore"):
                 own = 2.0 * 1.881 / np.sqrt(info)  # the 94 % normal interval's width
         else:  # a law ties the shifts: each one's own points do not set it
@@ -137,13 +142,16 @@ class _TMixture:
         from ..inference import GaussianMixture
 
         pick = x[rng.choice(x.shape[0], size=DRAWS, replace=True, p=w)]
-        unique = np.unique(pick, axis=0)
-        if unique.shape[0] < 5 * x.shape[1]:  # too few distinct draws for a covariance
-            mean = w @ x
-            shape = _well_conditioned(WIDEN * np.cov(x, rowvar=False, aweights=w))
-            return cls([1.0 - defensive, defensive], [mean, laplace[0]],
-                       [shape, laplace[1]], rng)
-        fit = GaussianMixture.fit(pick, rng)
+        fallback = cls([1.0 - defensive, defensive], [w @ x, laplace[0]],
+                       [4.0 * laplace[1], laplace[1]], rng)
+        if np.unique(pick, axis=0).shape[0] < 5 * x.shape[1]:
+            return fallback  # too few distinct draws for a covariance: Laplace's, widened
+        try:
+            fit = GaussianMixture.fit(pick, rng)
+        except np.linalg.LinAlgError:
+            fit = None
+        if fit is None:
+            return fallback
         shapes = [_well_conditioned(WIDEN * (c @ c.T)) for c in fit.chols]
         return cls(list((1.0 - defensive) * fit.weights) + [defensive],
                    list(fit.means) + [laplace[0]], shapes + [laplace[1]], rng)

@@ -49,9 +49,11 @@ class Shifts:
     Attributes
     ----------
     posterior : ShiftPosterior
-        Of the model chosen.
+        Of the model chosen (a mixture where the shifts are averaged over vertical options).
     vertical, law, noise : str
-        The model chosen.
+        The model chosen; ``vertical`` is ``"free"`` where the shifts are averaged over
+        several vertical options (its draws then hold each option's values; the notes say
+        which, with their probabilities).
     vertical_evidence, law_evidence : dict
         ``{option: {"log_evidence", "log_evidence_err", "probability", "certified",
         "sampler"}}`` of the options weighed (``log_evidence_upper`` and

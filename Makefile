@@ -5,6 +5,9 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 DOCS_STAMP := $(VENV)/.docs-stamp
 DEMO_OUT ?= demo-output
+# The default suite runs its test files on two processes (pytest-xdist; one file stays on one
+# process, so its module fixtures are computed once). XDIST= runs them in this process.
+XDIST ?= -n 2 --dist loadfile
 
 .PHONY: help venv test test-unit test-slow test-all test-plain demo bench docs clean
 
@@ -27,7 +30,7 @@ venv: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check bayesfo tests benchmarks examples
-	MPLBACKEND=Agg $(BIN)/python -m pytest -m "not slow" -q --durations=15
+	MPLBACKEND=Agg $(BIN)/python -m pytest -m "not slow" -q --durations=15 $(XDIST)
 
 test-unit: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -m "not slow" -q --durations=10 tests/unit

@@ -45,7 +45,8 @@ from .errors import BayesfoError, InputError, NonlinearityWarning, OutputError, 
 #: nor scipy: ``bayesfo --help`` stays fast, and a Ctrl-C while the command line's libraries
 #: load reaches :func:`bayesfo.cli.main`, which says "interrupted" in one line (it gave a
 #: traceback of 30 to 50 lines while ``import bayesfo`` loaded scipy).
-_LAZY = {"compare": "comparison", "write_outputs": "output", "load": "comparison",
+_LAZY = {"compare": "comparison", "write_outputs": "output", "write_mastercurve": "output",
+         "load": "comparison",
          "Comparison": "comparison", "StructureResult": "comparison", "Criteria": "comparison",
          "predict": "predictions", "Prediction": "predictions",
          "mastercurve": "tts", "MasterCurve": "tts", "design": "planning", "Design": "planning",
@@ -86,6 +87,7 @@ __all__ = [
     "mastercurve",
     "predict",
     "read",
+    "write_mastercurve",
     "write_outputs",
     "FrequencyResponse",
     "InputError",

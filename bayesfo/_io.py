@@ -11,6 +11,8 @@ import stat
 import tempfile
 from pathlib import Path
 
+from .errors import InputError
+
 
 def atomic_write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8", *,
                       named: bool = False) -> Path:
@@ -130,7 +132,7 @@ MAX_TEXT_BYTES = 256 * 1024 * 1024
 # Invisible characters that no text data file holds: C0 and C1 control characters other than
 # tab, line feed and carriage return, DEL, and a byte-order mark after the start of the file
 # (files joined together). A NUL byte is the usual sign of a UTF-16 or binary file.
-_INVISIBLE = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ufeff]")
+INVISIBLE = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ufeff]")
 _LINE_BREAK = re.compile(r"\r\n|\r|\n")
 
 
@@ -144,8 +146,6 @@ def read_text_file(path: str | os.PathLike, what: str = "file",
     tab and line breaks, or a byte-order mark after the start); the first such character is named
     by line and character position.
     """
-    from .errors import InputError
-
     where = f"{what} '{path}'"
     try:
         info = os.stat(path)
@@ -187,7 +187,7 @@ def read_text_file(path: str | os.PathLike, what: str = "file",
         hint = " (it looks like UTF-16)" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else ""
         raise InputError(f"{where} is not a UTF-8 text file{hint}: undecodable byte at line "
                          f"{line}; save it as UTF-8 text") from None
-    bad = _INVISIBLE.search(text)
+    bad = INVISIBLE.search(text)
     if bad:
         line, char = text_position(text, bad.start())
         code = ord(bad.group())
@@ -220,8 +220,6 @@ def csv_cells(line: str, where: str, lineno: int, delimiter: str = ",",
               delimiter_name: str = "comma") -> list[str]:
     """The cells of one delimited line (comma-separated by default), or an InputError naming the
     file and line."""
-    from .errors import InputError
-
     try:
         return next(csv.reader([line], delimiter=delimiter), [])
     except csv.Error as exc:

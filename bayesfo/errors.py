@@ -21,12 +21,42 @@ class InputError(BayesfoError, ValueError):
     ----------
     command_line : str or None
         The same message in the words of the command line (``--block 2`` where the message says
-        ``block=2``), where the two differ; the command line prints it instead of the message.
+        ``block=2``), where the two differ and :attr:`option` cannot say how; the command line
+        prints it instead of the message.
+    option : str or None
+        The argument of the API the message is about (``"workers"``, ``"window"``), where it
+        names one as ``argument 'window'`` or at its start (``workers must be ...``); the
+        command line says its flag instead (``--workers``, ``--window``: :meth:`in_command_line`).
+    where : str or None
+        The API function that raised it (``"predict"``), which the message starts with
+        (``predict: ...``); the command line, which names the command already, leaves it out.
     """
 
-    def __init__(self, *args, command_line: str | None = None):
+    def __init__(self, *args, command_line: str | None = None, option: str | None = None,
+                 where: str | None = None):
         super().__init__(*args)
         self.command_line = command_line
+        self.option = option
+        self.where = where
+
+    def in_command_line(self, flags: dict | None = None) -> str:
+        """The message in the words of the command line: :attr:`command_line` where given,
+        else the message without its function's name (:attr:`where`) and with the option
+        (:attr:`option`) as its flag: ``flags[option]`` where given, else the option's name
+        (``argument 'per_decade'`` → ``--per-decade``)."""
+        # getattr: a subclass may set its attributes without this class's __init__.
+        if getattr(self, "command_line", None):
+            return self.command_line
+        text, where, option = str(self), getattr(self, "where", None), getattr(self, "option", None)
+        if where and text.startswith(f"{where}: "):
+            text = text[len(where) + 2:]
+        if option:
+            flag = (flags or {}).get(option) or "--" + option.replace("_", "-")
+            if f"argument '{option}'" in text:
+                return text.replace(f"argument '{option}'", flag, 1)
+            if text.startswith(f"{option} "):
+                return flag + text[len(option):]
+        return text
 
 
 class StructureError(InputError):

@@ -157,15 +157,8 @@ def check_options(options: dict, where: str) -> dict:
     opts = {**DEFAULT_OPTIONS, **options}
     if opts["kind"] is not None and opts["kind"] not in KINDS:
         raise InputError(f"{where}: kind must be one of {', '.join(KINDS)}, got {opts['kind']!r}")
-    if opts["evidence"] not in EVIDENCE_ROUTES:
-        raise InputError(f"{where}: evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
-                         f"got {opts['evidence']!r}")
-    if opts["sampler"] not in SAMPLERS:
-        raise InputError(f"{where}: sampler must be one of {', '.join(SAMPLERS)}, "
-                         f"got {opts['sampler']!r}")
-    if opts["sample"] not in SAMPLE:
-        raise InputError(f"{where}: sample must be one of {', '.join(SAMPLE)}, "
-                         f"got {opts['sample']!r}")
+    check_routes(opts["sampler"], opts["evidence"], where)
+    check_sample(opts["sample"], where)
     if opts["noise"] not in NOISE_MODELS:
         raise InputError(f"{where}: noise must be one of {', '.join(NOISE_MODELS)}, "
                          f"got {opts['noise']!r}")
@@ -221,6 +214,67 @@ MAX_SEED = 2**32 - 1
 MAX_WALKERS = 10_000
 MAX_STEPS = 10_000_000
 MAX_CHAIN = 20_000_000
+
+
+#: The names of the sampled noise scales (of the noise models ``constant``; ``proportional``
+#: and ``relative_parts``), which a prior may name beside the structures' parameters.
+NOISE_PARAMETERS = ("sigma", "sigma_rel")
+
+
+def check_prior_names(priors, structures) -> None:
+    """Check that every prior of ``priors`` (``{name: Prior}``) names a parameter of one of
+    ``structures`` or a noise scale (:data:`NOISE_PARAMETERS`), before any work: a misspelt
+    name is refused, not left unused.
+
+    Raises
+    ------
+    InputError
+        Naming the parameter and the closest real one (``option="priors"``).
+    """
+    known = {p for s in structures for p in s.param_names} | set(NOISE_PARAMETERS)
+    unknown = [k for k in (priors or {}) if k not in known]
+    if unknown:
+        import difflib
+
+        names = sorted(known)
+        close = difflib.get_close_matches(unknown[0], names, n=1)
+        hint = f"did you mean '{close[0]}'? " if close else ""
+        raise InputError(f"argument 'priors' names '{unknown[0]}', which no selected structure "
+                         f"has; {hint}the selected structures' parameters (as sampled, on the "
+                         f"scaled problem) are: {', '.join(names)}", option="priors")
+
+
+def check_sample(sample, where: str | None = None) -> None:
+    """Check which structures to sample, ``sample`` (:data:`SAMPLE`); the message starts with
+    ``where`` where given.
+
+    Raises
+    ------
+    InputError
+        Naming the option (``option="sample"``).
+    """
+    if sample not in SAMPLE:
+        at = f"{where}: " if where else ""
+        raise InputError(f"{at}sample must be one of {', '.join(SAMPLE)}, got {sample!r}",
+                         option="sample", where=where)
+
+
+def check_routes(sampler, evidence, where: str | None = None) -> None:
+    """Check the posterior route ``sampler`` (:data:`SAMPLERS`) and the ln Z route
+    ``evidence`` (:data:`EVIDENCE_ROUTES`); the message starts with ``where`` where given.
+
+    Raises
+    ------
+    InputError
+        Naming the option (``option="sampler"`` or ``"evidence"``).
+    """
+    at = f"{where}: " if where else ""
+    if sampler not in SAMPLERS:
+        raise InputError(f"{at}sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}",
+                         option="sampler", where=where)
+    if evidence not in EVIDENCE_ROUTES:
+        raise InputError(f"{at}evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
+                         f"got {evidence!r}", option="evidence", where=where)
 
 
 def check_sampler_settings(options: dict, where: str) -> None:

@@ -45,6 +45,21 @@ def available_cpus() -> int:
         return os.cpu_count() or 1
 
 
+
+def check_workers(workers, name: str = "workers") -> int:
+    """``workers`` (a number of processes, 0: one per CPU) after checking it; the message
+    calls it ``name``.
+
+    Raises
+    ------
+    InputError
+        Not a non-negative integer (``option="workers"``).
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+        raise InputError(f"{name} must be a non-negative integer, got {workers!r}",
+                         option="workers")
+    return workers
+
 @contextmanager
 def worker_environment():
     """Single-threaded BLAS in the worker processes spawned inside this block (a variable the
@@ -242,8 +257,7 @@ def process_pool(workers: int = 0, *, fork: bool = False):
     concurrent.futures.ProcessPoolExecutor
         Its workers are ended at once if the block raises (Ctrl-C included).
     """
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
-        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    check_workers(workers)
     with worker_environment():  # processes are spawned as tasks are submitted
         pool = new_pool(workers or available_cpus(), fork=fork)
         try:
@@ -333,8 +347,7 @@ def lazy_process_pool(workers: int = 0, prepare=None):
     is forked, see :meth:`LazyPool.prepare`) is e.g. the import of the libraries the workers
     share. Like :func:`process_pool`, its workers are ended at once if the block raises
     (Ctrl-C included)."""
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
-        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    check_workers(workers)
     with worker_environment():
         lazy = LazyPool(workers or available_cpus(), prepare)
         try:
@@ -384,8 +397,7 @@ def executor(workers: int, n_tasks: int | None = None, prepare=None):
     ------
     concurrent.futures.Executor or LazyPool
     """
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
-        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    check_workers(workers)
     n = min(workers or available_cpus(), n_tasks or available_cpus())
     if workers == 0:
         with lazy_process_pool(n, prepare) as pool:

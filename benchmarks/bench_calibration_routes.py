@@ -97,10 +97,10 @@ def _tails(lik, post, theta, level, seed) -> dict:
     from bayesfo.inference._arviz import psis
     from bayesfo.inference._mixture import _GaussianMixture
     from bayesfo.inference.importance import _mvt
-    from bayesfo.inference.transform import _log_prob_fn, _Transform
+    from bayesfo.inference.transform import Transform, _log_prob_fn
 
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     log_prob = _log_prob_fn(lik, tr)
     u = tr.to_u(lik.to_scaled(post.samples))
     mix = _GaussianMixture.fit(u, rng)
@@ -161,9 +161,9 @@ def _negative(log_density):
 def _exact_setup(lik, theta):
     """What the sampler-free checks share: the sampling coordinates, the log posterior density
     in them, and the truth there."""
-    from bayesfo.inference.transform import _log_prob_fn, _Transform
+    from bayesfo.inference.transform import Transform, _log_prob_fn
 
-    tr = _Transform(lik)
+    tr = Transform(lik)
     return tr, _log_prob_fn(lik, tr), tr.to_u(lik.to_scaled(theta[None, :]))[0]
 
 

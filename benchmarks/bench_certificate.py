@@ -46,7 +46,7 @@ from bayesfo.inference import Likelihood, certified, importance, starting_points
 from bayesfo.inference._configurations import configurations
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
-from bayesfo.inference.transform import _Transform
+from bayesfo.inference.transform import Transform
 from bayesfo.structures import get_structure
 
 OMEGA = np.logspace(-2, 2, 25)
@@ -61,7 +61,7 @@ def simulate(card: str, seed: int) -> FrequencyResponse:
     dummy = FrequencyResponse(OMEGA, np.ones(OMEGA.size) + 1j, NOISE * np.ones(OMEGA.size),
                               kind="modulus")
     lik = Likelihood(s, dummy, noise="known")
-    tr = _Transform(lik)
+    tr = Transform(lik)
     k = s.n_params
     while True:
         u = rng.uniform(tr.lo_u[:k], tr.hi_u[:k])

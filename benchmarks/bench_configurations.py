@@ -42,7 +42,7 @@ from bayesfo.inference import certified, certified_posterior  # noqa: E402
 from bayesfo.inference._arviz import psis  # noqa: E402
 from bayesfo.inference._configurations import _Slab, configurations  # noqa: E402
 from bayesfo.inference._mixture import _GaussianMixture  # noqa: E402
-from bayesfo.inference.transform import _log_prob_fn, _Transform  # noqa: E402
+from bayesfo.inference.transform import Transform, _log_prob_fn  # noqa: E402
 
 #: Scale of the slabs and ways in the proposal of the exact computation.
 SCALE = 4.0
@@ -70,7 +70,7 @@ class _Box:
 
 def _exact(lik, draws_u, slabs, n=1_000_000, seed=5):
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     log_prob = _log_prob_fn(lik, tr)
     mix = _GaussianMixture.fit(draws_u, rng)
     wide = _GaussianMixture(mix.weights, mix.means, mix.chols * 2.0)
@@ -103,7 +103,7 @@ def main() -> None:
     args = ap.parse_args()
     print(f"{platform.processor() or platform.machine()}, {platform.python_version()}")
     lik, modes, starts = setup.set_44()
-    tr = _Transform(lik)
+    tr = Transform(lik)
     variants = [("with the configurations", None)]
     if args.without:
         variants.append(("without", lambda *a, **k: []))

@@ -21,7 +21,7 @@ import numpy as np
 
 from bayesfo.inference.likelihood import Likelihood
 from bayesfo.inference.smc import ladder_run
-from bayesfo.inference.transform import _Transform
+from bayesfo.inference.transform import Transform
 from bayesfo.structures import get_structure, passivity, response
 from bayesfo.studies import g_spec_data
 
@@ -70,7 +70,7 @@ def main(argv=None):
         structure = get_structure(name)
         lik = Likelihood(structure, g_spec_data(0, kind=kind))
         run = ladder_run(lik, rng=np.random.default_rng(0))
-        theta = _Transform(lik).to_theta(run.particles)[:, :structure.n_params]
+        theta = Transform(lik).to_theta(run.particles)[:, :structure.n_params]
         # Particles and their scatter: the points a ladder's moves propose.
         rng = np.random.default_rng(1)
         theta = np.concatenate([theta, theta + rng.normal(0, 0.05, theta.shape)

@@ -118,8 +118,13 @@ def main() -> int:
                          (mean[i] - truth[i]) / sd[i] if sd[i] > 0 else math.nan,
                          abs(mean[i] - truth[i]), sh.posterior.converged,
                          i in undetermined))
+        mine = [r for r in rows if r[0] == k]
+        claimed = [r[7] for r in rows if not r[11]]
         print(f"set {k}: {cfg} -> noise {sh.noise}, vertical {sh.vertical}, law {sh.law}; "
-              f"covered {sum(r[7] for r in rows if r[0] == k)}/{truth.size - 1}; "
+              f"covered {sum(r[7] for r in mine if not r[11])}/"
+              f"{sum(not r[11] for r in mine)} determined, "
+              f"{sum(r[7] for r in mine if r[11])}/{sum(r[11] for r in mine)} not; so far "
+              f"{np.mean(claimed) if claimed else math.nan:.3f} of {len(claimed)}; "
               f"{time.time() - t0:.0f} s", flush=True)
     gone = np.array([r[11] for r in rows])
     print(f"\n{args.n} sets, {len(rows)} shifts, {time.time() - t0:.0f} s")

@@ -39,7 +39,7 @@ def measure(names: list[str], calls: int) -> dict:
     import bayesfo
     from bayesfo.comparison import compare
     from bayesfo.inference import Likelihood
-    from bayesfo.inference.transform import _log_prob_fn, _Transform
+    from bayesfo.inference.transform import Transform, _log_prob_fn
     from bayesfo.output.write import preload
     from bayesfo.structures import get_structure
 
@@ -48,7 +48,7 @@ def measure(names: list[str], calls: int) -> dict:
     out = {}
     for name in names:
         lik = Likelihood(get_structure(name), data, noise="constant")
-        tr = _Transform(lik)
+        tr = Transform(lik)
         log_prob = _log_prob_fn(lik, tr)
         rng = np.random.default_rng(0)
         for _ in range(10_000):  # a point of the support

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from .. import __version__
 from .._io import csv_cells, read_text_file, split_lines
-from ..data import is_contract_csv
+from ..data import contract_text, is_contract_csv, read_isotherms
 from ..data.temperature import parse_temperature, temperature_of_file
 from ..errors import InputError
 from ..options import (
@@ -202,8 +202,6 @@ def _lab_entries(file: Path, opts: dict, seed: int, temperature: float | None, o
     """The entries of a file that is not a contract CSV (a lab export): one per data set of
     :func:`bayesfo.data.read_isotherms`, each carrying its data as a contract CSV; a file that
     cannot be read is one entry with its error."""
-    from ..data import contract_text, read_isotherms
-
     try:
         sets = read_isotherms(file, kind=opts.get("kind"))
     except InputError as exc:

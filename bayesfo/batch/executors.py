@@ -10,6 +10,7 @@ from concurrent.futures import FIRST_COMPLETED, wait
 
 from ..errors import InputError, OutputError
 from ..outdir import check_output_directory
+from ..parallel import check_workers, new_pool, terminate, worker_environment
 from .store import BatchResult, Outcome, _lost, _store, _stored_rows, write_batch_outputs
 from .task import INPUT_ERROR, OK, run_task
 
@@ -28,7 +29,6 @@ def _run_pool(todo, workers, on_result, task=run_task) -> list:
     exception."""
     from concurrent.futures.process import BrokenProcessPool
 
-    from ..parallel import new_pool, terminate, worker_environment
 
     broken = []
     with worker_environment():  # processes are spawned while tasks are submitted
@@ -158,9 +158,8 @@ def run_batch(datasets, out_dir, *, workers: int | None = None, scheduler=None,
     if workers is not None and scheduler is not None:
         raise InputError("--workers applies to local processes; with --scheduler the Dask "
                          "cluster's workers run the tasks")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 0):
-        raise InputError(f"--workers must be a non-negative integer, got {workers!r}")
+    if workers is not None:
+        check_workers(workers, "--workers")
     out_dir = check_output_directory(out_dir)
 
     outcomes: dict[str, Outcome] = {}

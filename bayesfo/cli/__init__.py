@@ -25,6 +25,11 @@ from ..errors import InputError, OutputError
 COMMANDS = ("inspect", "compare", "predict", "export", "mastercurve", "design", "identify",
             "simulate", "structures", "extract", "batch")
 
+#: The flags of the API's options whose names differ from the option's (``--name`` for the
+#: option ``name``, underscores as hyphens, otherwise): how an :class:`InputError` that names
+#: an option (:attr:`InputError.option`) is said on the command line.
+FLAGS = {"priors": "--prior"}
+
 
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
@@ -190,7 +195,7 @@ def main(argv=None) -> int:
             pass
         return 141
     except InputError as exc:
-        print(f"bayesfo: error: {getattr(exc, 'command_line', None) or exc}", file=sys.stderr)
+        print(f"bayesfo: error: {exc.in_command_line(FLAGS)}", file=sys.stderr)
         return 2
     except OutputError as exc:
         print(f"bayesfo: error: {exc}", file=sys.stderr)

@@ -15,8 +15,8 @@ def load_libraries(formats=()) -> None:
     The objects that exist by then (the modules' functions, classes and tables, the data
     read) live as long as the command: they are frozen out of the garbage collector
     (:func:`gc.freeze`), whose full collections would otherwise walk them again and again in
-    this process and in the worker processes forked from it (BENCHMARKS.md, "Twenty-fourth
-    session"). :func:`bayesfo.cli.main` puts them back when the command returns."""
+    this process and in the worker processes forked from it (BENCHMARKS.md, "The libraries
+    frozen out of the collector"). :func:`bayesfo.cli.main` puts them back when the command returns."""
     with held():
         from ..output.write import preload
 

@@ -6,8 +6,8 @@ import contextlib
 import sys
 from pathlib import Path
 
-from ..errors import InputError
 from ..options import (
+    check_prior_names,
     check_sampler_settings,
     parse_floats,
     parse_priors,
@@ -141,28 +141,18 @@ def _print_undetermined(result) -> None:
 def run(args) -> int:
     from ..comparison.table import ranking_lines
     from ..outdir import check_output_directory
+    from ..parallel import check_workers
     from ..structures import resolve_structures
 
     data = read_data(args)
     structures = resolve_structures(args.structures, library(args))
     priors = parse_priors(args.prior)
-    known = {p for s in structures for p in s.param_names} | {"sigma", "sigma_rel"}
-    unknown = [k for k in priors if k not in known]
-    if unknown:
-        import difflib
-
-        names = sorted(known)
-        close = difflib.get_close_matches(unknown[0], names, n=1)
-        hint = f"did you mean '{close[0]}'? " if close else ""
-        raise InputError(f"--prior names '{unknown[0]}', which no selected structure has; "
-                         f"{hint}the selected structures' parameters (as sampled, on the "
-                         f"scaled problem) are: {', '.join(names)}")
+    check_prior_names(priors, structures)
     settings = {"max_steps": args.max_steps, "walkers": args.walkers}
     check_sampler_settings(settings, "compare")
     formats, detail = figure_options(args)
     holdout = parse_floats(args.holdout, "--holdout") if args.holdout else None
-    if args.workers < 0:
-        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got {args.workers}")
+    check_workers(args.workers)
     progress = not args.quiet and sys.stderr.isatty()
     options = dict(noise=args.noise, seed=args.seed, priors=priors, progress=progress,
                    evidence=args.evidence, evidence_check=args.evidence_check, holdout=holdout,

@@ -49,6 +49,7 @@ def run(args) -> int:
     from ..comparison import load
     from ..options import parse_floats
     from ..planning import design
+    from ..tts import MasterCurve
 
     window = None
     if args.window is not None:
@@ -67,7 +68,7 @@ def run(args) -> int:
             raise InputError(f"--figure {args.figure}: is a directory; give a file name in "
                              "it (e.g. design.png)")
     result = load(args.directory, models=getattr(args, "models", ()) or ())
-    if hasattr(result, "shift_draws"):
+    if isinstance(result, MasterCurve):
         raise InputError(f"'{args.directory}' holds a master curve: design chooses frequencies "
                          "between structures of a comparison; run it on a bayesfo compare "
                          "directory (e.g. of the master curve's master.csv)")
@@ -93,9 +94,6 @@ def run(args) -> int:
     try:
         plan = design(result, window=window, points=args.points, structures=structures,
                       cost=args.cost, seed=args.seed)
-    except InputError as exc:  # the API's words, in the command line's
-        raise InputError(str(exc).replace("argument 'window'", "--window")
-                         .replace("argument 'points'", "--points")) from None
     except np.linalg.LinAlgError as exc:
         raise InputError(f"the design's linear algebra failed ({exc}): the predictions over "
                          "the window are degenerate; give a narrower --window or other "
@@ -162,9 +160,6 @@ def _parameter(result, args, window, structures, notes=()) -> int:
                                 structure=structures[0] if structures else None, window=window,
                                 points=args.points, cost=args.cost, seed=args.seed,
                                 notes=notes)
-    except InputError as exc:
-        raise InputError(str(exc).replace("argument 'window'", "--window")
-                         .replace("argument 'points'", "--points")) from None
     except np.linalg.LinAlgError as exc:
         raise InputError(f"the design's linear algebra failed ({exc}): the predictions over "
                          "the window are degenerate; give a narrower --window") from None

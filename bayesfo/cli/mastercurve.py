@@ -137,15 +137,15 @@ def read_isotherm_files(paths, temperatures=None, columns=None) -> list[tuple]:
 def run(args) -> int:
     from ..data import columns_from_text
     from ..options import parse_floats
-    from ..outdir import check_output_directory, staged_run
+    from ..outdir import check_output_directory
+    from ..output import write_mastercurve
+    from ..parallel import check_workers
     from ..tts import mastercurve
-    from ..tts.joint import _master_names
+    from ..tts.joint import master_names
     from ._libraries import load_libraries
 
-    if args.workers < 0:
-        raise InputError(f"--workers must be 0 (one per CPU) or a positive number, got "
-                         f"{args.workers}")
-    structures = _master_names(args.structures)  # an unknown name fails before reading
+    check_workers(args.workers)
+    structures = master_names(args.structures)  # an unknown name fails before reading
     temperatures = (parse_floats(args.temperatures, "--temperatures")
                     if args.temperatures is not None else None)
     isotherms = read_isotherm_files(args.data, temperatures, columns_from_text(args.columns))
@@ -155,49 +155,9 @@ def run(args) -> int:
     mc = mastercurve(isotherms, structures, reference_temperature=args.reference_temperature,
                      noise=args.noise, vertical=args.vertical, law=args.law,
                      shifts=args.shifts, seed=args.seed, workers=args.workers)
-    from ..output.write import _finite
-    from ..tts.stored import summary_fields
-
-    # Not-finite numbers (a posterior's undefined diagnostic) are null, as in compare's.
-    summary = _finite({"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)})
-    master = mc.master_data()
-    law = mc.shift_law()
-    comments = [f"master curve at {mc.reference_temperature:g} °C of {len(mc.temperatures)} "
-                f"isotherms ({min(mc.temperatures):g} to {max(mc.temperatures):g} °C), shifted "
-                f"by the posterior mean log10 a_T"
-                + ("" if mc.vertical == "none" else f" and log10 b_T ({mc.vertical})")
-                + f" of bayesfo mastercurve ({mc.structure})",
-                f"temperature: {mc.reference_temperature:g} °C",
-                f"shift law: {law['name']} "
-                + ", ".join(f"{k} = {v['mean']:.6g} {v['unit']}".rstrip()
-                            for k, v in law["parameters"].items())]
-    with staged_run(out) as stage:
-        (stage / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False,
-                                                       allow_nan=False) + "\n")
-        (stage / "master.csv").write_text(master.to_csv_text(comments))
-        from ..inference import save_netcdf
-        from ..output.write import _without_distributed
-        from ..tts.stored import netcdf_of
-
-        with _without_distributed():
-            save_netcdf(netcdf_of(mc), stage / f"{mc.structure}.nc")
-        if not args.no_figures:
-            from ..plotting.mastercurve import plot_mastercurve
-            from ..plotting.output import save_figure
-
-            (stage / "figures").mkdir()
-            from ..plotting.mastercurve import plot_isotherm_residuals, plot_van_gurp_palmen
-
-            figures = {}
-            for name, plot in (("mastercurve", plot_mastercurve),
-                               ("residuals", plot_isotherm_residuals),
-                               ("van_gurp_palmen", plot_van_gurp_palmen)):
-                figures[name] = stage / "figures" / f"{name}.png"
-                save_figure(plot(mc).figure, figures[name], close=True)
-            from ..output.mastercurve_report import write_mastercurve_report
-
-            write_mastercurve_report(mc, stage, figures)
+    written = write_mastercurve(mc, out, figures=not args.no_figures)
     if args.json:
+        summary = json.loads(written["summary.json"].read_text())
         print(json.dumps({k: summary[k] for k in ("shift_factors", "shift_law")}, indent=1,
                          ensure_ascii=False))
         return 0

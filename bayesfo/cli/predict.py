@@ -87,13 +87,8 @@ def run(args) -> int:
                                                                            ".svg"):
         raise InputError(f"--figure '{args.figure}': give a .png, .pdf or .svg file")
     result = load(args.directory, models=getattr(args, "models", ()) or ())
-    try:
-        p = predict(result, args.quantity, x, structure=args.structure, average=args.average,
-                    seed=args.seed, temperature=args.temperature)
-    except InputError as exc:  # the API's words, in the command line's
-        text = str(exc).replace("predict: ", "", 1)
-        text = text.replace("average must be", "--average must be")
-        raise InputError(f"--{text}" if text.startswith("temperature ") else text) from None
+    p = predict(result, args.quantity, x, structure=args.structure, average=args.average,
+                seed=args.seed, temperature=args.temperature)
     if args.figure is not None:
         _figure(p, args.figure)
     if args.json:

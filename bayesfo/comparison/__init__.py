@@ -17,11 +17,3 @@ from .table import RANKING_FIELDS, ranking_rows
 __all__ = ["LADDER_SHORTFALL", "PARETO_K_WARN", "RANKING_FIELDS", "Comparison", "Criteria",
            "StructureResult", "compare", "load", "ranking_rows"]
 
-
-def __getattr__(name):
-    # Kept for one release: the writers moved to the output layer (bayesfo.output).
-    if name in ("write_outputs", "ranking_csv"):
-        from .. import output
-
-        return getattr(output, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -14,8 +14,8 @@ from ..data import FrequencyResponse
 from ..errors import InputError, PredictiveWarning
 from ..identify.optimize import FitResult
 from ..inference import Likelihood, PosteriorResult
-from ..inference._arviz import loo as psis_loo
-from ..inference._arviz import waic as waic_of
+from ..inference import loo as psis_loo
+from ..inference import waic as waic_of
 from ..inference.bound import model_probabilities, probability_bound
 
 PARETO_K_WARN = 0.7
@@ -114,8 +114,8 @@ def delta_loo_se(results) -> dict[str, float]:
     frequencies, as ``arviz.compare`` computes its ``dse`` (0 for the best structure).
 
     From the pointwise elpd the criteria keep (``loo_pointwise``): ``arviz.compare`` would give
-    the same numbers (tested) but runs PSIS again for every structure, 0.29 s against 0.4 ms
-    for the seven structures of the demo. Structures whose elpd is not finite are left out.
+    the same numbers (tested) but runs PSIS again for every structure, hundreds of times the
+    work. Structures whose elpd is not finite are left out.
     """
     pointwise = {r.name: np.asarray(r.criteria.loo_pointwise, float) for r in results
                  if r.error is None and r.criteria.loo_pointwise is not None}

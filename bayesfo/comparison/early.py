@@ -1,6 +1,7 @@
 """The optimisations of a comparison begun early, in a process forked from this one before it
 loads the libraries that the later steps use (ArviZ and xarray, emcee, matplotlib), whose
-imports keep one CPU busy while the other waits (BENCHMARKS.md, "Twenty-sixth session"). The
+imports keep one CPU busy while the other waits (BENCHMARKS.md, "The optimisations in a
+process forked before the imports"). The
 optimisations need none of them, so they run on that CPU meanwhile.
 
 The schedule (:mod:`.schedule`) takes each structure's optimum from here once it has come

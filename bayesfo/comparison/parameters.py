@@ -9,8 +9,11 @@ import math
 
 import numpy as np
 
+from ..inference import hdi
 from ..inference.results import HDI_PROB
+from ..predictions.prony import EXTRAPOLATED
 from ..structures import coefficient_units, parameter_forms, picture_of
+from ..structures.physical import stress_unit
 
 #: Noise parameters sampled with a structure: ``sigma`` has the data's unit, ``sigma_rel`` none.
 NOISE_UNITS = {"sigma": "data", "sigma_rel": ""}
@@ -44,8 +47,6 @@ def summarise_draws(values, map_value, unit: str) -> dict:
     the posterior summarises its parameters (94 % HDI by arviz). A draw at ±inf (an order at
     its bound makes a time overflow) leaves mean and sd undefined (NaN, null in JSON); the HDI
     and the median are those of all draws."""
-    from ..inference._arviz import hdi
-
     x = np.asarray(values, dtype=float).ravel()
     x = x[~np.isnan(x)]
     out = {"unit": unit}
@@ -187,8 +188,6 @@ def shown_hdi(summary: dict) -> tuple[float, float]:
 
 
 def _hdi(x):
-    from ..inference._arviz import hdi
-
     with np.errstate(invalid="ignore"):  # inf - inf among the candidate widths
         return hdi(x, HDI_PROB)
 
@@ -314,9 +313,6 @@ def extrapolated(block: dict, data) -> dict[str, str]:
     ``data`` cover (1/ω_max to 1/ω_min), and, for modulus data, a modulus whose HDI lies
     wholly above :data:`~bayesfo.predictions.prony.EXTRAPOLATED` times the largest measured
     |G*| (a plateau beyond the highest frequency). Quantities not determined are left out."""
-    from ..predictions.prony import EXTRAPOLATED
-    from ..structures.physical import stress_unit
-
     t_lo, t_hi = 1.0 / float(np.max(data.omega)), 1.0 / float(np.min(data.omega))
     modulus = stress_unit("modulus", data.units or "") if data.kind == "modulus" else None
     top = float(np.max(np.abs(data.response)))

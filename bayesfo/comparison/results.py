@@ -15,8 +15,11 @@ from ..errors import StructureError
 from ..identify.optimize import FitResult
 from ..inference import PosteriorResult
 from ..inference.results import HDI_PROB, draws_digest
+from ..predictions import predict
+from ..predictions.draws import Draws, comparison_draws
 from ..structures import Structure
 from .criteria_types import Criteria
+from .notebook import comparison_html
 from .parameters import (  # noqa: F401  (re-exported: the names results offered before)
     NOISE_UNITS,
     limit_reasons,
@@ -476,12 +479,24 @@ class Comparison:
                 f"{listed} noise, equal prior weights), so every structure is ranked on one "
                 "footing; each posterior is under its most probable noise model")
 
+    def draws(self, structure: str | None = None, average: str | None = None, *,
+              seed: int = 0, temperature: float | None = None) -> Draws:
+        """The posterior draws that predictions, Prony series and long-time moduli evaluate:
+        :data:`~bayesfo.predictions.draws.MAX_DRAWS` of ``structure`` (default the best
+        ranked), or of the ``average`` (``"bma"`` or ``"stacking"``) of the ranked structures.
+
+        Raises
+        ------
+        InputError
+            An unknown structure or average, both given, a structure without a posterior, or
+            a ``temperature`` (a comparison's draws are at the data's own).
+        """
+        return comparison_draws(self, structure, average, seed=seed, temperature=temperature)
+
     def predict(self, quantity: str, x, *, structure: str | None = None,
                 average: str | None = None, seed: int = 0):
         """A material function with its credible band: :func:`bayesfo.predict` of this
         comparison (G′, G″, tan δ, J′, J″, |η*| at ω; G(t), J(t); spectra H(τ), L(τ))."""
-        from ..predictions import predict
-
         return predict(self, quantity, x, structure=structure, average=average, seed=seed)
 
     def __getitem__(self, name: str) -> StructureResult:
@@ -502,8 +517,6 @@ class Comparison:
                 + (f"; {failed} failed" if failed else "") + ">")
 
     def _repr_html_(self) -> str:
-        from .notebook import comparison_html
-
         return comparison_html(self)
 
     def summary(self) -> str:

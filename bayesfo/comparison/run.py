@@ -19,8 +19,10 @@ import numpy as np
 from ..data import MAX_FREQUENCIES, FrequencyResponse
 from ..errors import DataWarning, InputError
 from ..inference.bound import BOUND_MARGIN
-from ..options import EVIDENCE_ROUTES, SAMPLE, SAMPLERS, check_sampler_settings
-from ..parallel import LazyPool, executor, runs_here, single_blas_thread
+from ..inference.likelihood import zero_part
+from ..inference.posterior import sample_posterior
+from ..options import check_prior_names, check_routes, check_sample, check_sampler_settings
+from ..parallel import LazyPool, check_workers, executor, runs_here, single_blas_thread
 from ..structures import resolve_structures
 from .criteria import _model_probabilities
 from .results import Comparison, data_problems
@@ -112,15 +114,10 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
     _check_sampler_options(sampler_kwargs)
     if not structures:
         raise InputError("no structure to compare")
-    if sample not in SAMPLE:
-        raise InputError(f"sample must be one of {', '.join(SAMPLE)}, got {sample!r}")
-    if sampler not in SAMPLERS:
-        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}")
-    if evidence not in EVIDENCE_ROUTES:
-        raise InputError(f"evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
-                         f"got {evidence!r}")
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
-        raise InputError(f"workers must be a non-negative integer, got {workers!r}")
+    check_routes(sampler, evidence)
+    check_sample(sample)
+    check_workers(workers)
+    check_prior_names(priors, structures)
     if data.n_frequencies > MAX_FREQUENCIES:
         raise InputError(f"{data.where()}: {data.n_frequencies} frequencies, more than the "
                          f"{MAX_FREQUENCIES} the samplers handle in reasonable time; thin to "
@@ -132,7 +129,6 @@ def compare(data: FrequencyResponse, structures, *, noise: str = "auto", seed: i
                          "has no scale; remove the point or give sigma")
     if noise == "relative_parts":
         # The relative error of a real or imaginary part that is exactly 0 has no scale either.
-        from ..inference.likelihood import zero_part
         if (why := zero_part(data)) is not None:
             raise InputError(why)
     held_out = None
@@ -184,7 +180,6 @@ def _check_sampler_options(options: dict) -> None:
     """A misspelt sampler option fails here, before any work, not inside a worker."""
     import inspect
 
-    from ..inference.posterior import sample_posterior
 
     known = [n for n, p in inspect.signature(sample_posterior).parameters.items()
              if p.kind is p.KEYWORD_ONLY and n not in ("seed", "progress")]

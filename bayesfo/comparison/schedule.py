@@ -31,11 +31,11 @@ structures' (2) and (3) go to the pool, whose processes start with the first of 
 have started (two or more), every step still to come goes to them as well, those queued here
 included: this process then only waits, so the comparison never runs more processes than CPUs
 while the workers are busy, nor leaves a CPU idle while this process works alone
-(BENCHMARKS.md, "Twenty-second session"). The steps for the workers wait here and go to them as
+(BENCHMARKS.md, "Every step goes to the workers once they have started"). The steps for the workers wait here and go to them as
 they free up (one queued ahead), the longest first: a posterior without the promise, then the
 fits (which find the other long posteriors), then the quick posteriors and the conclusions; a
 long posterior found late thus starts before quick steps queued earlier (BENCHMARKS.md,
-"Twenty-fifth session"). A wrong promise costs time, never a different number. Where the
+"The automatic schedule hands the workers the longest steps first"). A wrong promise costs time, never a different number. Where the
 pool has a preparation still to run (:meth:`~bayesfo.parallel.LazyPool.prepare`: the command
 loads the libraries then), the optimisations begin first, in a process forked from this one
 (:mod:`.early`), and each step (1) takes its optimum from there once it has come.
@@ -62,7 +62,7 @@ from concurrent.futures.process import BrokenProcessPool
 import numpy as np
 
 from ..errors import InputError
-from ..inference._arviz import preload
+from ..inference import preload_arviz
 from ..inference.bound import BOUND_MARGIN, bounded
 from ..parallel import settle_worker
 from .early import EarlyFits
@@ -84,7 +84,7 @@ def _task(step, *args):
     """One step in a worker: (value, InputError message or None, warnings as (category,
     message)). A worker process of a pool loads the ArviZ libraries at its first step and
     freezes its objects out of the garbage collector (:func:`~bayesfo.parallel.settle_worker`)."""
-    settle_worker(preload)
+    settle_worker(preload_arviz)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:

@@ -26,8 +26,9 @@ import numpy as np
 from ..data import FrequencyResponse
 from ..errors import InputError, NoiseWarning
 from ..identify.optimize import fit_structure
-from ..inference import Likelihood, starting_points
+from ..inference import Likelihood, PosteriorResult, starting_points
 from ..inference.adequacy import check_adequacy
+from ..inference.bound import BOUND_MARGIN, BOUND_REASON
 from ..inference.certified import certified_posterior, evidence_check
 from ..inference.evidence import other_noise_evidence
 from ..inference.importance import K_HAT_MAX, screen_noise
@@ -655,8 +656,6 @@ def best_fit_adequacy(s: Structure, data: FrequencyResponse, noise: str, fit,
     with the best fit under ``noise`` (and its maximum-likelihood noise scale) standing in
     for the posterior: whether the best the structure can do describes the data. None where
     no point has a finite likelihood or the checks cannot be made."""
-    from ..inference import PosteriorResult
-
     _, theta, lik = _best_point(s, data, noise, fit, options)
     if theta is None:
         return None
@@ -696,8 +695,6 @@ def bounded_result(s: Structure, data: FrequencyResponse, fit, best: dict[str, f
     """The result of a structure left out by the evidence bound: its best fit (the optimum,
     RMSE), the maximum log-likelihood (the largest of ``best``, by noise model) with AIC, AICc
     and BIC from it, and ``criteria.bound``; no posterior, so no PSIS-LOO, WAIC or figures."""
-    from ..inference.bound import BOUND_MARGIN, BOUND_REASON
-
     noise = max(best, key=best.get)
     lik = Likelihood(s, data, noise=noise, priors=options.priors_of(s, noise))
     max_ll = float(best[noise])

@@ -4,7 +4,7 @@ be (:func:`netcdf_for`).
 
 ``summary.json`` holds every number of the contract; each ``<structure>.nc`` holds the draws,
 the pointwise log-likelihood, the posterior predictive and the data. Besides arviz' groups, each
-NetCDF carries these attributes (format :data:`NETCDF_FORMAT`):
+NetCDF carries these attributes (format :data:`~bayesfo.inference.results.NETCDF_FORMAT`):
 
 ``posterior``
     ``bayesfo_format``; the sampler's ``n_steps``, ``burn``, ``thin``, ``acceptance`` and
@@ -30,16 +30,20 @@ import numpy as np
 from ..data import FrequencyResponse
 from ..errors import InputError, StructureError
 from ..identify.optimize import FitResult
-from ..inference import PosteriorResult
+from ..inference import PosteriorResult, external_storage, group_names, open_tree
 from ..inference.adequacy import Adequacy
 from ..inference.evidence import Evidence
-from ..inference.results import ParameterSummary, draws_digest
-from ..structures import Scaling
+from ..inference.likelihood import NOISE_MODELS
+from ..inference.results import NETCDF_FORMAT, ParameterSummary, draws_digest
+from ..outdir import one_run
+from ..structures import Scaling, default_library, get_structure, load_library
+from ..tts import MasterCurve
+from ..tts.joint import VERTICAL
+from ..tts.model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
+from ..tts.spectrum import NAME as SPECTRUM
+from ..tts.spectrum import Spectrum
 from .criteria_types import Criteria
 from .results import Comparison, StructureResult
-
-#: Version of the attributes :func:`netcdf_for` adds (``posterior.attrs["bayesfo_format"]``).
-NETCDF_FORMAT = 1
 
 #: Criteria that summary.json holds as plain numbers (null where not finite).
 _NUMBERS = ("max_log_likelihood", "aic", "aicc", "bic", "waic", "waic_se", "loo", "loo_se",
@@ -121,8 +125,6 @@ def load(directory, *, models=()):
     if not d.is_dir():
         raise InputError(f"'{d}': " + ("not a directory" if d.exists() else "no such directory")
                          + "; give the output directory of bayesfo compare")
-    from ..outdir import one_run
-
     # The summary and the NetCDF files of one run (a swap under way is waited for, one that a
     # killed run left half-done is completed, and files another run wrote are refused).
     with one_run(d, lambda name: name == "summary.json" or name.endswith(".nc")):
@@ -130,8 +132,6 @@ def load(directory, *, models=()):
 
 
 def _load(d: Path, models) -> Comparison:
-    from ..structures import default_library, load_library
-
     path = d / "summary.json"
     if not path.is_file():
         raise InputError(f"'{path}': " + ("not a regular file" if path.exists() else "missing")
@@ -187,7 +187,6 @@ def _read_netcdf(path: Path, name: str, s: dict | None = None, n_frequencies=Non
     files (HDF5 external or virtual storage) is refused."""
     import stat
 
-    from ..inference._arviz import external_storage, group_names, open_tree
 
     try:
         info = path.stat()
@@ -275,8 +274,6 @@ def _check_name(name, d: Path) -> None:
 
 
 def _comparison(summary: dict, d: Path, library) -> Comparison:
-    from ..structures import get_structure
-
     entries = summary["structures"]
     where = d / "summary.json"
     for s in entries:
@@ -347,12 +344,6 @@ def _comparison(summary: dict, d: Path, library) -> Comparison:
 def _mastercurve(summary: dict, d: Path, library):
     """The :class:`~bayesfo.tts.MasterCurve` that ``bayesfo mastercurve`` wrote into ``d``
     (what it stores: :mod:`bayesfo.tts.stored`)."""
-    from ..structures import get_structure
-    from ..tts import MasterCurve
-    from ..tts.model import SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
-    from ..tts.spectrum import NAME as SPECTRUM
-    from ..tts.spectrum import Spectrum
-
     where = d / "summary.json"
     if "posterior" not in summary or "isotherms" not in summary:
         raise InputError(f"'{where}': a master curve written by an earlier version of bayesfo, "
@@ -431,9 +422,6 @@ def _tampered(where: Path, what: str):
 def _check_master_summary(summary: dict, where: Path) -> None:
     """The blocks of a master curve's summary.json that load passes on unread, checked now
     (a tampered file failed later, in predict or export, with AttributeError or ValueError)."""
-    from ..tts.joint import VERTICAL
-    from ..tts.model import LAWS
-
     laws = summary.get("laws")
     if not isinstance(laws, dict) or not all(
             isinstance(v, dict) and isinstance(v.get("parameters"), dict)
@@ -459,8 +447,6 @@ def _is_probability(value) -> bool:
 
 
 def _check_noise(s: dict, where: Path) -> None:
-    from ..inference.likelihood import NOISE_MODELS
-
     if s.get("noise") not in NOISE_MODELS:
         raise _tampered(where, f"the noise model of '{s.get('name')}' is {s.get('noise')!r}, "
                                f"not one of {', '.join(NOISE_MODELS)}")

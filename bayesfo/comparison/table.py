@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 from .._text import number  # noqa: F401  (the comparison's table writes its numbers)
+from ..inference.bound import BOUND_REASON
 from .parameters import flagged_names, natural_block, physical_text
 
 #: The parameters that name a structure's fractional order, in order of preference: the
@@ -222,8 +223,6 @@ def ranking_lines(rows: list[dict]) -> list[str]:
 
     lines = [line([header for header, _, _ in TEXT_COLUMNS]), *map(line, cells)]
     if any(r.get("sampled") is False for r in ranked):
-        from ..inference.bound import BOUND_REASON
-
         lines.append(f"≤: {BOUND_REASON} (ln Z ≤ max ln L); no PSIS-LOO, WAIC or posterior "
                      "figures; --sample all samples it")
     for r in rows:

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._io import atomic_write_text
 from ..errors import InputError
+from .kramers_kronig import kramers_kronig
 from .symbols import RECIPROCAL, SYMBOLS, compliance_symbol, modulus_symbol, response_symbol
 
 KINDS = ("compliance", "modulus", "generic")
@@ -398,8 +399,6 @@ class FrequencyResponse:
     def kramers_kronig(self):
         """The linear Kramers–Kronig test of the two parts
         (:func:`bayesfo.data.kramers_kronig.kramers_kronig`), or None with too few points."""
-        from .kramers_kronig import kramers_kronig
-
         try:
             return kramers_kronig(self)
         except InputError:

@@ -53,7 +53,7 @@ from .tables import (
     sniff_decimal,
     split_file,
 )
-from .temperature import temperature_in_text
+from .temperature import looks_like_kelvin, temperature_in_text
 
 DUPLICATES = ("error", "first", "mean")
 _EXCEL = (".xlsx", ".xlsm", ".xls")
@@ -425,8 +425,6 @@ def _contract(path, kind, units, name, lines) -> Isotherm:
 def _plain_temperature(text: str | None, where: str = "") -> float | None:
     if not text:
         return None
-    from .temperature import looks_like_kelvin
-
     if looks_like_kelvin(text):
         value = float(text.replace("C", "").strip())
         warnings.warn(f"{where + ': ' if where else ''}'# temperature: {text}' has no unit and "

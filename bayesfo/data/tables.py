@@ -12,8 +12,8 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .._io import _INVISIBLE, csv_cells, parse_number, read_text_file, show, text_position
-from ..errors import InputError
+from .._io import INVISIBLE, csv_cells, parse_number, read_text_file, show, text_position
+from ..errors import DataWarning, InputError
 from .units import looks_like_unit
 
 #: Delimiters the reader recognises, with the names it reports.
@@ -90,7 +90,7 @@ def decode(path, max_bytes: int) -> tuple[str, str]:
                              "text") from None
         encoding, text = "Latin-1", raw.decode("latin-1")
     text = text.removeprefix("\ufeff")
-    bad = _INVISIBLE.search(text)
+    bad = INVISIBLE.search(text)
     if bad:
         line, char = text_position(text, bad.start())
         raise InputError(f"file '{path}', line {line}, character {char}: a control character "
@@ -393,7 +393,6 @@ def _openpyxl_sheets(path: Path) -> list[tuple[str, list[list[str]]]]:
 
     import openpyxl
 
-    from ..errors import DataWarning
 
     try:
         book = openpyxl.load_workbook(path, read_only=True, data_only=True)

@@ -6,10 +6,11 @@ isotherm file's temperature from a ``# temperature:`` line, the file stem (``Tm0
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 from .._io import read_text_file
-from ..errors import InputError
+from ..errors import DataWarning, InputError
 from .units import parse_unit
 
 _NUMBER = r"[+\-\u2212]?\d+(?:\.\d*)?(?:[eE][+\-]?\d+)?"
@@ -124,10 +125,6 @@ def temperature_of_file(path) -> float | None:
                 raise InputError(f"file '{path}', line {lineno}: '# temperature:' expects a "
                                  f"temperature such as 20, 20 C or 293.15 K, got {value.strip()!r}")
             if looks_like_kelvin(value):
-                import warnings
-
-                from ..errors import DataWarning
-
                 warnings.warn(f"file '{path}', line {lineno}: '# temperature: {value.strip()}' "
                               f"has no unit and is read as {meta[key]:g} °C, yet it looks like "
                               f"kelvin ({meta[key] - 273.15:g} °C); write '{value.strip()} K' "

@@ -197,12 +197,3 @@ def split_header(cell: str) -> tuple[str, str | None]:
             if unit is not None and unit.quantity != "dimensionless":
                 return "_".join(parts[:-k]), suffix
     return text, None
-
-
-def __getattr__(name):
-    # Kept for one release: the parser moved to bayesfo.data.temperature.
-    if name == "temperature_in_text":
-        from .temperature import temperature_in_text
-
-        return temperature_in_text
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -33,6 +33,7 @@ from ..errors import InputError
 from ..priors import LogUniform
 from ..structures import Scaling, Structure, passivity
 from ..structures.response import commensurate_response, dissipation_grid
+from .scan import fit_linear, q_grid_scan
 
 #: The penalty weights (times the root of the optimum's cost) of :meth:`_Problem.repair`.
 REPAIR_WEIGHTS = (1e1, 1e3, 1e5)
@@ -454,8 +455,6 @@ def linear_seeds(structure: Structure, data: FrequencyResponse, q_values=None,
     Returns an empty array for structures that are not of the thesis form (e.g. the
     generalised Maxwell model) or when a method cannot be applied.
     """
-    from .scan import fit_linear
-
     degrees = thesis_degrees(structure)
     if degrees is None:
         return np.empty((0, structure.n_params))
@@ -487,8 +486,6 @@ def linear_fits(structure: Structure, data: FrequencyResponse) -> dict[str, np.n
     in physical units: ``{"method 1": theta, ...}``. Methods without a stable fit are left
     out; empty for structures that are not of the thesis form (e.g. the generalised Maxwell).
     """
-    from .scan import fit_linear, q_grid_scan
-
     degrees = thesis_degrees(structure)
     if degrees is None:
         return {}

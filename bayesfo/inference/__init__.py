@@ -3,7 +3,9 @@
 :func:`certified_posterior` (:mod:`.certified`) is the entry point that ``compare`` uses: from
 the optima of a likelihood, a posterior certified by importance sampling, the tempered ladder
 or emcee, with its ln Z and, in words, how it was reached. :func:`run_posterior` runs emcee
-alone from the global optimisation and the linear seeds.
+alone from the global optimisation and the linear seeds. The ArviZ statistics (``hdi``,
+``psis``, ``loo``, ``waic``, R-hat and ESS) and the DataTree's files (``open_tree``) are named
+here for the layers after this one.
 """
 
 from __future__ import annotations
@@ -11,14 +13,29 @@ from __future__ import annotations
 import numpy as np
 
 from ..identify.optimize import fit_structure, linear_seeds
+from ._arviz import (  # the ArviZ statistics and container, for the layers after this one
+    ess_min,
+    external_storage,
+    group_names,
+    hdi,
+    hdi_columns,
+    loo,
+    open_tree,
+    psis,
+    rhat_max,
+    waic,
+)
+from ._arviz import preload as preload_arviz
+from ._mixture import _GaussianMixture as GaussianMixture
 from .certified import CertifiedPosterior, certified_posterior
 from .likelihood import NOISE_MODELS, Likelihood, choose_noise
 from .posterior import ConvergenceWarning, PosteriorResult, sample_posterior, save_netcdf
 
 __all__ = [
-    "CertifiedPosterior", "ConvergenceWarning", "Likelihood", "NOISE_MODELS", "PosteriorResult",
-    "certified_posterior", "choose_noise", "run_posterior", "sample_posterior", "save_netcdf",
-    "starting_points",
+    "CertifiedPosterior", "ConvergenceWarning", "GaussianMixture", "Likelihood", "NOISE_MODELS", "PosteriorResult",
+    "certified_posterior", "choose_noise", "ess_min", "external_storage", "group_names", "hdi",
+    "hdi_columns", "loo", "open_tree", "preload_arviz", "psis", "rhat_max", "run_posterior",
+    "sample_posterior", "save_netcdf", "starting_points", "waic",
 ]
 
 

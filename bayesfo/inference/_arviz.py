@@ -18,9 +18,9 @@ from types import SimpleNamespace
 
 import numpy as np
 
-#: xarray's NetCDF engine: netCDF4 (the netCDF-C library), several times faster than
-#: h5netcdf per posterior, written and read (h5netcdf's cost is per variable; BENCHMARKS.md,
-#: "Twenty-first session"); the files are the same NetCDF-4/HDF5 either way.
+#: xarray's NetCDF engine: netCDF4 (the netCDF-C library), faster than h5netcdf per
+#: posterior, written and read (h5netcdf's cost is per variable; BENCHMARKS.md, "NetCDF files
+#: through netCDF-C"); the files are the same NetCDF-4/HDF5 either way.
 ENGINE = "netcdf4"
 
 #: The quantiles of the tail ESS (ArviZ's: the 5 % and 95 % quantiles).

@@ -10,7 +10,8 @@ configuration; the importance proposal and the guide of the tempered ladder are 
 and a ladder whose particles leave the plateau at one rung does not regain it: the
 differential-evolution moves cannot reach a region that no particle occupies, and the
 independence moves propose from mixtures fitted to where the particles already are. Two runs
-that agree can then both miss a tenth of the posterior (BENCHMARKS.md, "Nineteenth session").
+that agree can then both miss a tenth of the posterior (BENCHMARKS.md, "A region of the
+posterior that no optimum seeds").
 
 :func:`vanishing_slabs` looks for each such configuration from the highest optima: the
 coefficient held near its lower prior bound, the others maximised (a profile point, as the
@@ -36,7 +37,10 @@ from functools import cached_property
 
 import numpy as np
 
+from ._mixture import _GaussianMixture
+from ._peaks import _hessian
 from ._ridge import PROBE_MAX_DIM, _profile_point
+from .transform import Transform, _log_prob_fn
 
 #: Where a coefficient is held to find the configuration in which its element vanishes: this
 #: share of its prior range (in the sampling coordinates) above its lower bound.
@@ -116,9 +120,7 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
     noise parameter where ``lik`` has one); ``guide_u``: draws that already cover the posterior
     as far as they reach (a configuration whose plateau holds :data:`COVERED` of them gives no
     slab). Deterministic: no random step."""
-    from .transform import _log_prob_fn, _Transform
-
-    tr = _Transform(lik)
+    tr = Transform(lik)
     log_prob = _log_prob_fn(lik, tr)
     modes_u = np.atleast_2d(np.asarray(modes_u, dtype=float))
     heights = log_prob(modes_u)
@@ -150,7 +152,7 @@ def vanishing_slabs(lik, modes_u: np.ndarray, guide_u: np.ndarray | None = None)
             # Where two springpots exchange roles (one vanishes, the other takes over with
             # nearly the same order), the profile's Newton and L-BFGS-B steps can stall in a
             # narrow curved valley, far below the valley's highest point: Nelder-Mead from where
-            # they ended (BENCHMARKS.md, "Nineteenth session": 112 nats below, then found).
+            # they ended (BENCHMARKS.md, "A region of the posterior that no optimum seeds").
             u, height, cross = _retried(log_prob, u, j, value, lo, hi)
         cross = _kept(log_prob, u, height, cross, j, lo, hi, top)
         if cross is None:
@@ -190,8 +192,6 @@ def _cross_section(log_prob, u: np.ndarray, j: int, lo, hi):
     curvature (the order of the element that vanished, which the data no longer see) get a
     variance that spreads over the prior box, as in the importance route's Laplace
     approximations. None where the difference stencil leaves the support."""
-    from ._peaks import _hessian
-
     rest = np.delete(np.arange(u.size), j)
     span = np.where(np.isfinite(hi - lo), hi - lo, 1.0 + np.abs(u))[rest]
     h = 1e-4 * span
@@ -254,8 +254,6 @@ def _way(log_prob, start: np.ndarray, mode: np.ndarray, j: int, end: float, lo, 
     :data:`SLAB_SCALE`) and the step along the crest; weighted by their Laplace masses. A
     :class:`~bayesfo.inference._mixture._GaussianMixture`, or None where no point is within
     :data:`DEPTH` of ``top`` or the way is empty."""
-    from ._mixture import _GaussianMixture
-
     if not mode[j] > end:
         return None
     d = start.size
@@ -298,8 +296,6 @@ def configurations(lik, modes_scaled, guide_u=None) -> list:
     where ``lik`` has one); [] where the search fails numerically, and for posteriors of more
     than :data:`~._ridge.PROBE_MAX_DIM` parameters (each profile point maximises over all the
     others, as the ridge probe's: the joint master-curve posteriors are not searched)."""
-    from .transform import _Transform
-
     modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
     if modes.size == 0 or lik.ndim > PROBE_MAX_DIM:
         return []
@@ -307,7 +303,7 @@ def configurations(lik, modes_scaled, guide_u=None) -> list:
         modes = np.column_stack([modes, lik.noise_estimate(modes)])
     try:
         with np.errstate(all="ignore"):
-            return vanishing_slabs(lik, _Transform(lik).to_u(modes), guide_u)
+            return vanishing_slabs(lik, Transform(lik).to_u(modes), guide_u)
     except (np.linalg.LinAlgError, FloatingPointError, ValueError):
         return []
 
@@ -333,10 +329,9 @@ def missed_share(lik, slabs, draws_u: np.ndarray, log_z_support: float, seed: in
     they represent it."""
     from scipy.special import logsumexp
 
-    from .transform import _log_prob_fn, _Transform
 
     rng = np.random.default_rng([seed, 19])
-    log_prob = _log_prob_fn(lik, _Transform(lik))
+    log_prob = _log_prob_fn(lik, Transform(lik))
     n = len(slabs)
     which = rng.integers(n, size=MISSED_DRAWS)
     x = np.empty((MISSED_DRAWS, draws_u.shape[1]))

@@ -24,9 +24,10 @@ PROBE_DEPTH = 15.0
 PROBE_POINTS = 200
 #: Posteriors of more parameters are not probed: each profile point maximises over all the
 #: other coordinates, so the cost grows with the square of the dimension (on the joint
-#: posterior of a Zener master and 19 shifts, 19 s against 3 s for the rest of the route). The
+#: posterior of a master structure and many shifts it outweighs the rest of the route). The
 #: joint master-curve posteriors are such; their shifts' intervals are calibrated
-#: (BENCHMARKS.md, thirteenth session), and ``info["probe"]["skipped"]`` says why.
+#: (BENCHMARKS.md, "Calibration of the master-curve shifts"), and ``info["probe"]["skipped"]``
+#: says why.
 PROBE_MAX_DIM = 12
 #: Newton steps of a profile point before it falls back to L-BFGS-B.
 PROFILE_NEWTON = 8
@@ -34,7 +35,7 @@ PROFILE_NEWTON = 8
 #: the weights to certify it. The probe's estimate is from above (on the 74 certified posteriors
 #: of the bundled isotherms, 2-3 times the share of an unguided ladder's draws outside the
 #: reported draws' range); 3 % keeps every posterior that misses 5 % or more off the fast route
-#: (BENCHMARKS.md, fourteenth session).
+#: (BENCHMARKS.md, "The ridge probe").
 PROBE_MISSED = 0.03
 
 

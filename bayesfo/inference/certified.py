@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import CertifiedWarning, ConvergenceWarning, EvidenceWarning, InputError
-from ..options import EVIDENCE_ROUTES, SAMPLERS
+from ..options import EVIDENCE_ROUTES, SAMPLERS, check_routes  # noqa: F401  (the routes, named here too)
 from ._configurations import configurations, missed_share, vanished
 from ._ridge import PROBE_MAX_DIM
 from .evidence import Evidence, bridge_evidence, ladder_runs, nested_evidence
@@ -58,7 +58,7 @@ from .importance import importance_posterior
 from .likelihood import Likelihood
 from .posterior import sample_posterior, support_seeds
 from .results import PosteriorResult, ladder_agreement, posterior_from_particles
-from .transform import _Transform
+from .transform import Transform
 
 #: A tempered-ladder run whose best particle ends this far (nats) below the best fit found by
 #: the optimiser and the sampler has missed part of the posterior (1 000 particles of a
@@ -136,11 +136,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
     -------
     CertifiedPosterior
     """
-    if sampler not in SAMPLERS:
-        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {sampler!r}")
-    if evidence not in EVIDENCE_ROUTES:
-        raise InputError(f"evidence must be one of {', '.join(EVIDENCE_ROUTES)}, "
-                         f"got {evidence!r}")
+    check_routes(sampler, evidence)
     sampler_options = dict(sampler_options or {})
     modes = np.atleast_2d(np.asarray(modes, dtype=float))
     name = lik.structure.name
@@ -198,7 +194,7 @@ def certified_posterior(lik: Likelihood, modes, *, starts=None, sampler: str = "
         if slabs is None and (evidence == "ladder" or (evidence == "auto" and ev is None and (
                 not post.converged or post.sampler == "importance"))):
             # A ladder runs for ln Z: it proposes in the configurations too.
-            slabs = configurations(lik, modes, _Transform(lik).to_u(post.samples_scaled))
+            slabs = configurations(lik, modes, Transform(lik).to_u(post.samples_scaled))
         found = _evidence(lik, post, seed, evidence, best_log_likelihood=best, importance=ev,
                           slabs=slabs or ())
         runs = found.pop("ladder_runs")
@@ -247,7 +243,7 @@ def _configurations_checked(lik, modes, post, ev, info: dict, seed: int):
     whose vanishing was found, the share missed); where it exceeds :data:`CONFIGURATIONS_MISSED`
     the importance posterior is not certified (``vanishing`` and ``reason`` in ``info``, its
     draws the ladder's guide). Returns (posterior or None, evidence or None, slabs)."""
-    draws_u = _Transform(lik).to_u(post.samples_scaled)
+    draws_u = Transform(lik).to_u(post.samples_scaled)
     slabs = configurations(lik, modes, draws_u)
     names = vanished(lik, slabs)
     missed = 0.0
@@ -279,7 +275,7 @@ def _ladder_first(lik, seed: int, guide=None, slabs=(), reach: float = -math.inf
     of two runs whose particles share ancestors scatters enough on a broad posterior that two
     runs of the same posterior can fail the test by chance, and emcee, the next route, costs
     many times as much on the posteriors that reach it (undetermined orders; BENCHMARKS.md,
-    "Eighteenth session").
+    "The demo's Maxwell: a second pair of ladder runs").
 
     Returns (posterior, evidence, None, note), or (None, None, reason, None) when the runs
     disagree or the ladder fails: emcee then runs, and a ladder guided by its walkers. ``note``
@@ -350,7 +346,8 @@ def _shortfall(reach: float, ev: Evidence, what: str) -> str | None:
 #: draws on some parameter, beyond the share expected of draws from the same posterior
 #: (:func:`_expected_outside`), before the ladder's particles replace them. Ladders beside
 #: importance draws of the same posterior left about 1 % outside; importance posteriors that
-#: missed a configuration of the springpots left 13-45 % (BENCHMARKS.md, "Fifteenth session").
+#: missed a configuration of the springpots left far more (BENCHMARKS.md, "The ladder run for
+#: ln Z checks the importance draws").
 LADDER_MISSED = 0.03
 
 
@@ -378,7 +375,7 @@ def _checked_by_ladder(lik, post, runs, seed, info: dict):
     returns (posterior, note or None)."""
     name = lik.structure.name
     agreement = ladder_agreement(lik, runs, seed=seed)
-    particles = _Transform(lik).to_theta(
+    particles = Transform(lik).to_theta(
         agreement.chain_u.reshape(-1, agreement.chain_u.shape[-1]))
     outside = _outside(post.samples_scaled, particles)
     info["ladder_outside"] = outside

@@ -35,12 +35,12 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
-from ._arviz import psis
+from ._arviz import ess_draws, psis
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
 from .results import PosteriorResult, exponent_intervals
 from .smc import _upper_count, ladder_runs_together
-from .transform import _log_prob_fn, _Transform
+from .transform import Transform, _log_prob_fn
 
 
 @dataclass(frozen=True)
@@ -153,8 +153,6 @@ def log_support_fraction(lik: Likelihood, rng: np.random.Generator, n: int = 20_
 
 def _ess(x: np.ndarray) -> float:
     """Effective size of the draws (walker-major rows) of a scalar, by arviz."""
-    from ._arviz import ess_draws
-
     return ess_draws(x)
 
 
@@ -176,7 +174,7 @@ def bridge_evidence(lik: Likelihood, posterior: PosteriorResult, *, seed: int = 
     X.-L. Meng and W. H. Wong (1996), Statistica Sinica 6; Q. F. Gronau et al. (2017), J. Math.
     Psychol. 81; S. Frühwirth-Schnatter (2004), Econometrics Journal 7.
     """
-    tr = _Transform(lik)
+    tr = Transform(lik)
     u = tr.to_u(posterior.samples_scaled)
     return _bridge(lik, u.reshape(posterior.n_walkers, -1, u.shape[1]), seed=seed,
                    max_iter=max_iter, tol=tol)
@@ -190,7 +188,7 @@ def _bridge(lik: Likelihood, draws: np.ndarray, *, seed: int, max_iter: int = 10
     has them (:func:`log_support_fraction`, else estimated here)."""
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     log_q = _log_prob_fn(lik, tr)
     n_walkers = draws.shape[0]
     fit_half = draws[:, 0::2].reshape(-1, draws.shape[2])
@@ -318,7 +316,7 @@ def ladder_runs(lik: Likelihood, *, seed: int = 0, n_particles: int = 1000, n_ru
     if guide is None or isinstance(guide, np.ndarray):
         guide_u = guide
     else:
-        guide_u = _Transform(lik).to_u(guide.samples_scaled)
+        guide_u = Transform(lik).to_u(guide.samples_scaled)
     shares = [None] * n_runs if guide_u is None else np.array_split(guide_u, n_runs)
     # The runs advance in lock-step (one batch of evaluations for all of them); each is the run
     # that ladder_run would give with its generator.

@@ -15,7 +15,8 @@ leaves the box; the weights are then the posterior density in z (the density in 
 Jacobian |du/dz|) over the proposal's, so that their mean is still the evidence. The proposal
 stays in u wherever it keeps its draws: a coordinate that leans on a bound along a ridge is
 covered better there, by a component cut at the bound, than in z, where the curvature at the
-mode does not reach along the ridge (BENCHMARKS.md, twelfth session). An optimum on the edge
+mode does not reach along the ridge (BENCHMARKS.md, "the importance proposal in unbounded
+coordinates"). An optimum on the edge
 of the support inside the box (a coefficient at 0 where its element vanishes, two orders that
 meet) has no difference stencil around it: the curvature is taken a few (smaller) steps
 inside (:func:`~._peaks._inward`), and the component spills part of its draws over the edge,
@@ -73,11 +74,13 @@ from scipy.special import logsumexp
 
 from ..errors import InputError
 from ._arviz import psis
+from ._mixture import _GaussianMixture
 from ._peaks import DF, _laplace, _mixture_log_pdf, _polished
 from ._ridge import PROBE_MAX_DIM, PROBE_MISSED, _ridge_probe
+from .evidence import Evidence, log_support_fraction
 from .likelihood import Likelihood
-from .results import exponent_intervals
-from .transform import _Unbounded
+from .results import exponent_intervals, result_from_draws
+from .transform import Transform, _log_prob_fn, _Unbounded
 
 #: Certificate of the importance weights: Pareto k̂ below this (Vehtari et al.'s threshold of
 #: reliable estimates) and at least this many effective draws.
@@ -105,7 +108,8 @@ NEWTON = 4
 #: The third round (:func:`_fitted`): draws resampled from the certified weights to fit the
 #: mixture to (k ≤ 4 components by BIC), and the scale of its Student-t components relative
 #: to the fitted covariances (broad: on misfitting structures of real isotherms, 1.6 gave
-#: k̂ < 0.5 where 1.0 and 1.3 often did not; BENCHMARKS.md, fourteenth session).
+#: k̂ < 0.5 where 1.0 and 1.3 often did not; BENCHMARKS.md, "ln Z where the first round's
+#: weights are heavy-tailed").
 FIT_DRAWS = 4000
 FIT_SCALE = 1.6
 SCALE = 1.5     # proposal scale relative to the Laplace covariance
@@ -189,13 +193,9 @@ def importance_posterior(lik: Likelihood, modes_scaled, *, seed: int = 0,
         where its k̂ < 0.5 (see :data:`K_HAT_EVIDENCE`; else the evidence is None). The
         posterior's ESS is that of the resampled draws, 1/(1/ESS_weights + 1/n_draws).
     """
-    from .evidence import Evidence, log_support_fraction
-    from .results import result_from_draws
-    from .transform import _Transform
-
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)
     if isinstance(out, dict):
         return None, None, out
@@ -367,8 +367,6 @@ def _weights(lik: Likelihood, tr, modes_scaled, n_proposals: int, rng: np.random
     of the box, such as an order at 0, spills half of its component over it), it is built again
     in the unbounded coordinates of :class:`~.transform._Unbounded`, from new draws, with the
     weights in those coordinates (see :func:`_proposal`)."""
-    from .transform import _log_prob_fn
-
     log_prob = _log_prob_fn(lik, tr)
     modes = np.atleast_2d(np.asarray(modes_scaled, dtype=float))
     if modes.size == 0:
@@ -458,8 +456,6 @@ def _fitted(assessed, n_proposals: int, rng: np.random.Generator):
     :data:`FIT_SCALE` times the component's covariance, in the coordinates of the certified
     round's proposal. The mixture follows a skewed or curved posterior that one Laplace
     approximation or one matched component does not. None where the fit fails."""
-    from ._mixture import _GaussianMixture
-
     out, _, _, w, _ = assessed
     _, _, finite, n_modes, prop = out
     zs = prop["z"][finite]
@@ -516,8 +512,6 @@ def _adapted(first, n_proposals: int, rng: np.random.Generator):
 
 
 def _log_support(lik, rng):
-    from .evidence import log_support_fraction
-
     return log_support_fraction(lik, rng, n=5000, max_draws=5000)
 
 
@@ -538,10 +532,8 @@ def screen_noise(lik: Likelihood, modes_scaled, *, seed: int = 0, n_proposals: i
     :data:`UNDETERMINED`; "" if none), for which the importance route will not certify the
     posterior whatever k̂.
     """
-    from .transform import _Transform
-
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     out = _weights(lik, tr, modes_scaled, n_proposals, rng)
     if isinstance(out, dict):
         return None

@@ -62,6 +62,40 @@ NOISE_PRIORS = {
 }
 
 
+def noise_variance(noise: str, g, sigma) -> np.ndarray:
+    """The variance of a measurement's ln|G| and arg G [rad] (last axis, 2) under the noise
+    model ``noise`` where the model's response is ``g`` (any shape, physical units), in the
+    small-noise approximation: what a new point measured there would scatter by.
+
+    ``sigma`` is the noise scale, broadcast against ``g``: the sampled ``sigma`` (in the units
+    of G) or ``sigma_rel`` of :data:`NOISE_PRIORS`' models, and for ``known`` noise the data's
+    relative σ (σ/|G|).
+
+    Examples
+    --------
+    Noise proportional to |G| scatters ln|G| and arg G alike, by σ_rel²/2:
+
+    >>> noise_variance("proportional", np.array([2.0 + 1.0j]), 0.1)
+    array([[0.005, 0.005]])
+    """
+    g2 = np.abs(g) ** 2
+    if noise == "known":
+        v = np.full(g.shape, sigma**2 / 2.0)
+        return np.stack([v, v], axis=-1)
+    if noise == "constant":
+        v = sigma**2 / (2.0 * g2)
+        return np.stack([v, v], axis=-1)
+    if noise == "relative_parts":
+        re2, im2 = g.real**2, g.imag**2
+        return np.stack([sigma**2 * (re2**2 + im2**2) / g2**2,
+                         sigma**2 * 2.0 * re2 * im2 / g2**2], axis=-1)
+    if noise == "proportional":
+        v = np.broadcast_to(sigma**2 / 2.0, g.shape)
+        return np.stack([v, v], axis=-1)
+    raise InputError(f"noise must be one of {', '.join(NOISE_MODELS)}, got {noise!r}",
+                     option="noise")
+
+
 def zero_part(data: FrequencyResponse) -> str | None:
     """Why ``relative_parts`` noise cannot be used on ``data`` (a real or imaginary part exactly
     0 at some frequency, where the relative error of that part has no scale), or None."""
@@ -240,6 +274,10 @@ class Likelihood:
         out += self._unit_shift
         np.copyto(out, -np.inf, where=~np.isfinite(out))
         return out
+
+    def noise_variance(self, g, sigma) -> np.ndarray:
+        """:func:`noise_variance` under this likelihood's noise model."""
+        return noise_variance(self.noise, g, sigma)
 
     def _relative_parts2(self, model) -> np.ndarray:
         """(ΔRe/Re g)² + (ΔIm/Im g)² per point, the summand of pyRheo's cost."""

@@ -37,7 +37,7 @@ from .results import (
     result_from_draws,
     save_netcdf,
 )
-from .transform import _log_prob_fn, _Transform
+from .transform import Transform, _log_prob_fn
 
 __all__ = ["ConvergenceWarning", "PosteriorResult", "initial_walkers", "posterior_from_particles",
            "result_from_draws", "sample_posterior", "save_netcdf", "support_seeds"]
@@ -53,7 +53,7 @@ def support_seeds(lik: Likelihood, seeds_scaled, rng: np.random.Generator, *,
     seeds = np.atleast_2d(np.asarray(seeds_scaled, dtype=float))
     if lik.noise_param:
         seeds = np.column_stack([seeds, lik.noise_estimate(seeds)])
-    tr = _Transform(lik)
+    tr = Transform(lik)
     # Project the seeds into the prior box (in the sampling coordinates), then keep those that
     # satisfy the constraints; without any, start from prior draws inside the support.
     span = tr.hi_u - tr.lo_u
@@ -95,7 +95,7 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
     share the walkers round-robin, each walker a Gaussian jitter of relative size up to
     ``jitter`` in the sampling coordinates that lies in the support.
     """
-    tr = _Transform(lik)
+    tr = Transform(lik)
     seeds, _ = support_seeds(lik, seeds_scaled, rng, mode_window=mode_window)
     u_seeds = tr.to_u(seeds)
     # Jittered copies of every seed, the jitter shrinking from ``jitter`` to 1e-4 of it: a seed
@@ -113,7 +113,7 @@ def initial_walkers(lik: Likelihood, seeds_scaled, n_walkers: int, rng: np.rando
                      for i in range(n_walkers)])
 
 
-def _into_support(lik: Likelihood, tr: _Transform, theta, anchor, *, steps: int = 40):
+def _into_support(lik: Likelihood, tr: Transform, theta, anchor, *, steps: int = 40):
     """A point in the support near ``theta`` (outside it): ``theta`` with one coordinate set to
     zero (or to the lower bound of a log-uniform prior), the most likely of those that are in
     the support; else the point of the segment from ``anchor`` (in the support) to ``theta``
@@ -268,7 +268,7 @@ def sample_posterior(
         raise InputError(f"n_walkers must be at least {2 * ndim} for {ndim} parameters")
     if progress is None:
         progress = sys.stderr.isatty()
-    tr = _Transform(lik)
+    tr = Transform(lik)
     p0 = tr.to_u(initial_walkers(lik, seeds_scaled, n_walkers, rng))
     # DE with γ = 1 carries a walker by the distance between two others: from one mode to
     # another where walkers sit in both (ter Braak 2006). Max-order members have such modes

@@ -19,7 +19,7 @@ from .._io import publish
 from ._arviz import ess_min, from_dict, group_names, hdi, rhat_max, write_tree
 from .likelihood import Likelihood
 from .smc import unique_rows
-from .transform import _log_prob_fn, _Transform
+from .transform import Transform, _log_prob_fn
 
 HDI_PROB = 0.94
 
@@ -185,7 +185,7 @@ def ladder_agreement(lik: Likelihood, runs, *, seed: int = 0) -> Agreement:
     """The certificate of :func:`posterior_from_particles` alone (the same numbers from the same
     ``seed``): where the runs only decide what runs next, the posterior need not be built."""
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     chain_u = np.stack([np.asarray(getattr(r, "particles", r), dtype=float) for r in runs])
     n_runs, n_kept, _ = chain_u.shape
     if n_runs < 2:
@@ -260,7 +260,7 @@ def result_from_draws(lik: Likelihood, chain_u, *, sampler: str, rhat: float, es
     (``chain_u``: chains × draws × parameters in the sampling coordinates), with that route's
     diagnostics. ``n_walkers`` is the number of chains, ``n_steps`` 0 and ``tau`` NaN."""
     rng = np.random.default_rng(seed)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     chain_u = np.asarray(chain_u, dtype=float)
     n_chains, n_kept, ndim = chain_u.shape
     flat_u = chain_u.reshape(-1, ndim)  # chain-major
@@ -392,6 +392,11 @@ def _inference_data(lik, post, pointwise, flat_scaled, lp_flat, n_walkers, n_kep
         units=lik.data.units or "", omega_units="rad/s", data=lik.data.label,
     )
     return idata
+
+
+#: Version of the attributes that a NetCDF of bayesfo carries (``posterior.attrs["bayesfo_format"]``),
+#: the same for a comparison's structures and a master curve's joint posterior.
+NETCDF_FORMAT = 1
 
 
 def _netcdf_bytes_needed(idata) -> int:

@@ -48,9 +48,10 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
+from ..parallel import Helper, SpareCPU
 from ._mixture import _GaussianMixture
 from .likelihood import Likelihood
-from .transform import _log_parts_fn, _Transform
+from .transform import Transform, _log_parts_fn
 
 #: A rung whose moves leave fewer distinct particles than this many per dimension (of the
 #: 1000) ends the run with an error: the population has collapsed (see :func:`ladder_run`).
@@ -89,7 +90,7 @@ class _Target:
 
     def __init__(self, lik: Likelihood):
         self.lik = lik
-        self.tr = _Transform(lik)
+        self.tr = Transform(lik)
         self._parts = _log_parts_fn(lik, self.tr)
         self._box_parts = _log_parts_fn(lik, self.tr, constraints=False)
 
@@ -185,7 +186,7 @@ def unique_rows(x: np.ndarray) -> np.ndarray:
     """The distinct rows of ``x`` (finite values) in lexicographic order: ``np.unique(x,
     axis=0)``, by a lexicographic sort of the columns instead of a sort of the rows as
     records, which is faster on the ladder's particles and guide draws (BENCHMARKS.md,
-    "Twenty-third session")."""
+    "The ladder's distinct rows")."""
     x = np.asarray(x)
     if len(x) < 2:
         return x.copy()
@@ -308,8 +309,6 @@ def _drive(target: _Target, runs: list) -> list:
     their results back; a run's result does not depend on the runs it is advanced with, so the
     numbers are the same. Where the helper fails, the runs go on here from where it took them.
     """
-    from ..parallel import Helper, SpareCPU
-
     out = [None] * len(runs)
     pending = {}
 

@@ -16,11 +16,11 @@ from ..priors import LogUniform, Uniform
 from .likelihood import Likelihood
 
 #: Batches of at most this many rows are checked against the prior box in one comparison
-#: (:meth:`_Transform.in_box`).
+#: (:meth:`Transform.in_box`).
 BOX_ROWS = 256
 
 
-class _Transform:
+class Transform:
     """θ ↔ u (log for log-uniform priors) and the log-Jacobian.
 
     In u, uniform and log-uniform priors are flat: their log density is the constant
@@ -41,7 +41,7 @@ class _Transform:
         """Rows of ``u`` (2-D) inside the prior box: the whole comparison at once for the
         small batches of the optimisers and certificates (fewer calls), column by column for
         a sampler's thousands of rows (fewer temporaries); the same decisions (BENCHMARKS.md,
-        "Twenty-fifth session")."""
+        "The constraint checks of small batches")."""
         if u.shape[0] <= BOX_ROWS:
             return ((u >= self.lo_u) & (u <= self.hi_u)).all(axis=1)
         ok = np.ones(u.shape[0], dtype=bool)
@@ -141,7 +141,7 @@ class _Unbounded:
         return log_target
 
 
-def _log_parts_fn(lik: Likelihood, tr: _Transform, *, constraints: bool = True):
+def _log_parts_fn(lik: Likelihood, tr: Transform, *, constraints: bool = True):
     """(log prior density in u, log-likelihood) of a batch of points in u, both −inf outside
     the support; the tempered ladder weighs the two parts differently. With
     ``constraints=False`` only the prior box bounds the support: the structure's constraints
@@ -174,7 +174,7 @@ def _log_parts_fn(lik: Likelihood, tr: _Transform, *, constraints: bool = True):
     return log_parts
 
 
-def _log_prob_fn(lik: Likelihood, tr: _Transform):
+def _log_prob_fn(lik: Likelihood, tr: Transform):
     """Log posterior density in u (the hot path: one vectorised call per half-ensemble)."""
     log_parts = _log_parts_fn(lik, tr)
 

@@ -7,8 +7,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from .. import __version__
 from .._io import atomic_write_text
 from ..comparison.table import number
+from ..tts.validity import describe, describe_parts
 from .report import CSS, _e, _figures_section, _num
 
 #: Captions of the master curve's figures.
@@ -32,8 +34,6 @@ def mastercurve_verdict(mc) -> list[tuple[str, bool]]:
     """Sentences in reading order, each with whether it is a caution: is superposition valid,
     does the master function describe every isotherm, which master function and which shift
     law the evidence supports, and whether the posterior is certified."""
-    from ..tts.validity import describe, describe_parts
-
     out: list[tuple[str, bool]] = []
     vgp = mc.tts_checks.get("van_gurp_palmen")
     if vgp is not None:
@@ -193,8 +193,6 @@ def _laws_table(mc) -> str:
 def render_mastercurve_report(mc, figures: dict | None = None) -> str:
     """The report of a master curve as one self-contained HTML document (figures embedded from
     their PNG files, ``{name: path}``)."""
-    from .. import __version__
-
     title = f"bayesfo master curve: {mc.data.label}"
     sentences = "".join(f"<p class='flag'>{_e(t)}</p>" if flagged else f"<p>{_e(t)}</p>"
                         for t, flagged in mastercurve_verdict(mc))

@@ -23,12 +23,16 @@ import base64
 import html
 from pathlib import Path
 
+from .. import __version__
 from .._io import atomic_write_text
 from ..comparison.parameters import UNDETERMINED_DECADES, extrapolated, shown_hdi
 from ..comparison.table import number
 from ..data.symbols import describe, in_symbol, mode, parameter_label
 from ..errors import InputError
+from ..inference.bound import BOUND_MARGIN, BOUND_REASON
 from ..options import LEADING_STRUCTURES, VERY_STRONG
+from ..plotting.captions import file_stem
+from ..structures import picture_of
 from ..structures.physical import in_brackets, meanings
 from .verdict import (  # noqa: F401  (_bayes_factor, _strength: re-exported for the tests)
     HDI_PERCENT,
@@ -219,8 +223,6 @@ def _ranking_table(comparison) -> str:
             "posterior predictive checks pass (small: a systematic misfit within 2° and "
             "3.5 %; partly: they pass, but the fitted noise swamps points the fit misses).</p>")
     if any(not r.get("sampled", True) for r in comparison.table() if r.get("rank")):
-        from ..inference.bound import BOUND_MARGIN, BOUND_REASON
-
         note += (f"<p class='small'>≤: {_e(BOUND_REASON)}. Its maximum log-likelihood (the "
                  "global optimiser's, under every noise model) is an upper bound of ln Z under "
                  f"any normalised prior and lies more than {BOUND_MARGIN:g} nats below the "
@@ -387,8 +389,6 @@ def _physical_table(block: dict, symbol: str = "G", meaning: dict | None = None,
 def _picture_text(structure, picture: str, symbol: str = "G") -> str:
     """The picture's name, title and mechanical network, escaped; the network's moduli and
     G*(s) in the letters of data measured as ``symbol`` (E_e and E*(s) for tensile data)."""
-    from ..structures import picture_of
-
     pic = picture_of(structure, picture)
     text = pic.name + (f", {pic.title}" if pic.title else "")
     if pic.network is not None:
@@ -533,8 +533,6 @@ def _figures_section(figures: dict, comparison=None, captions: dict | None = Non
 
 def _without_corner(figures: dict, comparison) -> str:
     """A note naming the structures that have no corner figure among ``figures``, if any."""
-    from ..plotting.captions import file_stem
-
     # Structures left out by the evidence bound have no posterior to draw (the table says so).
     unsampled = {r.name for r in comparison.results if getattr(r, "posterior", True) is None}
     missing = [n for n in comparison.ranking if f"corner_{file_stem(n)}" not in figures
@@ -594,8 +592,6 @@ def render_report(comparison, figures: dict | None = None) -> str:
         f"<h2 id='priors'>Priors</h2>{_priors_section(comparison)}",
         f"<h2 id='diagnostics'>Warnings and convergence</h2>{_diagnostics_section(comparison)}",
     ]
-    from .. import __version__
-
     return (
         "<!DOCTYPE html>\n<html lang='en'>\n<head>\n<meta charset='utf-8'>\n"
         "<meta name='viewport' content='width=device-width, initial-scale=1'>\n"

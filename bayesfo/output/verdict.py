@@ -18,8 +18,10 @@ from __future__ import annotations
 import math
 
 from ..comparison.parameters import UNDETERMINED_DECADES, flagged_names, shown_hdi
-from ..comparison.table import CRITERIA, ORDER_SYMBOLS
+from ..comparison.steps import BOUND_METHOD, NOISE_DECISIVE
+from ..comparison.table import CRITERIA, ORDER_SYMBOLS, order_parameters
 from ..data.symbols import in_symbol, parameter_label
+from ..inference.bound import BOUND_MARGIN
 from ..options import VERY_STRONG
 
 #: Kass & Raftery (1995) on ln B (their 2 ln B thresholds 2, 6, 10, halved).
@@ -55,8 +57,6 @@ def _strength(d: float) -> str:
 
 def _orders(result) -> list:
     """``(name, summary)`` of every fractional order of a result's posterior."""
-    from ..comparison.table import order_parameters
-
     summary = result.posterior.summary
     return [(p, summary[p]) for p in order_parameters(summary)]
 
@@ -178,8 +178,6 @@ def verdict(comparison) -> list[tuple[str, bool]]:
                 out.append((f"The difference from {second['structure']} is within twice its "
                             "estimation error: the evidence does not separate the two.", True))
     if bounded:
-        from ..inference.bound import BOUND_MARGIN
-
         listed = _join([f"{r['structure']} (ln Z ≤ {r['log_evidence_bound']:.2f})"
                         for r in bounded])
         out.append((f"Not sampled: {listed}: the best fit of each (the global optimiser's "
@@ -329,8 +327,6 @@ def _undecided_noise(name, result) -> str:
     """``"zener (q 0.236–0.259 under constant noise, 0.463–0.549 under proportional;
     probability 0.891 for constant)"`` where the structure's exponents depend on the noise
     model and the evidence does not decide it; empty otherwise."""
-    from ..comparison.steps import NOISE_DECISIVE
-
     record = result.criteria.noise_models
     if not record or not record.get("sensitive"):
         return ""
@@ -349,8 +345,6 @@ def _undecided_noise(name, result) -> str:
 def _plausible(models) -> list[str]:
     """The noise models the evidence has not excluded (probability of at least
     1 − NOISE_DECISIVE, or none stated)."""
-    from ..comparison.steps import NOISE_DECISIVE
-
     return [n for n, m in models.items()
             if m["probability"] is None or m["probability"] >= 1.0 - NOISE_DECISIVE]
 
@@ -363,8 +357,6 @@ def _contested(record) -> list[str]:
 
 def _noise_sentences(name, result) -> list[tuple[str, bool]]:
     """How the winner's noise model was chosen, and whether its exponents depend on it."""
-    from ..comparison.steps import BOUND_METHOD, NOISE_DECISIVE
-
     record = result.criteria.noise_models
     if not record:
         return []

@@ -1,5 +1,7 @@
-"""The output directory of a comparison: one NetCDF per structure, figures, report.html,
-ranking.csv and summary.json, swapped in as one run (:mod:`bayesfo.outdir`)."""
+"""The output directory of a comparison (one NetCDF per structure, figures, report.html,
+ranking.csv and summary.json: :func:`write_outputs`) and of a master curve (summary.json,
+master.csv, the joint posterior's NetCDF, figures and report.html: :func:`write_mastercurve`),
+each swapped in as one run (:mod:`bayesfo.outdir`)."""
 
 from __future__ import annotations
 
@@ -17,9 +19,11 @@ from .._io import atomic_write_text
 from ..comparison.results import Comparison
 from ..comparison.stored import netcdf_for
 from ..comparison.table import RANKING_FIELDS
-from ..inference import save_netcdf
+from ..inference import preload_arviz, save_netcdf
 from ..options import STRUCTURE_FIGURES
 from ..outdir import final_path, staged_run
+from ..tts.result import MasterCurve
+from ..tts.stored import netcdf_of, summary_fields
 
 
 def ranking_csv(comparison: Comparison) -> str:
@@ -70,8 +74,8 @@ def _without_distributed():
     """Inside the block, dask's ``distributed`` cannot be imported unless it already was.
 
     xarray's ``to_netcdf`` asks dask which scheduler is active, and dask imports ``distributed``
-    (when installed) to look for a ``Client`` (about 0.2 s on a quiet machine, 1 s on a busy
-    one, in every command that writes NetCDF). A ``Client`` cannot exist in a process that never
+    (when installed) to look for a ``Client``, an import that costs every command that writes
+    NetCDF noticeable time. A ``Client`` cannot exist in a process that never
     imported the package, so the answer is the same without it: the import fails at once
     (``sys.modules`` entries ``None``) and xarray takes the scheduler for a local one. A process
     that has imported it (a batch on a Dask cluster) is left alone.
@@ -115,7 +119,6 @@ def preload(formats=()) -> None:
     import scipy.special  # noqa: F401
     import scipy.stats  # noqa: F401
 
-    from ..inference._arviz import preload as preload_arviz
 
     preload_arviz()
     if formats:
@@ -192,3 +195,99 @@ def write_outputs(comparison: Comparison, out_dir, *, figures: bool = True,
     return {name: [final_path(p, stage, out_dir) for p in paths] if isinstance(paths, list)
             else final_path(paths, stage, out_dir) for name, paths in written.items()}
 
+
+
+#: The figures of a master curve's output directory (``figures/NAME.png``), in the order drawn.
+MASTERCURVE_FIGURES = ("mastercurve", "residuals", "van_gurp_palmen")
+
+
+def mastercurve_summary(mc: MasterCurve) -> dict:
+    """The content of a master curve's ``summary.json``: the data, the master curve's fields
+    and what :func:`bayesfo.load` needs to restore it; a number that is not finite (a
+    posterior's undefined diagnostic) is None, as in a comparison's."""
+    return _finite({"data": mc.data.to_dict(), **mc.to_dict(), **summary_fields(mc)})
+
+
+def _master_csv_comments(mc: MasterCurve) -> list[str]:
+    """The comment lines of ``master.csv``: what the reduced data are, the reference
+    temperature (read back by ``compare``) and the shift law."""
+    law = mc.shift_law()
+    return [f"master curve at {mc.reference_temperature:g} °C of {len(mc.temperatures)} "
+            f"isotherms ({min(mc.temperatures):g} to {max(mc.temperatures):g} °C), shifted "
+            f"by the posterior mean log10 a_T"
+            + ("" if mc.vertical == "none" else f" and log10 b_T ({mc.vertical})")
+            + f" of bayesfo mastercurve ({mc.structure})",
+            f"temperature: {mc.reference_temperature:g} °C",
+            f"shift law: {law['name']} "
+            + ", ".join(f"{k} = {v['mean']:.6g} {v['unit']}".rstrip()
+                        for k, v in law["parameters"].items())]
+
+
+def write_mastercurve(mc: MasterCurve, out_dir, *, figures: bool = True) -> dict[str, Path]:
+    """Write what ``bayesfo mastercurve`` writes of a master curve into ``out_dir``.
+
+    ``summary.json`` (:func:`mastercurve_summary`), ``master.csv`` (the reduced data, which
+    :func:`bayesfo.read` and ``compare`` read), ``<structure>.nc`` (the joint posterior, which
+    :func:`bayesfo.load` restores; :mod:`bayesfo.tts.stored`) and, with ``figures``,
+    ``figures/mastercurve.png``, ``figures/residuals.png``, ``figures/van_gurp_palmen.png``
+    and ``report.html``. Staged and swapped in as one run, as :func:`write_outputs` does.
+
+    Parameters
+    ----------
+    mc : MasterCurve
+        From :func:`bayesfo.mastercurve` or :func:`bayesfo.load`.
+    out_dir : path
+        Created if missing.
+    figures : bool
+        Draw the figures and the report (matplotlib).
+
+    Returns
+    -------
+    dict
+        ``{name: path}`` of the files written (figures: ``{"figures": [paths]}``).
+
+    Raises
+    ------
+    OutputError
+        If the outputs cannot be written; the earlier outputs stay.
+
+    Examples
+    --------
+    >>> import bayesfo as bf
+    >>> mc = bf.mastercurve(isotherms, "zener")  # doctest: +SKIP
+    >>> bf.write_mastercurve(mc, "out")["summary.json"]  # doctest: +SKIP
+    PosixPath('out/summary.json')
+    """
+    out_dir = Path(out_dir)
+    summary = mastercurve_summary(mc)
+    master = mc.master_data()
+    comments = _master_csv_comments(mc)
+    written = {}
+    with staged_run(out_dir) as stage:
+        written["summary.json"] = atomic_write_text(
+            stage / "summary.json",
+            json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False) + "\n")
+        written["master.csv"] = atomic_write_text(stage / "master.csv",
+                                                  master.to_csv_text(comments))
+        with _without_distributed():
+            written[f"{mc.structure}.nc"] = save_netcdf(netcdf_of(mc),
+                                                        stage / f"{mc.structure}.nc")
+        if figures:
+            from ..plotting.mastercurve import (
+                plot_isotherm_residuals,
+                plot_mastercurve,
+                plot_van_gurp_palmen,
+            )
+            from ..plotting.output import save_figure
+            from .mastercurve_report import write_mastercurve_report
+
+            (stage / "figures").mkdir()
+            drawn = {}
+            for name, plot in zip(MASTERCURVE_FIGURES, (plot_mastercurve, plot_isotherm_residuals,
+                                                        plot_van_gurp_palmen), strict=True):
+                drawn[name] = stage / "figures" / f"{name}.png"
+                save_figure(plot(mc).figure, drawn[name], close=True)
+            written["figures"] = list(drawn.values())
+            written["report.html"] = write_mastercurve_report(mc, stage, drawn)
+    return {name: [final_path(p, stage, out_dir) for p in paths] if isinstance(paths, list)
+            else final_path(paths, stage, out_dir) for name, paths in written.items()}

@@ -47,6 +47,8 @@ import numpy as np
 from scipy.special import logsumexp
 
 from ..errors import InputError
+from ..inference.likelihood import NOISE_PRIORS, noise_variance
+from ..tts.result import MasterCurve
 
 __all__ = ["COSTS", "Design", "design", "seconds"]
 
@@ -157,22 +159,12 @@ def seconds(omega) -> np.ndarray:
 
 def _noise_var(result, draws, g, rel_sigma) -> np.ndarray:
     """Variance of a measurement's ln|G| and arg G [rad] (last axis) for model responses ``g``
-    (draws × frequencies) under the structure's noise model (small-noise approximation)."""
+    (draws × frequencies) under the structure's noise model
+    (:func:`~bayesfo.inference.likelihood.noise_variance`): each draw's sampled noise scale
+    (its last parameter, physical units), or the data's relative σ under known noise."""
     noise = result.posterior.noise
-    g2 = np.abs(g) ** 2
-    if noise == "known":
-        v = np.full(g.shape, rel_sigma**2 / 2.0)
-        return np.stack([v, v], axis=-1)
-    sigma = draws[:, -1][:, None]  # the noise parameter, last (physical units)
-    if noise == "constant":
-        v = sigma**2 / (2.0 * g2)
-        return np.stack([v, v], axis=-1)
-    if noise == "relative_parts":
-        re2, im2 = g.real**2, g.imag**2
-        return np.stack([sigma**2 * (re2**2 + im2**2) / g2**2,
-                         sigma**2 * 2.0 * re2 * im2 / g2**2], axis=-1)
-    v = np.broadcast_to(sigma**2 / 2.0, g.shape)  # proportional
-    return np.stack([v, v], axis=-1)
+    sigma = draws[:, -1][:, None] if noise in NOISE_PRIORS else rel_sigma
+    return noise_variance(noise, g, sigma)
 
 
 @dataclass
@@ -268,19 +260,22 @@ def _checked(data, window, points, cost) -> tuple[float, float]:
     """The window (default: the data's, a decade wider on each side), after checking it,
     ``points`` and ``cost``."""
     if cost not in COSTS:
-        raise InputError(f"argument 'cost' must be one of {', '.join(COSTS)}, got {cost!r}")
+        raise InputError(f"argument 'cost' must be one of {', '.join(COSTS)}, got {cost!r}",
+                         option="cost")
     if isinstance(points, bool) or not isinstance(points, (int, np.integer)) \
             or not 1 <= points <= 20:
-        raise InputError(f"argument 'points' must be an integer from 1 to 20, got {points!r}")
+        raise InputError(f"argument 'points' must be an integer from 1 to 20, got {points!r}",
+                         option="points")
     if window is None:
         window = (float(data.omega.min()) / 10.0, float(data.omega.max()) * 10.0)
     try:
         w_lo, w_hi = (float(w) for w in window)
     except (TypeError, ValueError):
         raise InputError(f"argument 'window' must be two frequencies (low, high) in rad/s, "
-                         f"got {window!r}") from None
+                         f"got {window!r}", option="window") from None
     if not (0 < w_lo < w_hi and math.isfinite(w_hi)):
-        raise InputError(f"argument 'window' must have 0 < low < high, got ({w_lo:g}, {w_hi:g})")
+        raise InputError(f"argument 'window' must have 0 < low < high, got ({w_lo:g}, {w_hi:g})",
+                         option="window")
     return w_lo, w_hi
 
 
@@ -302,7 +297,7 @@ def capped_window(data, w_lo: float, w_hi: float) -> tuple[float, float, str | N
                          f"{MAX_REACH_DECADES:g} decades beyond the measured frequencies "
                          f"({float(data.omega.min()):.4g}-{float(data.omega.max()):.4g} "
                          "rad/s), where the data constrain no prediction; give a window that "
-                         "reaches nearer")
+                         "reaches nearer", option="window")
     if (lo, hi) == (w_lo, w_hi):
         return w_lo, w_hi, None
     return lo, hi, (f"the window {w_lo:.4g}-{w_hi:.4g} rad/s is cut to {lo:.4g}-{hi:.4g} rad/s, "
@@ -408,7 +403,7 @@ def design(result, *, window=None, points: int = 3, structures=None, cost: str =
         Fewer than two structures to tell apart, a window that is not two positive increasing
         frequencies, an unknown cost or structure.
     """
-    if hasattr(result, "shift_draws"):
+    if isinstance(result, MasterCurve):
         raise InputError("design: a master curve is not a comparison of structures; design "
                          "on a comparison (e.g. of the master curve's master_data())")
     data = result.data

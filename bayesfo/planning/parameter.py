@@ -5,11 +5,13 @@ window)."""
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import DataWarning, InputError
+from ..tts.result import MasterCurve
 from .choice import (
     N_CANDIDATES,
     N_DRAWS,
@@ -113,10 +115,6 @@ def design_parameter(result, parameter: str | None, *, structure: str | None = N
     w_lo, w_hi = _checked(result.data, window, points, cost)
     w_lo, w_hi, cut = capped_window(result.data, w_lo, w_hi)
     if cut is not None:
-        import warnings
-
-        from ..errors import DataWarning
-
         warnings.warn(cut, DataWarning, stacklevel=2)
     name = structure or (result.ranking[0] if result.ranking else None)
     if name not in result.ranking or result[name].posterior is None:
@@ -128,7 +126,7 @@ def design_parameter(result, parameter: str | None, *, structure: str | None = N
     if parameter is not None and parameter not in own:
         raise InputError(f"design: structure {name} has no parameter '{parameter}'; its "
                          f"parameters are {', '.join(own)}")
-    if hasattr(result, "shift_draws"):
+    if isinstance(result, MasterCurve):
         raise InputError("design: a master curve is not a comparison of structures; design "
                          "on a comparison (e.g. of the master curve's master_data())")
     names = own if parameter is None else [parameter]

@@ -11,7 +11,11 @@ import math
 
 import numpy as np
 
+from ..comparison.table import ORDER_SYMBOLS
+from ..comparison.table import order_parameter as from_names
+from ..data.symbols import in_symbol, parameter_label
 from ..errors import InputError
+from ..structures.physical import in_brackets, physical_parameters, physical_units
 
 #: The ranking figure draws at most this many structures (the best by the ranking); the rest
 #: are named in a note under it (the report's table and ranking.csv hold every one).
@@ -126,8 +130,6 @@ def quantiles(values: np.ndarray, probs=BAND_PROBS) -> dict[float, np.ndarray]:
 def order_parameter(result) -> str | None:
     """Name of the free fractional order of a structure
     (:func:`bayesfo.comparison.table.order_parameter`), else None."""
-    from ..comparison.table import order_parameter as from_names
-
     post = result.posterior
     return from_names(post.param_names if post is not None else result.structure.param_names)
 
@@ -192,7 +194,7 @@ def density_1d(samples: np.ndarray, lo: float, hi: float, n_grid: int = 400):
     # Reflection keeps the mass that a kernel puts beyond a hard prior bound. Points farther
     # than KDE_REACH bandwidths from every draw get 0: each kernel is below exp(-50) of its
     # peak there. A narrow posterior on a wide prior leaves most of the even grid and of its
-    # reflections there (the q figure of two structures: 0.34 s → 0.06 s of kernel sums).
+    # reflections there, whose kernel sums are then skipped.
     points = np.concatenate([grid, 2 * lo - grid, 2 * hi - grid])
     near = (points >= x.min() - KDE_REACH * bw) & (points <= x.max() + KDE_REACH * bw)
     values = np.zeros(points.size)
@@ -274,9 +276,6 @@ def natural_coordinates(result) -> Coordinates:
     if phys is None or phys.get("natural_form") != "physical":
         _, labels, is_log = sampling_coordinates(result)
         return Coordinates(post.param_names, labels, is_log, lambda theta: theta, False)
-    from ..comparison.table import ORDER_SYMBOLS
-    from ..structures.physical import physical_parameters, physical_units
-
     kind, unit = result.data_kind, result.data_units
     units = physical_units(s, kind, unit, derived=False)
     k = s.n_params
@@ -343,8 +342,6 @@ def unit_mathtext(unit: str) -> str:
 
 def unit_suffix(unit: str) -> str:
     """`` [unit]`` in mathtext, or nothing for a parameter without a unit."""
-    from ..structures.physical import in_brackets
-
     return in_brackets(unit_mathtext(unit) if unit else "")
 
 
@@ -395,8 +392,6 @@ def param_symbol(name: str) -> str:
 def _label(name: str, log: bool, unit: str = "", symbol: str = "G") -> str:
     """The axis label of a parameter: its name in the letters of data measured as ``symbol``
     (``G_e`` → ``$E_{e}$`` for tensile data), log10 where drawn so, and its unit."""
-    from ..data.symbols import in_symbol, parameter_label
-
     sym = param_symbol(parameter_label(name, symbol))
     return (f"log$_{{10}}$ {sym}" if log else sym) + unit_suffix(in_symbol(unit, symbol))
 

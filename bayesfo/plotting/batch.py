@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..comparison.table import ORDER_SYMBOLS
+from .style import structure_styles
+
 HDI_LABEL = "94 % HDI"
 
 
@@ -25,8 +28,6 @@ def _structure_styles(rows, order=None):
     """``{name: StructureStyle}``: by position in ``order`` (the structures as requested, as
     in :func:`~.style.comparison_styles`), then the others alphabetically, including
     structures without results, so that a structure has one style in every figure."""
-    from .style import structure_styles
-
     names = list(dict.fromkeys(order or []))
     others = {r["structure"] for r in rows if r.get("structure")} - set(names)
     return structure_styles(names + sorted(others))
@@ -63,8 +64,6 @@ def _order_series(rows, name: str, marker: str) -> list[tuple]:
     batch's table gives them) or, for rows read back from ``batch_summary.csv``, its one
     ``q_*`` columns. The first order has the structure's marker, the others
     :data:`ORDER_MARKERS`; the label names the order by its symbol unless it is a plain q."""
-    from ..comparison.table import ORDER_SYMBOLS
-
     sel = [r for r in rows if r.get("structure") == name]
     keys = list(dict.fromkeys(k for r in sel for k in (r.get("order_summaries") or {})))
     if keys:

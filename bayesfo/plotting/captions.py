@@ -16,11 +16,13 @@ from __future__ import annotations
 import math
 import re
 
+from ..data.symbols import in_symbol
 from ._compute import (
     NYQUIST_LOG_DECADES,
     ORDER_STRUCTURES,
     RANKING_SHOWN,
     magnitude_decades,
+    natural_coordinates,
 )
 
 #: Convergence targets of the sampler (as :mod:`bayesfo.inference.results`).
@@ -75,8 +77,6 @@ def trace_caption(result) -> str:
 
 def corner_caption(result) -> str:
     """Caption of :func:`~bayesfo.plotting.plot_corner` for ``result``."""
-    from ._compute import natural_coordinates
-
     post = result.posterior
     coords = natural_coordinates(result)
     form = ("the physical parameters and the noise; log10 of those that are positive"
@@ -104,8 +104,6 @@ def figure_caption(name: str, comparison) -> str | None:
     ``comparison`` (``corner_<structure>`` and ``trace_<structure>`` by the structure's file
     stem), or None for a name it does not know. The response's symbols follow the data's
     (E′, E″, E(t), D(t) for tensile data, :attr:`~bayesfo.data.FrequencyResponse.symbol`)."""
-    from ..data.symbols import in_symbol
-
     text = _combined_caption(name, comparison)
     if text is not None:
         return in_symbol(text, getattr(comparison.data, "symbol", "G"))

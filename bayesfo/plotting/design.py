@@ -6,6 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from ._base import Drawn, new_figure
+from ._compute import quantiles, response_draws, unwrapped_phase_deg
+from .response import OMEGA_LABEL, _band
+from .style import COLUMN_WIDTH, DATA_COLOR, comparison_styles, quantity_symbol, style
 
 
 def plot_design(result, plan, *, fig=None, n_draws: int = 300, seed: int = 0) -> Drawn:
@@ -24,10 +27,6 @@ def plot_design(result, plan, *, fig=None, n_draws: int = 300, seed: int = 0) ->
         Axes (magnitude, phase, information). Values: ``"omega"`` (the candidates),
         ``"information"``, ``"proposed"``, per structure ``"<name>/magnitude_median"``.
     """
-    from ._compute import quantiles, response_draws, unwrapped_phase_deg
-    from .response import OMEGA_LABEL, _band
-    from .style import COLUMN_WIDTH, DATA_COLOR, comparison_styles, quantity_symbol, style
-
     with style():
         fig = new_figure(fig, (COLUMN_WIDTH + 0.4, 5.2))
         axes = fig.subplots(3, 1, sharex=True, height_ratios=[1.2, 1.0, 0.8])

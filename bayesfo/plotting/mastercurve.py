@@ -7,9 +7,14 @@ import numpy as np
 
 from ..data.symbols import parts as parts_of
 from ..data.symbols import response_symbol
+from ..predictions import evaluate
+from ..structures import get_structure
 from ..structures.physical import in_brackets
-from ._base import Drawn, new_figure
-from .style import temperature_colormap
+from ..tts import arrhenius, wlf
+from ..tts.joint import ISOTHERM_MISFIT
+from ..tts.validity import loss_angle_deg
+from ._base import Drawn, axes_or_new, new_figure
+from .style import COLUMN_WIDTH, style, temperature_colormap
 
 
 def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
@@ -27,8 +32,6 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     """
     import matplotlib as mpl
 
-    from ..predictions import evaluate
-    from ..structures import get_structure
 
     fig = new_figure(fig, (11.0, 3.8))
     axes = fig.subplots(1, 3)
@@ -87,8 +90,6 @@ def plot_mastercurve(mc, *, fig=None, n_grid: int = 200) -> Drawn:
     ax.errorbar(temps, mean, yerr=[mean - low, high - mean], fmt="o", color="k", ms=3,
                 capsize=2, label=f"posterior (94 % HDI{shifts})")
     tt = np.linspace(temps.min(), temps.max(), 200)
-    from ..tts import arrhenius, wlf
-
     laws = mc.laws
     c1, c2 = (laws["wlf"]["parameters"][k]["mean"] for k in ("C1", "C2"))
     ea = laws["arrhenius"]["parameters"]["Ea"]["mean"]
@@ -125,9 +126,6 @@ def plot_van_gurp_palmen(mc, *, ax=None) -> Drawn:
     """
     import matplotlib as mpl
 
-    from ..tts.validity import loss_angle_deg
-    from ._base import axes_or_new
-    from .style import COLUMN_WIDTH, style
 
     with style():
         fig, ax = axes_or_new(ax, (COLUMN_WIDTH + 0.6, 3.2))
@@ -177,9 +175,6 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
     """
     import matplotlib as mpl
 
-    from ..predictions.functions import _evaluate
-    from ..structures import get_structure
-    from ..tts.joint import ISOTHERM_MISFIT
 
     fig = new_figure(fig, (11.0, 3.6))
     axes = fig.subplots(1, 3)
@@ -201,7 +196,7 @@ def plot_isotherm_residuals(mc, *, fig=None, n_draws: int = 200, seed: int = 0) 
         shifts = mc.shift_draws[rows, i]
         w = d.omega[None, :] * 10.0 ** shifts[:, None]
         quantity = ("storage", "loss") if modulus else ("storage_compliance", "loss_compliance")
-        parts = [_evaluate(structure, theta, q, w) for q in quantity]
+        parts = [evaluate(structure, theta, q, w) for q in quantity]
         if vertical is not None:  # the model of the isotherm: the master divided by b_T
             scale = 10.0 ** (-vertical[:, i] if modulus else vertical[:, i])
             parts = [p * scale[:, None] for p in parts]

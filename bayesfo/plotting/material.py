@@ -13,11 +13,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ._base import Drawn, new_figure
+from ..predictions.functions import QUANTITIES, evaluate_together, quantity_unit
+from ..structures.physical import in_brackets
+from ._base import Drawn, axes_or_new, new_figure
 from ._compute import N_DRAWS, legend_name, select_results, structure_draws
 from ._legend import _legend
 from .response import _band_handle, positive_band
-from .style import COLUMN_WIDTH, EXTRAPOLATED, comparison_styles
+from .style import COLUMN_WIDTH, EXTRAPOLATED, comparison_styles, style
 
 #: Points of the time grid.
 N_TIMES = 120
@@ -55,8 +57,6 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
     InputError
         For generic (transfer-function) data, or an unknown or failed structure.
     """
-    from ..predictions.functions import _unit, evaluate_together
-
     data = comparison.data
     if data.kind not in ("modulus", "compliance"):
         raise InputError("G(t) and J(t) are defined for modulus or compliance data, not for "
@@ -67,8 +67,6 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
     styles = comparison_styles(comparison)
     values, artists = {"time": t, "window": np.array(window)}, {}
     handles, labels = [], []
-    from .style import style
-
     quantities = ("relaxation_modulus", "creep_compliance")
     # G(t) and J(t) for shear data, E(t) and D(t) for tensile data
     symbols = {"relaxation_modulus": f"{data.modulus_symbol}(t)",
@@ -89,7 +87,7 @@ def plot_time_functions(comparison, structures=None, fig=None, *, n_draws: int =
         for ax, q in zip(axes, quantities, strict=True):
             ax.set_xscale("log")
             ax.set_yscale("log")
-            u = _unit(q, data) if data.units else ""
+            u = quantity_unit(q, data) if data.units else ""
             ax.set_ylabel(symbols[q] + (f" [{u}]" if u else ""))
             lo, hi = t[0], t[-1]
             ax.axvspan(lo, window[0], **EXTRAPOLATED)
@@ -110,8 +108,6 @@ def plot_prediction(prediction, *, ax=None) -> Drawn:
     Drawn
         Values: ``"x"``, ``"median"``, ``"hdi_low"``, ``"hdi_high"``.
     """
-    from ._base import axes_or_new
-
     p = prediction
     fig, ax = axes_or_new(ax, (COLUMN_WIDTH, 3.2))
     finite = np.isfinite(p.median)
@@ -144,9 +140,6 @@ def plot_prediction(prediction, *, ax=None) -> Drawn:
         for k, i in enumerate(np.flatnonzero(out)):
             ax.axvspan(bounds[i], bounds[i + 1], **EXTRAPOLATED,
                        label=None if k else "extrapolated")
-    from ..predictions.functions import QUANTITIES
-    from ..structures.physical import in_brackets
-
     domain = QUANTITIES[p.quantity][0]
     ax.set_xlabel({"omega": "ω [rad/s]", "time": "t [s]", "tau": "τ [s]"}[domain])
     ax.set_ylabel(f"{p.symbol}" + in_brackets(p.unit))

@@ -33,7 +33,7 @@ from ._compute import (
 )
 from ._legend import _legend, _note_artists
 from .response import DATA_STYLE, HOLDOUT_STYLE, OMEGA_LABEL, _band_handle, positive_band
-from .style import COLUMN_WIDTH, comparison_styles, unit_suffix
+from .style import COLUMN_WIDTH, comparison_styles, style, unit_suffix
 
 #: Symbols of the panels for each kind of shear data: (storage, loss); tensile data (symbol E)
 #: take E′, E″ and D′, D″ (:func:`bayesfo.data.symbols.parts`).
@@ -128,8 +128,6 @@ def plot_moduli(comparison, structures=None, fig=None, *, n_draws: int = N_DRAWS
     styles = comparison_styles(comparison)
     values, artists = {"omega": omega}, {}
     handles, labels = [], []
-    from .style import style
-
     with style():
         fig = new_figure(fig, (COLUMN_WIDTH, 5.2))
         axes = fig.subplots(3, 1, sharex=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..comparison.table import order_parameters
 from ..errors import InputError
 from ._base import Drawn, axes_or_new
 from ._compute import (
@@ -81,7 +82,6 @@ def plot_q_posteriors(comparison, ax=None, *, ridge_height: float = 0.85,
     """
     from matplotlib.transforms import blended_transform_factory
 
-    from ..comparison.table import order_parameters
 
     # One ridge per fractional order: a structure's first order (q, else β, else α) under its
     # name, its other orders (the second springpot's) under "<name>:<order>".

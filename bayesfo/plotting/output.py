@@ -8,6 +8,8 @@ import tempfile
 import warnings
 from pathlib import Path
 
+from .._io import is_special, publish, write_into, write_target
+from .._signals import cause
 from ..comparison.table import CRITERIA, CRITERIA_DIRECTION
 from ..errors import InputError
 from ..options import (
@@ -19,6 +21,7 @@ from ..options import (
     figure_format_names,
     structure_figures_ok,
 )
+from ..parallel import fork_safe, single_blas_thread
 from ._compute import ok_results, order_parameter
 from .captions import file_stem
 from .material import plot_time_functions
@@ -42,9 +45,6 @@ def save_figure(fig, path, *, close: bool = False, named: bool = False) -> None:
             return save_figure(fig, path, named=named)
         finally:
             plt.close(fig)
-    from .._io import is_special, publish, write_into, write_target
-    from .._signals import cause
-
     path = write_target(path) if named else Path(path)
     if named and is_special(path):
         import io
@@ -57,8 +57,8 @@ def save_figure(fig, path, *, close: bool = False, named: bool = False) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
-        # zlib level 1 for PNG: a quarter of the saving time less, files 8 % larger
-        # (BENCHMARKS.md, "Thirteenth session").
+        # zlib level 1 for PNG: less saving time for slightly larger files (BENCHMARKS.md,
+        # "PNG figures at zlib level 1").
         extra = {"pil_kwargs": {"compress_level": 1}} if path.suffix.lower() == ".png" else {}
         fig.savefig(tmp, dpi=200, **extra)
         publish(tmp, path)
@@ -348,8 +348,6 @@ def can_fork() -> bool:
     """Whether :func:`draw_forked` can fork this process (:func:`bayesfo.parallel.fork_safe`:
     on Linux, no other Python thread running once tqdm's idle monitor is ended, and no
     on-screen matplotlib backend)."""
-    from ..parallel import fork_safe
-
     return fork_safe()
 
 
@@ -466,7 +464,6 @@ def draw_forked(comparison, out_dir, formats=("png",), *, seed: int = 0,
     """
     import multiprocessing
 
-    from ..parallel import single_blas_thread
 
     formats = check_formats(formats)
     out_dir = Path(out_dir)

@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..data.symbols import modulus_symbol
+from ..predictions import predict
+from ..structures.physical import in_brackets
 from ._base import Drawn, new_figure
 from .style import EXTRAPOLATED
 
@@ -34,9 +37,6 @@ def plot_prony(result, prony, *, structure=None, average=None, seed: int = 0,
         Axes: (relaxation, error). Values: ``"t"``, ``"model_median"``, ``"model_low"``,
         ``"model_high"``, ``"series"``, ``"relative_error"`` (series against the median).
     """
-    from ..data.symbols import modulus_symbol
-    from ..predictions import predict
-
     lo, hi = prony.window
     t = np.logspace(np.log10(lo) - 1, np.log10(hi) + 1, N_TIMES)
     model = predict(result, "relaxation_modulus", t, structure=structure, average=average,
@@ -45,8 +45,6 @@ def plot_prony(result, prony, *, structure=None, average=None, seed: int = 0,
     error = series / model.median - 1
     half = (model.hdi_high - model.hdi_low) / 2 / np.abs(model.median)
     letter = modulus_symbol(prony.symbol)
-    from ..structures.physical import in_brackets
-
     unit = in_brackets(prony.unit)
 
     fig = new_figure(fig, (6.4, 5.2))

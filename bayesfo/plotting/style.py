@@ -20,6 +20,8 @@ from __future__ import annotations
 import contextlib
 from dataclasses import dataclass
 
+from ..data.symbols import response_symbol
+
 COLUMN_WIDTH = 3.5
 PAGE_WIDTH = 7.1
 
@@ -164,8 +166,6 @@ def quantity_symbol(kind: str, symbol: str = "G") -> str:
     """Mathtext symbol of the response for data of ``kind`` measured as ``symbol``
     (:attr:`~bayesfo.data.FrequencyResponse.symbol`): G* or J* for shear, E* or D* for
     tensile data, the plain letter for a generic response."""
-    from ..data.symbols import response_symbol
-
     letter = response_symbol(symbol, kind)
     return f"{letter}^*" if kind in ("modulus", "compliance") else letter
 

@@ -32,7 +32,8 @@ def _has_unit(unit: str) -> bool:
 def deck_text(prony, fmt: str) -> str:
     """The series ``prony`` in ``fmt`` (one of :data:`~bayesfo.predictions.prony.FORMATS`)."""
     if fmt not in FORMATS:
-        raise InputError(f"export: format must be one of {', '.join(FORMATS)}, got {fmt!r}")
+        raise InputError(f"export: format must be one of {', '.join(FORMATS)}, got {fmt!r}",
+                         where="export")
     e, mode = modulus_symbol(prony.symbol), mode_of(prony.symbol)
     head = [f"Prony series of {prony.source} (bayesfo), {mode} modulus {e}"
             + (f" in {prony.unit}" if _has_unit(prony.unit) else " (the data give no unit)")
@@ -133,10 +134,12 @@ def _lsdyna(prony, head: list[str]) -> list[str]:
     if prony.g_inf > 0:
         rows.append((prony.g_inf, 0.0))
     if len(rows) > LSDYNA_MAX_TERMS:
-        raise InputError(f"export: LS-DYNA's *MAT_GENERAL_VISCOELASTIC takes at most "
-                         f"{LSDYNA_MAX_TERMS} terms (G_inf counts as one), this series has "
-                         f"{len(rows)}; ask for fewer (terms {LSDYNA_MAX_TERMS - 1} or 1 per "
-                         "decade), or for the automatic number of terms")
+        said = (f"LS-DYNA's *MAT_GENERAL_VISCOELASTIC takes at most {LSDYNA_MAX_TERMS} terms "
+                f"(G_inf counts as one), this series has {len(rows)}; ask for fewer")
+        raise InputError(f"export: {said} (terms {LSDYNA_MAX_TERMS - 1} or 1 per decade), or for "
+                         "the automatic number of terms",
+                         command_line=f"{said} (--terms {LSDYNA_MAX_TERMS - 1} or --per-decade 1), "
+                         "or for the automatic number of terms")
 
     def field(v: float) -> str:  # 4 significant digits: a blank keeps the fields apart
         return f"{v:10.3E}" if v != 0 else f"{0.0:10.1f}"

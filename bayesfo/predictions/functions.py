@@ -29,8 +29,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.symbols import in_symbol
 from ..errors import InputError
 from . import laplace
+from .draws import AVERAGES, MAX_DRAWS, Draws  # noqa: F401  (AVERAGES, MAX_DRAWS: named here too)
 
 #: quantity: (the argument it takes, its symbol, the dimension of its values).
 QUANTITIES = {
@@ -48,12 +50,8 @@ QUANTITIES = {
 #: The unit of each kind of argument, and its name.
 X_UNITS = {"omega": "rad/s", "time": "s", "tau": "s"}
 X_NAMES = {"omega": "omega", "time": "t", "tau": "tau"}
-#: Ways of averaging over structures.
-AVERAGES = ("bma", "stacking")
 #: Probability of the credible band (the highest-density interval, as everywhere in bayesfo).
 BAND = 0.94
-#: Posterior draws used per prediction (a random subset where a posterior has more).
-MAX_DRAWS = 2000
 #: Draws evaluated at once in the time domain (the contour's nodes multiply the work).
 _CHUNK = 250
 #: Arguments evaluated at once: they are taken in chunks of this many, so that memory stays
@@ -215,41 +213,14 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
     data = result.data
     if data.kind not in ("modulus", "compliance"):
         raise InputError(f"predict: the data are a {data.kind} transfer function; material "
-                         "functions follow from modulus or compliance data only")
-    if structure is not None and average is not None:
-        raise InputError("predict: give a structure or an average, not both")
-    rng = np.random.default_rng(seed)
-    if hasattr(result, "shift_draws"):
-        return _predict_master(result, quantity, x, structure, average, temperature, rng)
-    if temperature is not None:
-        raise InputError("predict: a temperature applies to a master curve only (bayesfo "
-                         "mastercurve); a comparison describes the data at their own temperature")
-    weights, notes, drawn = _mixture(result, structure, average, rng)
-    median, lo, hi, values = _chunked_band(
-        lambda part: np.concatenate([_evaluate(s, theta, quantity, part)
-                                     for s, theta in drawn], axis=0),
-        x, sum(theta.shape[0] for _, theta in drawn))
-    if average is None:
-        notes += _misfit_note(result[next(iter(weights))])
-    if quantity in ("relaxation_spectrum", "retardation_spectrum"):
-        discrete = [n for n in weights if result[n].structure.integer and weights[n] >= 1e-3]
-        if discrete:
-            notes.append(f"{', '.join(discrete)}: integer orders give a discrete spectrum "
-                         "(lines at the relaxation times), which a continuous density shows "
-                         "as 0 between them")
-    undefined = np.flatnonzero(np.isnan(median))
-    if undefined.size:
-        shown = ", ".join(f"{v:.4g}" for v in x[undefined[:6]])
-        notes.append(f"{_symbol(quantity, data)} is not finite for some draws at {X_NAMES[domain]} "
-                     f"{shown}{' and more' if undefined.size > 6 else ''} {X_UNITS[domain]}: "
-                     "no value or band there")
-    return Prediction(
-        quantity=quantity, unit=_unit(quantity, data), x=x, x_unit=X_UNITS[domain],
-        median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, data.omega),
-        structure=next(iter(weights)) if average is None else None,
-        weights=dict(weights) if average is not None else None, average=average,
-        notes=tuple(notes), values=values, symbol=_symbol(quantity, data),
-        window=_window(domain, data.omega))
+                         "functions follow from modulus or compliance data only", where="predict")
+    if isinstance(result, Draws):
+        if structure is not None or average is not None or temperature is not None:
+            raise InputError("predict: draws are of one structure, average and temperature "
+                             "already; give those to result.draws(...)", where="predict")
+        return _predict(result, quantity, x)
+    return _predict(result.draws(structure=structure, average=average, seed=seed,
+                                 temperature=temperature), quantity, x)
 
 
 #: How each kind of quantity scales with the vertical shift b_T and the horizontal a_T
@@ -257,69 +228,61 @@ def predict(result, quantity: str, x, *, structure: str | None = None,
 _SCALING = {"modulus": (0, -1), "compliance": (0, 1), "viscosity": (1, -1), "none": (0, 0)}
 
 
-def _predict_master(mc, quantity: str, x, structure, average, temperature, rng) -> Prediction:
-    """:func:`predict` of a master curve: its master structure's draws, each with its own
-    shifts at ``temperature`` (the reference temperature by default)."""
+def draws_values(draws: Draws, quantity: str, x) -> np.ndarray:
+    """``quantity`` at ``x`` (checked, one dimension) for every draw of ``draws``: shape
+    (n_draws, n_x). A master curve's draws are each evaluated at their own shifts,
+    G(ω; T) = G_ref(a_T ω)/b_T and G(t; T) = G_ref(t/a_T)/b_T."""
     domain = QUANTITIES[quantity][0]
-    t = mc.reference_temperature if temperature is None else temperature
-    master, theta, log_a, log_b, mean_a = _master_draws(mc, structure, average, t, rng)
-    a = 10.0 ** log_a[:, None]
+    if not draws.shifted:
+        return np.concatenate([_evaluate(s, theta, quantity, x)
+                               for _, s, theta in draws.parts if theta.shape[0]], axis=0)
+    a = 10.0 ** draws.log_a[:, None]
     pa, pb = _SCALING[QUANTITIES[quantity][2]]
+    ((_, structure, theta),) = draws.parts
+    values = _evaluate(structure, theta, quantity, x[None, :] * a if domain == "omega"
+                       else x[None, :] / a)
+    if pa or pb:
+        values = values * 10.0 ** (pa * draws.log_a + pb * draws.log_b)[:, None]
+    return values
 
-    def at(part):
-        values = _evaluate(master, theta, quantity,
-                           part[None, :] * a if domain == "omega" else part[None, :] / a)
-        if pa or pb:
-            values = values * 10.0 ** (pa * log_a + pb * log_b)[:, None]
-        return values
 
-    median, lo, hi, values = _chunked_band(at, x, theta.shape[0])
-    notes = [] if temperature is None else [
-        f"at {float(t):g} °C from the master curve at {mc.reference_temperature:g} °C with each "
-        f"draw's shifts (log10 a_T median {np.median(log_a):.3g}"
-        + ("" if mc.vertical == "none" else f", log10 b_T median {np.median(log_b):.3g}")
-        + ")"]
-    if (missed := mc.misfit()):
-        notes.append(missed[0].lower() + missed[1:].rstrip(".") + "; the band is the posterior "
-                     "of its mean function, without the data's scatter or its misfit, so "
-                     "measured values may lie outside it")
-    # At the posterior mean shift, as the reduced window: an isotherm's own frequencies at its
-    # own temperature are then inside it.
-    window = mc.reduced_omega() / 10.0 ** mean_a
+def _predict(draws: Draws, quantity: str, x) -> Prediction:
+    """:func:`predict` of ``draws`` at checked ``x``."""
+    domain = QUANTITIES[quantity][0]
+    data = draws.data
+    median, lo, hi, values = _chunked_band(lambda part: draws_values(draws, quantity, part),
+                                           x, draws.n_draws)
+    notes = list(draws.notes)
+    if not draws.shifted:
+        if quantity in ("relaxation_spectrum", "retardation_spectrum"):
+            discrete = [n for n, s, _ in draws.parts
+                        if s.integer and draws.weights[n] >= 1e-3]
+            if discrete:
+                notes.append(f"{', '.join(discrete)}: integer orders give a discrete spectrum "
+                             "(lines at the relaxation times), which a continuous density "
+                             "shows as 0 between them")
+        undefined = np.flatnonzero(np.isnan(median))
+        if undefined.size:
+            shown = ", ".join(f"{v:.4g}" for v in x[undefined[:6]])
+            notes.append(f"{_symbol(quantity, data)} is not finite for some draws at "
+                         f"{X_NAMES[domain]} {shown}{' and more' if undefined.size > 6 else ''} "
+                         f"{X_UNITS[domain]}: no value or band there")
+    window = draws.window()
     return Prediction(
-        quantity=quantity, unit=_unit(quantity, mc.data), x=x, x_unit=X_UNITS[domain],
+        quantity=quantity, unit=quantity_unit(quantity, data), x=x, x_unit=X_UNITS[domain],
         median=median, hdi_low=lo, hdi_high=hi, extrapolated=_outside(x, domain, window),
-        structure=mc.structure, notes=tuple(notes), values=values,
-        symbol=_symbol(quantity, mc.data), window=_window(domain, window), temperature=float(t))
-
-
-def _master_draws(mc, structure, average, temperature, rng) -> tuple:
-    """The master structure, :data:`MAX_DRAWS` of its draws, their log10 shifts (a_T, b_T) at
-    ``temperature``, and the posterior mean of log10 a_T there (over every draw)."""
-    if average is not None:
-        raise InputError("predict: a master curve holds the posterior of one master "
-                          f"structure ({mc.structure}), so there is nothing to average")
-    if structure is not None and structure != mc.structure:
-        raise InputError(f"predict: the master curve's structure is {mc.structure!r}, not "
-                          f"{structure!r}")
-    n = mc.master_draws.shape[0]
-    rows = (np.sort(rng.choice(n, size=MAX_DRAWS, replace=False)) if n >= MAX_DRAWS
-            else rng.choice(n, size=MAX_DRAWS, replace=True))
-    log_a, log_b = mc.shifts_at(temperature)
-    master = mc.master
-    if master is None:  # a MasterCurve built by hand, with the structure's name only
-        from ..structures import get_structure
-
-        master = get_structure(mc.structure)
-    return (master, np.asarray(mc.master_draws, float)[rows], log_a[rows], log_b[rows],
-            float(np.mean(log_a)))
+        structure=draws.structure,
+        weights=dict(draws.weights) if draws.average is not None else None,
+        average=draws.average, notes=tuple(notes), values=values,
+        symbol=_symbol(quantity, data), window=_window(domain, window),
+        temperature=draws.temperature)
 
 
 # ---------------------------------------------------------------------------- checks
 def _check_quantity(quantity) -> str:
     if quantity not in QUANTITIES:
         raise InputError(f"predict: unknown quantity {quantity!r}; one of "
-                         + ", ".join(QUANTITIES))
+                         + ", ".join(QUANTITIES), where="predict")
     return quantity
 
 
@@ -328,141 +291,26 @@ def _check_x(x, domain: str) -> np.ndarray:
     try:
         x = np.atleast_1d(np.asarray(x, dtype=float))
     except (TypeError, ValueError):
-        raise InputError(f"predict: the {what} must be numbers") from None
+        raise InputError(f"predict: the {what} must be numbers", where="predict") from None
     if x.ndim != 1 or x.size == 0:
-        raise InputError(f"predict: give one or more {what}")
+        raise InputError(f"predict: give one or more {what}", where="predict")
     bad = ~np.isfinite(x) | (x <= 0)
     if bad.any():
-        raise InputError(f"predict: the {what} must be finite and > 0; got {x[bad][0]:g}")
+        raise InputError(f"predict: the {what} must be finite and > 0; got {x[bad][0]:g}", where="predict")
     return x
-
-
-def _best(result) -> str:
-    if not result.ranking:
-        raise InputError("predict: the comparison has no structure with a posterior")
-    return result.ranking[0]
-
-
-def _usable(result, name: str):
-    try:
-        r = result[name]
-    except KeyError:
-        raise InputError(f"predict: no structure {name!r} in the comparison; it has "
-                         + ", ".join(x.name for x in result.results)) from None
-    if r.error is not None or r.posterior is None:
-        raise InputError(f"predict: structure {name!r} has no posterior ({r.error})")
-    return r
-
-
-# ---------------------------------------------------------------------------- weights
-def _weights(result, average: str) -> tuple[dict, list]:
-    """``{structure: weight}`` (summing to 1) and notes, for ``average``."""
-    if average not in AVERAGES:
-        raise InputError(f"predict: average must be one of {', '.join(AVERAGES)}, got "
-                         f"{average!r}")
-    # Structures the evidence bound left out have no posterior and weigh below e^-10 against
-    # the leader: they take no part (their weight in Bayesian model averaging is negligible).
-    ranked = [result[n] for n in result.ranking if result[n].posterior is not None]
-    if len(ranked) < 2:
-        raise InputError("predict: an average needs two or more structures with a posterior")
-    bma = {r.name: r.probability for r in ranked}
-    if any(v is None for v in bma.values()):
-        bma = None
-    notes = []
-    stacking = _stacking(ranked)
-    if average == "bma":
-        if bma is None:
-            raise InputError("predict: some structures have no evidence, so no posterior "
-                             "model probabilities; use average='stacking'")
-        weights = bma
-    else:
-        if stacking is None:
-            raise InputError("predict: stacking needs the pointwise log-likelihood of every "
-                             "structure (a comparison loaded from an older run lacks it)")
-        weights = stacking
-    if bma is not None and stacking is not None:
-        apart = max(abs(bma[n] - stacking[n]) for n in bma)
-        if apart > 0.5:
-            notes.append(f"the posterior model probabilities and the stacking weights disagree "
-                         f"(by up to {apart:.2f} for one structure): the average depends on "
-                         "which is taken")
-    for r in ranked:
-        adequacy = r.criteria.adequacy
-        if weights[r.name] >= 0.1 and adequacy is not None and not adequacy.adequate:
-            how = ("misses the data systematically, if by little" if adequacy.misfit_small
-                   else "does not fit the data")
-            notes.append(f"{r.name} carries weight {weights[r.name]:.2f} but {how} (posterior "
-                         "predictive checks)")
-    return weights, notes
-
-
-def _stacking(ranked) -> dict | None:
-    """Stacking weights of the structures (arviz-stats on their pointwise log-likelihood)."""
-    from arviz_stats import compare
-
-    trees = {r.name: r.posterior.idata for r in ranked}
-    if any(t is None or "log_likelihood" not in t.children for t in trees.values()):
-        return None
-    import warnings
-
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        warnings.simplefilter("ignore")  # Pareto k̂ warnings: compare() flags them already
-        table = compare(trees, method="stacking", var_name="G")
-    w = {name: float(table.loc[name, "weight"]) for name in trees}
-    total = sum(w.values())
-    return {k: v / total for k, v in w.items()}
-
-
-def _mixture(result, structure, average, rng) -> tuple[dict, list, list]:
-    """The draws :func:`predict` evaluates: ``(weights, notes, [(structure, theta), ...])``,
-    each structure's share of :data:`MAX_DRAWS` in proportion to its weight (the best ranked
-    structure alone where neither ``structure`` nor ``average`` is given)."""
-    notes = []
-    if average is None:
-        name = structure if structure is not None else _best(result)
-        weights = {_usable(result, name).name: 1.0}
-    else:
-        weights, notes = _weights(result, average)
-    drawn = [(result[name].structure, _draws(result[name], n, rng))
-             for name, n in _draw_counts(weights, rng).items() if n > 0]
-    return weights, notes, drawn
-
-
-def _misfit_note(r) -> list[str]:
-    """A note where the structure predicted from fails the posterior predictive checks: its
-    band is the posterior of the model's mean function, which measured values may then leave."""
-    adequacy = r.criteria.adequacy
-    if adequacy is None or adequacy.adequate:
-        return []
-    how = ("misses the data systematically, if by little" if adequacy.misfit_small
-           else "does not fit the data")
-    return [f"{r.name} {how} (posterior predictive checks): the band is the posterior of its "
-            "mean function, without the data's scatter or its misfit, so measured values may "
-            "lie outside it"]
-
-
-def _draw_counts(weights: dict, rng) -> dict:
-    """How many of :data:`MAX_DRAWS` draws each structure gives to the mixture."""
-    names = list(weights)
-    p = np.array([weights[n] for n in names], dtype=float)
-    p = np.clip(p, 0.0, None) / p.sum()
-    counts = rng.multinomial(MAX_DRAWS, p) if len(names) > 1 else [MAX_DRAWS]
-    return dict(zip(names, (int(c) for c in counts), strict=True))
-
-
-def _draws(r, n: int, rng) -> np.ndarray:
-    """``n`` posterior draws (physical units, without the noise parameter), without
-    replacement where the posterior has as many, else all of them repeated as needed."""
-    samples = np.asarray(r.posterior.samples, dtype=float)[:, :r.structure.n_params]
-    if samples.shape[0] >= n:
-        return samples[np.sort(rng.choice(samples.shape[0], size=n, replace=False))]
-    return samples[rng.choice(samples.shape[0], size=n, replace=True)]
 
 
 # ---------------------------------------------------------------------------- evaluation
 def evaluate(structure, theta, quantity: str, x) -> np.ndarray:
-    """``quantity`` of ``structure`` at ``x`` for each parameter set of ``theta`` (physical
-    units): shape (n_sets, n_x).
+    """``quantity`` of ``structure`` for each parameter set of ``theta`` (physical units) at
+    ``x``: shared by every set (shape (n_x,)) or each set's own (shape (n_sets, n_x), e.g.
+    frequencies shifted by each draw's a_T). Returns shape (n_sets, n_x).
+
+    Raises
+    ------
+    InputError
+        An unknown quantity; ``x`` not finite and > 0, or per set with another number of rows
+        than ``theta``.
 
     Examples
     --------
@@ -474,7 +322,18 @@ def evaluate(structure, theta, quantity: str, x) -> np.ndarray:
     >>> bool(np.isclose(g[0, 0], 2.0 / np.sqrt(np.pi)))
     True
     """
-    return evaluate_together(structure, theta, (quantity,), x)[quantity]
+    if np.ndim(x) != 2:
+        return evaluate_together(structure, theta, (quantity,), x)[quantity]
+    quantity = _check_quantity(quantity)
+    theta = np.atleast_2d(np.asarray(theta, float))
+    per_set = np.asarray(x, dtype=float)
+    if per_set.shape[0] != theta.shape[0] or per_set.shape[1] == 0:
+        raise InputError(f"evaluate: x per parameter set must have one row per set "
+                         f"({theta.shape[0]}) and one or more columns; got shape "
+                         f"{per_set.shape}")
+    _check_x(per_set.ravel(), QUANTITIES[quantity][0])
+    with np.errstate(all="ignore"):
+        return _evaluate(structure, theta, quantity, per_set)
 
 
 def _evaluate(structure, theta, quantity: str, x) -> np.ndarray:
@@ -561,7 +420,7 @@ def _chunked_band(values_at, x, n_draws: int):
 
 def _band(values) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Median and the ends of the 94 % HDI per column; NaN where a column has NaN draws."""
-    from ..inference._arviz import hdi_columns
+    from ..inference import hdi_columns
 
     with np.errstate(all="ignore"):
         median = np.median(values, axis=0)
@@ -590,15 +449,14 @@ def _outside(x, domain: str, omega) -> np.ndarray:
 
 def _symbol(quantity: str, data) -> str:
     """The quantity's symbol in the data's letters (E′ for a tensile modulus)."""
-    from ..data.symbols import in_symbol
-
     return in_symbol(QUANTITIES[quantity][1], getattr(data, "symbol", "G"))
 
 
-def _unit(quantity: str, data) -> str:
-    from ..structures.physical import _wrap, stress_unit
+def quantity_unit(quantity: str, data) -> str:
+    """The unit of ``quantity`` of a model fitted to ``data`` (its stress unit and kind)."""
+    from ..structures.physical import parenthesized, stress_unit
 
     modulus = stress_unit(data.kind, data.units or "")
     kind = QUANTITIES[quantity][2]
-    return {"modulus": modulus, "compliance": f"1/{_wrap(modulus)}",
+    return {"modulus": modulus, "compliance": f"1/{parenthesized(modulus)}",
             "viscosity": f"{modulus} s", "none": ""}[kind]

@@ -7,14 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .functions import _master_draws, _mixture
+from .draws import Draws
 
 
 def long_time_modulus(result, *, structure: str | None = None, average: str | None = None,
                       seed: int = 0) -> np.ndarray:
     """The long-time modulus G_e = lim G(t) as t → ∞ of each draw that
     :func:`~bayesfo.predictions.functions.predict` takes with the same arguments (a master
-    curve's at its reference temperature): 0 for a draw that relaxes fully (a liquid). Exact, from the lowest powers of s in the compliance
+    curve's at its reference temperature), or of ``result`` given as :class:`Draws`: 0 for a
+    draw that relaxes fully (a liquid). Exact, from the lowest powers of s in the compliance
     (:func:`equilibrium_modulus`), not from G(t) at a large t: a springpot of small order
     relaxes too slowly for any finite t to tell.
 
@@ -31,13 +32,11 @@ def long_time_modulus(result, *, structure: str | None = None, average: str | No
                          "data only")
     if structure is not None and average is not None:
         raise InputError("long_time_modulus: give a structure or an average, not both")
-    rng = np.random.default_rng(seed)
-    if hasattr(result, "shift_draws"):
-        master, theta, _, log_b, _ = _master_draws(result, structure, average,
-                                                   result.reference_temperature, rng)
-        return equilibrium_modulus(master, theta) / 10.0 ** log_b
-    _, _, drawn = _mixture(result, structure, average, rng)
-    return np.concatenate([equilibrium_modulus(s, theta) for s, theta in drawn])
+    draws = (result if isinstance(result, Draws)
+             else result.draws(structure=structure, average=average, seed=seed))
+    g = np.concatenate([equilibrium_modulus(s, theta) for _, s, theta in draws.parts
+                        if theta.shape[0]])
+    return g if draws.log_b is None else g / 10.0 ** draws.log_b
 
 
 def equilibrium_modulus(structure, theta) -> np.ndarray:

@@ -4,6 +4,7 @@ errors, in HTML (what their ``_repr_html_`` shows)."""
 from __future__ import annotations
 
 from .._text import block, elided, table
+from ..data.symbols import modulus_symbol
 
 
 def prediction_html(p) -> str:
@@ -28,7 +29,6 @@ def prediction_html(p) -> str:
 def prony_html(prony, suffix: str = "") -> str:
     """The series' terms, moduli and stated errors (``suffix``: the unit after a modulus,
     " Pa", or nothing for data without one)."""
-    from ..data.symbols import modulus_symbol
     from ..structures.physical import in_brackets
 
     e = modulus_symbol(prony.symbol)

@@ -42,10 +42,11 @@ say so and list the isotherms' own shifts.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..data.symbols import modulus_symbol
 from ..errors import InputError
 from .decks import (  # noqa: F401  (the formats and constants of the decks, named here too)
     DIGITS,
@@ -57,6 +58,8 @@ from .decks import (  # noqa: F401  (the formats and constants of the decks, nam
     deck_text,
     lsdyna_shift,
 )
+from .functions import predict
+from .long_time import long_time_modulus
 
 #: Decades of relaxation times beyond the data window on each side.
 TAU_MARGIN = 2
@@ -162,10 +165,8 @@ class Prony:
         return bool(self.band_fraction <= 1.0)
 
     def __repr__(self) -> str:
-        from ..data.symbols import modulus_symbol
-
         e = modulus_symbol(self.symbol)
-        unit = _unit_suffix(self.unit)
+        unit = unit_suffix(self.unit)
         band = ("inside" if self.inside_band else "outside") if not math.isnan(
             self.band_fraction) else "not judged against"
         return (f"<Prony series of {self.source}: {self.tau.size} terms, {e}0 = "
@@ -175,7 +176,7 @@ class Prony:
     def _repr_html_(self) -> str:
         from .notebook import prony_html
 
-        return prony_html(self, _unit_suffix(self.unit))
+        return prony_html(self, unit_suffix(self.unit))
 
     def relaxation(self, t) -> np.ndarray:
         t = np.asarray(t, float)
@@ -204,13 +205,11 @@ class Prony:
             return []
         return [f"the ratios g_i/g_0 are scaled by (1 - 1e-6) so that they sum to less than "
                 f"1, as the code requires: its long-time modulus is then 1e-6 g_0 "
-                f"({1e-6 * self.g_0:.3g}{_unit_suffix(self.unit)}), where the series has "
+                f"({1e-6 * self.g_0:.3g}{unit_suffix(self.unit)}), where the series has "
                 f"{self.g_inf:.6g}"]
 
     def error_text(self) -> list[str]:
         """The stated errors, each named for what it measures, and the band."""
-        from ..data.symbols import modulus_symbol
-
         e = modulus_symbol(self.symbol)
         error = max(self.max_rel_error_modulus, self.max_rel_error_relaxation)
         lines = [f"max_rel_error = {error:.3g}: the larger of max |d{e}(t)|/{e}(t) and "
@@ -268,8 +267,6 @@ class Prony:
         more than :data:`EXTRAPOLATED` times above the largest measured |G*|; empty otherwise."""
         if not self.g_0 > EXTRAPOLATED * self.measured_max:
             return []
-        from ..data.symbols import modulus_symbol
-
         e = modulus_symbol(self.symbol)
         return [f"{e}0 is the model's modulus {TAU_MARGIN} decades past the highest measured "
                 f"frequency, {self.g_0 / self.measured_max:.3g} x the largest measured |{e}*| "
@@ -281,7 +278,7 @@ class Prony:
         model, longest = self.model_g_inf, float(np.max(self.tau)) if self.tau.size else math.nan
         if math.isnan(model):
             return []
-        unit = _unit_suffix(self.unit)
+        unit = unit_suffix(self.unit)
         if self.g_inf == 0.0:
             if model == 0.0:
                 return ["g_inf = 0: the model relaxes fully (a liquid)"]
@@ -349,47 +346,48 @@ def prony_series(result, *, per_decade: int | None = None, liquid: bool | None =
     -------
     Prony
     """
-    from .functions import predict
-    from .long_time import long_time_modulus
-
     if per_decade is not None and (isinstance(per_decade, bool) or not isinstance(per_decade, int)
                                    or not 1 <= per_decade <= 10):
         raise InputError(f"export: terms per decade must be an integer from 1 to 10, got "
-                         f"{per_decade!r}")
+                         f"{per_decade!r}", command_line="--per-decade must be an integer from 1 "
+                         f"to 10, got {per_decade!r}")
     if terms is None:
         terms = "auto" if per_decade is None else None
     elif per_decade is not None:
-        raise InputError("export: give the number of terms or terms per decade, not both")
+        raise InputError("export: give the number of terms or terms per decade, not both",
+                         command_line="give --terms or --per-decade, not both")
     if terms is not None and terms != "auto" and (isinstance(terms, bool)
                                                   or not isinstance(terms, int)
                                                   or not 2 <= terms <= 100):
         raise InputError(f"export: the number of terms must be 'auto' or an integer from 2 to "
-                         f"100, got {terms!r}")
+                         f"100, got {terms!r}", command_line="--terms must be 'auto' or an "
+                         f"integer from 2 to 100, got {terms!r}")
     if max_terms is not None and (isinstance(max_terms, bool) or not isinstance(max_terms, int)
                                   or max_terms < 2):
         raise InputError(f"export: max_terms must be an integer of at least 2, got "
-                         f"{max_terms!r}")
-    master = hasattr(result, "shift_draws")
-    window_omega = result.reduced_omega() if master else result.data.omega
-    w_lo, w_hi = float(np.min(window_omega)), float(np.max(window_omega))
+                         f"{max_terms!r}", where="export")
+    # The draws once: every function below is of these (at the reference temperature for a
+    # master curve, whose window is then its reduced frequencies).
+    draws = result.draws(structure=structure, average=average, seed=seed)
+    master = draws.shifted  # a master curve's: its reduced data and its shift law go along
+    w_lo, w_hi = float(np.min(draws.omega)), float(np.max(draws.omega))
     omega = np.logspace(math.log10(w_lo) - 1, math.log10(w_hi) + 1,
                         int(20 * (math.log10(w_hi / w_lo) + 2)) + 1)
-    kw = dict(structure=structure, average=average, seed=seed)
-    storage = predict(result, "storage", omega, **kw)
-    loss = predict(result, "loss", omega, **kw)
+    storage = predict(draws, "storage", omega)
+    loss = predict(draws, "loss", omega)
     g = storage.median + 1j * loss.median
-    model_g_inf = float(np.median(long_time_modulus(result, **kw)))
+    model_g_inf = float(np.median(long_time_modulus(draws)))
     if liquid is None:
         liquid = model_g_inf == 0.0
     if not np.all(np.isfinite(g)):
-        raise InputError("export: the model's modulus is not finite over the window")
+        raise InputError("export: the model's modulus is not finite over the window", where="export")
     window = (1.0 / w_hi, 1.0 / w_lo)
     # The dense grids the series is judged on: its G(t) against the model's band at DENSE
     # times, its G′ and G″ against the medians at DENSE frequencies, both over the window.
     t = np.logspace(math.log10(window[0]), math.log10(window[1]), DENSE)
-    g_t = predict(result, "relaxation_modulus", t, **kw)
+    g_t = predict(draws, "relaxation_modulus", t)
     w = np.logspace(math.log10(w_lo), math.log10(w_hi), DENSE)
-    g_w = predict(result, "storage", w, **kw).median + 1j * predict(result, "loss", w, **kw).median
+    g_w = predict(draws, "storage", w).median + 1j * predict(draws, "loss", w).median
     # The terms reach TAU_MARGIN decades past the window: a power-law spectrum (a springpot)
     # relaxes over every decade, and terms only over the window leave its edges short.
     # Without G∞, a term further out takes the relaxation beyond the longest time that G∞
@@ -440,8 +438,6 @@ def prony_series(result, *, per_decade: int | None = None, liquid: bool | None =
     series_t = fitted.relaxation(t)
     err_t = float(np.max(np.abs(series_t - g_t.median) / scale))
     half = float(np.min((g_t.hdi_high - g_t.hdi_low) / 2 / np.abs(g_t.median)))
-    from dataclasses import replace
-
     data = result.master_data() if master else result.data
     measured = np.abs(data.response if data.kind == "modulus" else 1.0 / data.response)
     law, law_note, table = _shift_law(result) if master else (None, "", ())
@@ -508,5 +504,6 @@ def _shift_law(mc) -> tuple[dict | None, str, tuple]:
              "chi2_per_dof": float(mc.laws[law["name"]]["chi2_per_dof"])}, "", ())
 
 
-def _unit_suffix(unit: str) -> str:
+def unit_suffix(unit: str) -> str:
+    """`` unit`` to follow a number, or nothing where the data give no unit."""
     return f" {unit}" if _has_unit(unit) else ""

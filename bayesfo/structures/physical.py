@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._io import show
+from ..data.symbols import parameter_label
 from ..errors import StructureError
 from .expressions import Expr
 from .network import Network
@@ -222,8 +223,6 @@ def display_name(name: str, symbol: str = "G") -> str:
     >>> display_name("G_m", "E"), display_name("G_m", "G"), display_name("c_q", "E")
     ('E_m', 'G_m', 'c_q')
     """
-    from ..data.symbols import parameter_label
-
     return parameter_label(name, symbol)
 
 
@@ -263,10 +262,11 @@ def stress_unit(kind: str, unit: str = "") -> str:
     if u.startswith("1/"):
         inner = u[2:].strip()
         return inner[1:-1] if inner.startswith("(") and inner.endswith(")") else inner
-    return f"1/{_wrap(u)}"
+    return f"1/{parenthesized(u)}"
 
 
-def _wrap(u: str) -> str:
+def parenthesized(u: str) -> str:
+    """``u`` in parentheses where it is a compound unit (``(N/m)``), as it stands otherwise."""
     return f"({u})" if any(c in u for c in " /^*") else u
 
 
@@ -300,10 +300,10 @@ def format_unit(stress: float, time: str, stress_symbol: str) -> str:
     p = abs(stress)
     if p == 0:
         return t
-    s = stress_symbol if p == 1 else f"{_wrap(stress_symbol)}^{p:g}"
+    s = stress_symbol if p == 1 else f"{parenthesized(stress_symbol)}^{p:g}"
     if stress > 0:
-        return f"{_wrap(s)} {t}" if t else s
-    return f"{t or '1'}/{_wrap(s)}"
+        return f"{parenthesized(s)} {t}" if t else s
+    return f"{t or '1'}/{parenthesized(s)}"
 
 
 def _linear_text(t0: float, coefs: dict) -> str:

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from bayesfo._io import atomic_write_text, csv_cells, parse_number, read_text_file, split_lines
+from bayesfo.data import FrequencyResponse
 from bayesfo.errors import InputError
 
 from .sine import (
@@ -350,7 +351,6 @@ def extract_frequency_response(
     except ValueError:  # records on different drives
         source = ""
 
-    from bayesfo.data import FrequencyResponse  # imported here: data imports nothing from us
 
     fr = FrequencyResponse(
         omega, response, sigma=sigma, kind=kind, source=source, notes=tuple(notes)

@@ -91,9 +91,9 @@ def fit_on_shifts(iso: _Isotherms, structure, noise: str, seed: int, shifts: Shi
         No admissible fit of the structure to the shifted isotherms.
     """
     from ..inference import Likelihood, certified_posterior
-    from ..inference._arviz import preload
+    from ..inference import preload_arviz as preload
     from ..inference.results import result_from_draws
-    from ..inference.transform import _Transform
+    from ..inference.transform import Transform as _Transform
     from ..parallel import settle_worker
     from ..structures.response import dissipation_grid
 

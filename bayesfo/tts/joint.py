@@ -39,6 +39,7 @@ import numpy as np
 
 from ..data import FrequencyResponse
 from ..errors import InputError
+from ..parallel import check_workers
 from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F401
 from .laws import _fit_laws
 from .model import LAWS, SHIFT_MARGIN, SHIFT_RANGE, ShiftedStructure
@@ -143,8 +144,10 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
     ------
     InputError
         Fewer than two isotherms, a missing or repeated temperature, isotherms of different
-        kinds or units, a reference temperature without an isotherm.
+        kinds or units, a reference temperature without an isotherm, an unknown option, or
+        ``workers`` not a non-negative integer.
     """
+    check_workers(workers)  # before the isotherms are read and the model-free master runs
     if vertical not in ("auto", *VERTICAL):
         raise InputError(f"vertical must be one of auto, {', '.join(VERTICAL)}, got "
                          f"{vertical!r}")
@@ -152,7 +155,7 @@ def mastercurve(isotherms, structures="zener", *, reference_temperature: float |
         raise InputError(f"law must be one of auto, {', '.join(LAWS)}, got {law!r}")
     if shifts not in SHIFTS_FROM:
         raise InputError(f"shifts must be one of {', '.join(SHIFTS_FROM)}, got {shifts!r}")
-    names = _master_names(structures)
+    names = master_names(structures)
     iso = _isotherms(isotherms, reference_temperature)
     _warn_negative_loss(iso)
     _warn_temperature_gap(iso)
@@ -448,7 +451,7 @@ def _warn_temperature_gap(iso) -> None:
                           "(write '293.15 K', not '293.15')", DataWarning, stacklevel=3)
 
 
-def _master_names(structures) -> list:
+def master_names(structures) -> list:
     """The master functions asked for: structures of the library (names resolved as
     ``compare`` resolves them) and ``"spectrum"`` (:mod:`bayesfo.tts.spectrum`)."""
     from ..structures import resolve_structures
@@ -523,8 +526,8 @@ def _fit_one(iso: _Isotherms, structure, noise: str, seed: int,
 
     from ..identify.optimize import fit_structure
     from ..inference import Likelihood, certified_posterior
-    from ..inference._arviz import preload
-    from ..inference.transform import _Transform
+    from ..inference import preload_arviz as preload
+    from ..inference.transform import Transform as _Transform
     from ..parallel import settle_worker
     from ..structures import Scaling, get_structure
     from ..structures.response import dissipation_grid

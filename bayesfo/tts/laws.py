@@ -42,7 +42,7 @@ def _fit_laws(shift_draws, temperatures, reference: int, seed: int) -> dict:
     probabilities from the shifts' posterior mean and covariance."""
     from scipy.optimize import least_squares
 
-    from ..inference._arviz import hdi
+    from ..inference import hdi
 
     temps = np.asarray(temperatures, float)
     t_ref = temps[reference]

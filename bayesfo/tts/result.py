@@ -11,6 +11,7 @@ import numpy as np
 
 from ..data import FrequencyResponse
 from ..errors import InputError
+from ..predictions.draws import Draws, master_draws
 from .isotherms import _Isotherms, _reduced
 
 #: A median isotherm residual (relative rms) above this says the master function does not
@@ -148,7 +149,7 @@ class MasterCurve:
         """``[{"temperature", "log10_aT": {mean, sd, hdi_low, hdi_high}, "log10_bT": ...}]``
         as ``summary.json`` holds them (log10 b_T = 0 without vertical shifts; a fixed one,
         the density correction, has sd 0)."""
-        from ..inference._arviz import hdi
+        from ..inference import hdi
 
         def summary(x):
             lo, hi = (float(x[0]), float(x[0])) if np.ptp(x) == 0 else hdi(x, 0.94)
@@ -181,6 +182,21 @@ class MasterCurve:
                            "BIC of each law fitted to the posterior mean and covariance of "
                            "the shifts; parameters over the posterior draws")}
 
+    def draws(self, structure: str | None = None, average: str | None = None, *,
+              seed: int = 0, temperature: float | None = None) -> Draws:
+        """The posterior draws that predictions, Prony series and long-time moduli evaluate:
+        :data:`~bayesfo.predictions.draws.MAX_DRAWS` of the master structure, each with its
+        own log10 a_T and log10 b_T at ``temperature`` [°C] (default the reference
+        temperature; :meth:`shifts_at`).
+
+        Raises
+        ------
+        InputError
+            An ``average`` (a master curve has one structure), another ``structure``, or a
+            temperature outside the isotherms'.
+        """
+        return master_draws(self, structure, average, seed=seed, temperature=temperature)
+
     def reduced_omega(self) -> np.ndarray:
         """The reduced angular frequencies a_T·ω [rad/s] of every point at the posterior mean
         shifts: the window at the reference temperature that the data cover."""
@@ -210,12 +226,13 @@ class MasterCurve:
         try:
             t = float(temperature)
         except (TypeError, ValueError):
-            raise InputError(f"temperature must be a number in °C, got {temperature!r}") from None
+            raise InputError(f"temperature must be a number in °C, got {temperature!r}",
+                             option="temperature") from None
         temps = np.asarray(self.temperatures, float)
         if not (np.isfinite(t) and temps[0] - 1e-9 <= t <= temps[-1] + 1e-9):
             raise InputError(f"temperature {t:g} °C is outside the isotherms "
                              f"({temps[0]:g} to {temps[-1]:g} °C): the master curve says "
-                             "nothing measured there")
+                             "nothing measured there", option="temperature")
         vertical = (np.zeros_like(self.shift_draws) if self.vertical_draws is None
                     else self.vertical_draws)
         hi = int(np.clip(np.searchsorted(temps, t), 1, temps.size - 1))

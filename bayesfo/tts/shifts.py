@@ -28,6 +28,9 @@ from .smooth_posterior import (
 #: The vertical shifts that ``vertical="auto"`` chooses among, and the laws of ``law="auto"``.
 VERTICALS = ("none", "density", "free")
 LAWS = ("free", "wlf", "arrhenius")
+#: Vertical options of at least this probability are averaged over where the evidence leaves
+#: more than one open (below it an option's share of the draws would be a handful).
+AVERAGE_MIN = 0.01
 #: Isotherms from which ``law="auto"`` also weighs the laws (fewer: WLF has as many
 #: constants as there are shifts to test it).
 AUTO_LAWS_MIN = 4
@@ -45,9 +48,11 @@ class Shifts:
     Attributes
     ----------
     posterior : ShiftPosterior
-        Of the model chosen.
+        Of the model chosen (a mixture where the shifts are averaged over vertical options).
     vertical, law, noise : str
-        The model chosen.
+        The model chosen; ``vertical`` is ``"free"`` where the shifts are averaged over
+        several vertical options (its draws then hold each option's values; the notes say
+        which, with their probabilities).
     vertical_evidence, law_evidence : dict
         ``{option: {"log_evidence", "log_evidence_err", "probability", "certified",
         "sampler"}}`` of the options weighed (``log_evidence_upper`` and
@@ -211,8 +216,55 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
     else:
         post, reported = law_posts[chosen_law], chosen_law
     notes += [f"shifts ({_label(reported, 'law')}): {m}" for m in post.messages]
+    weights = {v: e["probability"] for v, e in v_evidence.items() if v in posts
+               and e.get("probability") is not None and e["probability"] >= AVERAGE_MIN}
+    if reported == "free" and len(weights) > 1:
+        # The evidence does not settle the vertical shift: the shifts are averaged over the
+        # options it leaves open, each by its probability, in the free vertical shifts'
+        # layout (no vertical shift and the density correction are values of it).
+        post = _averaged({v: posts[v] for v in weights}, weights, iso, reach, chosen_noise,
+                         seed)
+        notes.append("the evidence leaves the vertical shift open: the shifts are averaged "
+                     "over " + " and ".join(f"{_label(v, 'vertical')} (probability "
+                                            f"{weights[v] / sum(weights.values()):.2f})"
+                                            for v in sorted(weights, key=lambda v: -weights[v]))
+                     + ", carried as free vertical shifts")
+        chosen_v = "free"
     return Shifts(post, chosen_v, reported, v_evidence, l_evidence, tuple(notes),
                   chosen_noise, n_evidence)
+
+
+def _averaged(posts: dict, weights: dict, iso, reach: float, noise: str,
+              seed: int) -> ShiftPosterior:
+    """The posteriors ``posts`` (``{vertical option: ShiftPosterior}``, free shifts) as one
+    mixture in the free vertical shifts' layout, each with draws in proportion to its weight;
+    ln Z, the maximum and the certificate those of the heaviest."""
+    model = SmoothMaster.of(iso, "free", "free", reach, noise)
+    total = sum(weights.values())
+    rng = np.random.default_rng(seed)
+    n = max(p.draws.shape[0] for p in posts.values())
+    counts = rng.multinomial(n, [weights[v] / total for v in posts])
+    parts = []
+    for (v, p), c in zip(posts.items(), counts, strict=True):
+        if not c:
+            continue
+        rows = p.draws[rng.choice(p.draws.shape[0], size=c, replace=c > p.draws.shape[0])]
+        k = p.model.n_horizontal
+        vertical = np.delete(p.model.log_vertical(rows), model.reference, axis=1)
+        parts.append(np.column_stack([rows[:, :k], vertical, rows[:, -4:]]))  # ρ, σ last
+    draws = np.vstack(parts)[rng.permutation(n)]
+    top = max(posts, key=lambda v: weights[v])
+    lead = posts[top]
+    k = lead.model.n_horizontal
+    theta = np.r_[lead.map_theta[:k], np.delete(lead.model.log_vertical(lead.map_theta)[0],
+                                                model.reference), lead.map_theta[-4:]]
+    return ShiftPosterior(model, draws, lead.log_evidence, lead.log_evidence_err, theta,
+                          lead.max_log_likelihood, lead.sampler, max(p.k_hat for p in
+                                                                     posts.values()),
+                          min(p.ess for p in posts.values()),
+                          all(p.converged for p in posts.values()),
+                          tuple(m for p in posts.values() for m in p.messages),
+                          lead.model.shift_information(lead.map_theta))
 
 
 def _laplace(model: SmoothMaster, fit) -> float:

@@ -72,6 +72,10 @@ class ShiftPosterior:
     ess: float
     converged: bool
     messages: tuple[str, ...] = ()
+    #: What each isotherm's own points tell of its shift, where it was not ``model``'s
+    #: (:meth:`SmoothMaster.shift_information`; a posterior averaged over vertical options
+    #: takes the heaviest option's).
+    information: np.ndarray | None = None
 
     @property
     def shift_draws(self) -> np.ndarray:
@@ -88,11 +92,12 @@ class ShiftPosterior:
         interval that narrow. The second catches an isotherm on a featureless stretch whose
         posterior the smoothness prior holds near its neighbours: the data alone would let
         it slide."""
-        from ..inference._arviz import hdi_columns
+        from ..inference import hdi_columns
 
         lo, hi = hdi_columns(self.shift_draws, 0.94)
         if self.model.law == "free":
-            info = self.model.shift_information(self.map_theta)
+            info = (self.model.shift_information(self.map_theta) if self.information is None
+                    else self.information)
             with np.errstate(divide="ignore"):
                 own = 2.0 * 1.881 / np.sqrt(info)  # the 94 % normal interval's width
         else:  # a law ties the shifts: each one's own points do not set it
@@ -104,7 +109,7 @@ class ShiftPosterior:
 class _TMixture:
     """A proposal: a mixture of multivariate t's (weights, locations, shapes) with
     :data:`DF` degrees of freedom. One component is the Laplace proposal; adapted ones are
-    fitted to weighted draws (k-means clusters, :class:`~bayesfo.inference._mixture._GaussianMixture`),
+    fitted to weighted draws (k-means clusters, :class:`~bayesfo.inference.GaussianMixture`),
     with the Laplace component kept beside them (a defensive mixture: the weights stay bounded
     where the Laplace proposal covered the posterior)."""
 
@@ -134,16 +139,19 @@ class _TMixture:
         """Fitted to draws ``x`` with normalised weights ``w`` (resampled, then clustered),
         shapes widened by :data:`WIDEN`; the Laplace ``(loc, shape)`` kept with weight
         ``defensive``."""
-        from ..inference._mixture import _GaussianMixture
+        from ..inference import GaussianMixture
 
         pick = x[rng.choice(x.shape[0], size=DRAWS, replace=True, p=w)]
-        unique = np.unique(pick, axis=0)
-        if unique.shape[0] < 5 * x.shape[1]:  # too few distinct draws for a covariance
-            mean = w @ x
-            shape = _well_conditioned(WIDEN * np.cov(x, rowvar=False, aweights=w))
-            return cls([1.0 - defensive, defensive], [mean, laplace[0]],
-                       [shape, laplace[1]], rng)
-        fit = _GaussianMixture.fit(pick, rng)
+        fallback = cls([1.0 - defensive, defensive], [w @ x, laplace[0]],
+                       [4.0 * laplace[1], laplace[1]], rng)
+        if np.unique(pick, axis=0).shape[0] < 5 * x.shape[1]:
+            return fallback  # too few distinct draws for a covariance: Laplace's, widened
+        try:
+            fit = GaussianMixture.fit(pick, rng)
+        except np.linalg.LinAlgError:
+            fit = None
+        if fit is None:
+            return fallback
         shapes = [_well_conditioned(WIDEN * (c @ c.T)) for c in fit.chols]
         return cls(list((1.0 - defensive) * fit.weights) + [defensive],
                    list(fit.means) + [laplace[0]], shapes + [laplace[1]], rng)
@@ -358,7 +366,7 @@ def _importance(model: SmoothMaster, prop: _TMixture):
     the draws fall in the prior's support."""
     from scipy.special import logsumexp
 
-    from ..inference._arviz import psis
+    from ..inference import psis
 
     bounds = model.bounds
     log_prior = -model.log_prior_volume
@@ -407,7 +415,7 @@ def _emcee(model: SmoothMaster, u_map, cov, max_ll: float, seed: int, messages: 
     """The posterior by emcee (vectorised), walkers started around the maximum."""
     import emcee
 
-    from ..inference._arviz import ess_min, rhat_max
+    from ..inference import ess_min, rhat_max
 
     rng = np.random.default_rng(seed)
     bounds = model.bounds

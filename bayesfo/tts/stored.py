@@ -8,7 +8,7 @@ Prony series follow from it as from a comparison.
     The joint posterior of the chosen master structure, as ``compare`` writes a structure's
     (draws of the master parameters, of every ``log10_aT_*`` and ``log10_bT_*`` and of the
     noise; the pointwise log-likelihood; the posterior predictive; the joint data) with the
-    attributes ``compare`` adds (:data:`NETCDF_FORMAT`), and in ``observed_data``:
+    attributes ``compare`` adds (:data:`~bayesfo.inference.results.NETCDF_FORMAT`), and in ``observed_data``:
     ``point_isotherm`` (the isotherm of each point, indexing ``summary.json["isotherms"]``) and
     ``sigma`` where the data carry σ.
 
@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Version of the attributes the NetCDF carries (the same as ``compare``'s).
-NETCDF_FORMAT = 1
+from ..inference.results import NETCDF_FORMAT
+from .spectrum import Spectrum
 
 
 def netcdf_of(mc):
@@ -47,8 +47,6 @@ def netcdf_of(mc):
 def summary_fields(mc) -> dict:
     """The blocks of ``summary.json`` that restore the master curve: ``"isotherms"`` and
     ``"posterior"``."""
-    from .spectrum import Spectrum
-
     post = mc.posterior
     out = {"isotherms": [{"temperature": t, "name": d.label, "n_frequencies": d.n_frequencies}
                          for t, d in zip(mc.temperatures, mc.isotherms, strict=True)],

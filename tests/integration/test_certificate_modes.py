@@ -26,7 +26,7 @@ from bayesfo.inference import certified as certified_module
 from bayesfo.inference import importance as importance_module
 from bayesfo.inference.evidence import ladder_runs
 from bayesfo.inference.results import posterior_from_particles
-from bayesfo.inference.transform import _Transform
+from bayesfo.inference.transform import Transform
 from bayesfo.structures import get_structure
 
 CARD = "fractional_kelvin_voigt"
@@ -126,7 +126,7 @@ def test_a_determined_posterior_keeps_the_fast_route_and_says_what_was_checked()
     assert 0 < widest["share_of_prior"] < importance_module.UNDETERMINED
     # The share is that of the reported draws' 94 % interval (resampled from the same weights).
     lik = Likelihood(get_structure(CARD), data, noise="known")
-    tr = _Transform(lik)
+    tr = Transform(lik)
     j = lik.param_names.index(widest["parameter"])
     u = tr.to_u(r.posterior.samples_scaled)[:, j]
     lo, hi = np.quantile(u, [0.03, 0.97])
@@ -138,7 +138,7 @@ def test_widest_is_the_weighted_central_interval():
     rng = np.random.default_rng(0)
     data = _bench().simulate(CARD, 1)
     lik = Likelihood(get_structure(CARD), data, noise="known")
-    tr = _Transform(lik)
+    tr = Transform(lik)
     n = 4000
     x = rng.uniform(tr.lo_u, tr.hi_u, size=(n, lik.ndim))
     x[:, 2] = tr.lo_u[2] + 0.1 * (tr.hi_u[2] - tr.lo_u[2]) * rng.random(n)
@@ -167,7 +167,7 @@ def test_an_undetermined_coefficient_alone_keeps_the_fast_route():
     widest = r.criteria.importance["widest"]
     assert widest["parameter"] == "alpha" and widest["share_of_prior"] < 0.25
     lik = Likelihood(get_structure(card), data, noise="known")
-    tr = _Transform(lik)
+    tr = Transform(lik)
     j = lik.param_names.index("eta")
     u = tr.to_u(r.posterior.samples_scaled)[:, j]
     lo, hi = np.quantile(u, [0.03, 0.97])

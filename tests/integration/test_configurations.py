@@ -82,10 +82,10 @@ def test_the_mass_beyond_draws_that_miss_the_configuration_is_estimated(route):
     (it counts the slabs' draws alone; 0.079-0.095 over five seeds, BENCHMARKS.md). Draws that
     hold the region leave little beyond their range."""
     from bayesfo.inference._configurations import configurations, missed_share
-    from bayesfo.inference.transform import _Transform
+    from bayesfo.inference.transform import Transform
 
     lik, modes, found = route
-    u = _Transform(lik).to_u(found.posterior.samples_scaled)
+    u = Transform(lik).to_u(found.posterior.samples_scaled)
     main = u[u[:, 0] > math.log(LOWEST)]
     slabs = configurations(lik, modes, main)
     assert slabs

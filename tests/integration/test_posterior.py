@@ -205,12 +205,12 @@ def test_binned_density_equals_the_kernel_sum(n):
 
 def test_poorly_determined_flag_follows_the_prior_width():
     from bayesfo.inference.results import _summaries
-    from bayesfo.inference.transform import _Transform
+    from bayesfo.inference.transform import Transform
 
     s = get_structure("voigt")
     data = _noisy(s, [1.0, 1.0, 0.5], 0.02, seed=9)
     lik = Likelihood(s, data)
-    tr = _Transform(lik)
+    tr = Transform(lik)
     rng = np.random.default_rng(0)
     # q spread over most of its prior, a1 and b0 within a tiny part of their log ranges.
     u = np.column_stack([rng.normal(0, 0.1, 4000), rng.normal(0, 0.1, 4000), rng.uniform(0.1, 0.9, 4000)])

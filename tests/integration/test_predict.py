@@ -103,7 +103,7 @@ def test_averages_weigh_the_structures(result):
 
 
 def test_a_mixture_takes_draws_in_proportion_to_the_weights():
-    from bayesfo.predictions.functions import MAX_DRAWS, _draw_counts
+    from bayesfo.predictions.draws import MAX_DRAWS, _draw_counts
 
     counts = _draw_counts({"a": 0.75, "b": 0.25, "c": 0.0}, np.random.default_rng(0))
     assert sum(counts.values()) == MAX_DRAWS and counts["c"] == 0

@@ -423,9 +423,9 @@ def test_predict_takes_the_times_in_chunks(cmp1, monkeypatch):
 
     import numpy as np
 
-    from bayesfo.predictions import functions
+    from bayesfo.predictions import draws, functions
 
-    monkeypatch.setattr(functions, "MAX_DRAWS", 500)
+    monkeypatch.setattr(draws, "MAX_DRAWS", 500)
     result = bf.load(cmp1)
     x = np.logspace(-6, 6, 1200)
     tracemalloc.start()

@@ -196,7 +196,7 @@ def test_a_broad_guide_still_gives_the_narrow_modes_their_share():
     from bayesfo.inference.evidence import ladder_runs
     from bayesfo.inference.importance import importance_posterior
     from bayesfo.inference.results import posterior_from_particles
-    from bayesfo.inference.transform import _Transform
+    from bayesfo.inference.transform import Transform
     from bayesfo.structures import resolve_structures
 
     data = bf.read(Path(__file__).parents[2] / "examples" / "data" / "adhesive_468mp"
@@ -214,7 +214,7 @@ def test_a_broad_guide_still_gives_the_narrow_modes_their_share():
     # Binomial standard errors of a share near 0.24 (0.11): 0.0095 (0.007) with the
     # reference's ESS above 1 900, 0.014 (0.01) with about 900 effective particles per run
     # (the ESS over both runs is above 1 600): 4σ of the difference is 0.07 (0.05).
-    tr = _Transform(lik)
+    tr = Transform(lik)
 
     def right(q):
         return (abs(np.mean(q < 0.41) - np.mean(q_ref < 0.41)) < 0.07

@@ -293,10 +293,10 @@ def test_polynomials_of_parameter_columns_as_the_former_code():
 
 @pytest.mark.parametrize("rows", [0, 1, 9, 255, 256, 257, 2000])
 def test_prior_box_of_small_and_large_batches_as_column_by_column(rows):
-    from bayesfo.inference.transform import _Transform
+    from bayesfo.inference.transform import Transform
 
     lik = Likelihood(get_structure("zener"), g_spec_data(0), noise="constant")
-    tr = _Transform(lik)
+    tr = Transform(lik)
     rng = np.random.default_rng(rows)
     span = tr.hi_u - tr.lo_u
     u = tr.lo_u - 0.05 * span + rng.random((rows, span.size)) * 1.1 * span

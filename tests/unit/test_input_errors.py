@@ -469,3 +469,34 @@ def test_a_file_of_many_columns_is_read_in_linear_time_and_noted_briefly(tmp_pat
     note = next(x for x in data.notes if x.startswith("other columns kept as metadata"))
     assert note.startswith(f"other columns kept as metadata ({n}): 'x0', 'x1'")
     assert note.endswith(f"'x19' and {n - 20} more")
+
+
+def test_a_prior_of_no_parameter_is_refused_by_the_api_before_any_work():
+    """Through the API as on the command line: a misspelt prior is an error naming the option,
+    not a prior left unused."""
+    import bayesfo as bf
+    from bayesfo.priors import Uniform
+
+    omega = np.logspace(-1, 2, 12)
+    data = FrequencyResponse(omega, 1.0 / (1.0 + 1j * omega), kind="compliance")
+    with pytest.raises(InputError, match=r"^argument 'priors' names 'qq', which no selected "
+                                         r"structure has; did you mean 'q'\?") as info:
+        bf.compare(data, "voigt", priors={"qq": Uniform(0.2, 1.0)}, workers=1)
+    assert info.value.option == "priors"
+    assert info.value.in_command_line({"priors": "--prior"}).startswith(
+        "--prior names 'qq', which no selected structure has")
+
+
+@pytest.mark.parametrize("error, said", [
+    (InputError("workers must be a non-negative integer, got -1", option="workers"),
+     "--workers must be a non-negative integer, got -1"),
+    (InputError("argument 'per_decade' must be from 1 to 10", option="per_decade"),
+     "--per-decade must be from 1 to 10"),
+    (InputError("predict: average must be one of bma, stacking", where="predict",
+                option="average"), "--average must be one of bma, stacking"),
+    (InputError("predict: the times must be finite", where="predict"), "the times must be finite"),
+    (InputError("block=2 is not there", command_line="--block 2 is not there"),
+     "--block 2 is not there"),
+])
+def test_an_input_error_is_said_in_the_words_of_the_command_line(error, said):
+    assert error.in_command_line() == said

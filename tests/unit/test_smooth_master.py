@@ -178,3 +178,27 @@ def test_an_isotherm_on_a_featureless_stretch_is_not_determined():
     draws = post.shift_draws
     assert np.all(draws[:, 0] > draws[:, 1])  # the prior's order holds in every draw
     assert np.all(np.abs(draws.mean(axis=0)[1:] - truth[1:]) < 0.05)
+
+
+def test_shifts_are_averaged_over_the_vertical_options_the_evidence_leaves_open():
+    """Isotherms scaled by half the density factor: neither no vertical shift nor the density
+    correction is right, and on this draw of the noise the evidence gives them 0.13 and 0.87.
+    The shifts are then a mixture of the two posteriors in those proportions, carried as free
+    vertical shifts whose values are exactly 0 or the density correction's."""
+    truth = np.array([2.1, 1.0, 0.0, -0.9, -1.7])
+    density = np.log10((20.0 + 273.15) / (np.array(TEMPS) + 273.15))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sh = smooth_shifts(_isotherms(isotherms(truth, 0.5 * density, rel=0.03, seed=2), 20.0),
+                           law="free", noise="relative_parts")
+    p = {k: v["probability"] for k, v in sh.vertical_evidence.items()}
+    assert 0.02 < p["none"] < 0.5 and p["density"] > 0.5
+    assert sh.vertical == "free" and any("averaged over" in n for n in sh.notes)
+    b = sh.posterior.vertical_draws
+    on_density = np.isclose(b, density[None, :], atol=1e-12).all(axis=1)
+    on_none = np.isclose(b, 0.0, atol=1e-12).all(axis=1)
+    assert np.all(on_density | on_none)
+    share = on_none.mean() / (p["none"] / (p["none"] + p["density"]))
+    assert 0.7 < share < 1.3  # a multinomial share of 4000 draws
+    assert sh.posterior.undetermined() == []
+    assert np.all(np.abs(sh.posterior.shift_draws.mean(axis=0) - truth) < 0.1)

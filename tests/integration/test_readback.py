@@ -379,12 +379,24 @@ def test_ctrl_c_while_export_loads_its_libraries_is_one_line(cmp1, tmp_path, del
     import sys
     import time
 
+    import psutil
+
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[2]), MPLBACKEND="Agg")
     p = subprocess.Popen([sys.executable, "-m", "bayesfo.cli", "export", str(cmp1), "--format",
                           "csv", "--out", str(tmp_path / "s.csv")], cwd=tmp_path, env=env,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    time.sleep(delay)
+    # The signal comes after ``delay`` seconds of the process's own CPU time, not of the
+    # clock: on a busy machine a wall-clock delay may end while the interpreter still starts.
+    proc = psutil.Process(p.pid)
+    while p.poll() is None:
+        try:
+            used = sum(proc.cpu_times()[:2])
+        except psutil.NoSuchProcess:
+            break
+        if used >= delay:
+            break
+        time.sleep(0.005)
     p.send_signal(signal.SIGINT)
     _, err = p.communicate(timeout=60)
     assert "Traceback" not in err and err.count("\n") <= 1, err

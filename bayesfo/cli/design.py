@@ -80,6 +80,10 @@ def run(args) -> int:
 
     failing = all_inadequate(result, structures)
     if failing:
+        why = None if figure is None else _unwritable(figure)
+        if why is not None:
+            raise InputError(f"--figure '{args.figure}': cannot be written ({why}); give a "
+                             "file in a writable folder")
         if args.figure is not None:
             raise InputError(f"--figure draws the design of the model choice, and every "
                              f"structure considered ({', '.join(failing)}) fails the posterior "
@@ -115,6 +119,24 @@ def run(args) -> int:
         return 0
     _print(plan, figure)
     return 0
+
+
+def _unwritable(path: Path) -> str | None:
+    """Why no file can be written at ``path`` (None where one can): a file made there and
+    removed again, or an existing one opened for appending and left as it was."""
+    from .._io import write_error
+
+    try:
+        if path.exists():
+            with open(path, "ab"):
+                pass
+        else:
+            with open(path, "xb"):
+                pass
+            path.unlink()
+    except OSError as exc:
+        return write_error(path, exc)
+    return None
 
 
 def _print(plan, figure) -> None:

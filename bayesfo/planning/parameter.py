@@ -5,12 +5,11 @@ window)."""
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import DataWarning, InputError
+from ..errors import InputError
 from ..tts.result import MasterCurve
 from .choice import (
     N_CANDIDATES,
@@ -114,8 +113,8 @@ def design_parameter(result, parameter: str | None, *, structure: str | None = N
     """
     w_lo, w_hi = _checked(result.data, window, points, cost)
     w_lo, w_hi, cut = capped_window(result.data, w_lo, w_hi)
-    if cut is not None:
-        warnings.warn(cut, DataWarning, stacklevel=2)
+    if cut is not None:  # a note of the plan, as the model choice's design has it
+        notes = (*notes, cut)
     name = structure or (result.ranking[0] if result.ranking else None)
     if name not in result.ranking or result[name].posterior is None:
         raise InputError(f"design: no structure '{name}' with a posterior in the comparison; it "

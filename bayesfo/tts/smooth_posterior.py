@@ -384,6 +384,8 @@ def _importance(model: SmoothMaster, prop: _TMixture):
             return None
         smoothed, k_hat = psis(log_w[finite])
         w = np.exp(smoothed - logsumexp(smoothed))
+        if not np.all(np.isfinite(w)):  # the smoothing failed on extreme weights
+            return None
         ess = float(1.0 / np.sum(w ** 2))
         if k_hat >= K_HAT_MAX or ess >= ESS_MIN:
             break

@@ -5,6 +5,11 @@ relaxation spectrum (a log-normal of relaxation times, or a power law with two c
 as 60 Maxwell modes in plain NumPy, at reduced frequencies a_T·ω from an exact WLF or
 Arrhenius law, optionally divided by the density factor b_T = T_ref/T, with noise drawn either
 independently on each part (relative, a rheometer's) or as complex noise proportional to |G*|.
+WLF constants (C1 8–17, C2 50–120 °C) are drawn again where they would put an isotherm more
+than 12 decades from the reference or 6 from its neighbour: near the law's divergence
+(T_ref − C2) they give shifts of 20–50 decades between isotherms 10 K apart, which no
+measurement shows (WLF holds above the glass transition) and which lie outside the prior's
+±15 decades, where no interval can cover them (``--uncapped`` keeps them).
 Each set is fitted with ``smooth_shifts`` at its defaults (noise, vertical shift and law chosen
 by ln Z); the 94 % HDI of every non-reference log10 a_T that the fit calls determined
 (:meth:`~bayesfo.tts.smooth_posterior.ShiftPosterior.undetermined`: the interval the tool
@@ -35,6 +40,10 @@ from bayesfo.tts.isotherms import _isotherms  # noqa: E402
 from bayesfo.tts.shifts import smooth_shifts  # noqa: E402
 
 R = 8.314462618
+#: WLF constants are drawn again where the shifts would leave ±CAP decades, or step by more
+#: than CAP/2 between neighbours (``--uncapped`` keeps every draw).
+CAP = 12.0
+CAPPED = True
 
 
 def spectrum_modulus(omega, rng):
@@ -63,9 +72,13 @@ def one_set(rng):
     t_ref = temps[ref]
     if rng.random() < 0.5:
         law = "wlf"
-        c1, c2 = rng.uniform(8, 17), rng.uniform(50, 120)
         dt = temps - t_ref
-        log_a = -c1 * dt / (c2 + dt)
+        while True:  # shifts inside the prior's reach (see the module)
+            c1, c2 = rng.uniform(8, 17), rng.uniform(50, 120)
+            log_a = -c1 * dt / (c2 + dt)
+            if not CAPPED or (np.all(np.abs(log_a) <= CAP)
+                              and np.all(np.abs(np.diff(log_a)) <= CAP / 2)):
+                break
     else:
         law = "arrhenius"
         ea = rng.uniform(60e3, 250e3)
@@ -96,7 +109,10 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("n", type=int, nargs="?", default=100)
     ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--uncapped", action="store_true")
     args = ap.parse_args()
+    global CAPPED
+    CAPPED = not args.uncapped
     rng = np.random.default_rng(args.seed)
     rows = []
     t0 = time.time()
@@ -153,6 +169,11 @@ def main() -> int:
                  ("proportional", "proportional")}
         print(f"  {name} chosen as made: {np.mean([p in right for p in pairs]):.3f} of shifts")
     print(f"  certified: {np.mean([r[10] for r in rows]):.3f}")
+    for ok in (True, False):
+        sel = np.array([r[10] == ok for r in rows])
+        if sel.any():
+            print(f"  {'certified' if ok else 'not certified'} posteriors: coverage "
+                  f"{cover[sel].mean():.3f} of {sel.sum()}")
     return 0
 
 

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..data import FrequencyResponse
 from ..errors import InputError
+from ..inference.bound import model_probabilities
 from ..parallel import check_workers
 from .isotherms import _Isotherms, _isotherms, _reduced, _seed_shifts  # noqa: F401
 from .laws import _fit_laws
@@ -185,8 +186,7 @@ def _conclude(iso, fits, law, vertical, fit_laws) -> MasterCurve:
     ``ceiling`` comes back :class:`_Bounded`), and the model-free tests of superposition."""
     z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
     best = int(np.argmax(z))
-    p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
-    p = p / np.nansum(p)
+    p = model_probabilities(z)
     ranking = tuple(
         {"structure": f.structure, "log_evidence": _num(f.log_evidence),
          "log_evidence_err": _num(f.log_evidence_err), "probability": _num(pi),
@@ -303,8 +303,7 @@ def _on_smooth_shifts(iso, names, noise: str, vertical: str, law: str, seed: int
                          + "; ".join(f"{k}: {v}" for k, v in dropped.items()))
     z = np.array([f.log_evidence if math.isfinite(f.log_evidence) else -np.inf for f in fits])
     best = int(np.argmax(z))
-    p = np.exp(z - z[best]) if np.isfinite(z[best]) else np.full(z.size, np.nan)
-    p = p / np.nansum(p)
+    p = model_probabilities(z)
     ranking = [{"structure": f.structure, "log_evidence": _num(f.log_evidence),
                 "log_evidence_err": _num(f.log_evidence_err), "probability": _num(pi),
                 "certified": bool(f.posterior.converged), "sampler": f.posterior.sampler}

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_command import DATASETS, ROOT, run  # noqa: E402
+from bench_command import DATASETS, ROOT, add_options, chosen, run  # noqa: E402
 
 SAMPLINGS = {"bound": [], "sample all": ["--sample", "all"]}
 
@@ -74,22 +74,9 @@ def _check(key: str, variant: str, bound: dict, every: dict) -> list[str]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--datasets", default=",".join(DATASETS))
-    which = ap.add_mutually_exclusive_group()
-    which.add_argument("--figures-only", action="store_true")
-    which.add_argument("--no-figures-only", action="store_true")
+    add_options(ap)
     args = ap.parse_args()
-    keys = [k.strip() for k in args.datasets.split(",") if k.strip()]
-    unknown = [k for k in keys if k not in DATASETS]
-    if unknown:
-        ap.error(f"unknown data set {unknown[0]!r}; choose from {', '.join(DATASETS)}")
-    keys = [k for k in keys if DATASETS[k][0].is_file()]
-    variants = {"figures": [], "no figures": ["--no-figures"]}
-    if args.figures_only:
-        del variants["no figures"]
-    if args.no_figures_only:
-        del variants["figures"]
+    keys, variants = chosen(ap, args)
     print(f"machine: {platform.machine()}, {os.cpu_count()} CPUs, {platform.processor() or '-'}"
           f", python {platform.python_version()}; load average at start "
           + " ".join(f"{x:.2f}" for x in os.getloadavg()), flush=True)

@@ -57,20 +57,18 @@ def run(path: Path, extra: list[str], out: Path, source: Path) -> float:
     return wall
 
 
-def evidences(out: Path) -> list:
-    summary = json.loads((out / "summary.json").read_text())
-    return [(s["name"], round(s["log_evidence"], 6)) for s in summary["structures"]]
-
-
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def add_options(ap: argparse.ArgumentParser) -> None:
+    """The options of the timed command runs: rounds, data sets, with or without figures."""
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--datasets", default=",".join(DATASETS))
-    ap.add_argument("--other", type=Path, help="a checkout of another version to time beside")
     which = ap.add_mutually_exclusive_group()
     which.add_argument("--figures-only", action="store_true")
     which.add_argument("--no-figures-only", action="store_true")
-    args = ap.parse_args()
+
+
+def chosen(ap: argparse.ArgumentParser, args) -> tuple[list[str], dict]:
+    """The data sets named (those whose file exists) and the variants of the command
+    (``{label: extra arguments}``) that :func:`add_options`' options ask for."""
     keys = [k.strip() for k in args.datasets.split(",") if k.strip()]
     unknown = [k for k in keys if k not in DATASETS]
     if unknown:
@@ -81,6 +79,20 @@ def main() -> None:
         del variants["no figures"]
     if args.no_figures_only:
         del variants["figures"]
+    return keys, variants
+
+
+def evidences(out: Path) -> list:
+    summary = json.loads((out / "summary.json").read_text())
+    return [(s["name"], round(s["log_evidence"], 6)) for s in summary["structures"]]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    add_options(ap)
+    ap.add_argument("--other", type=Path, help="a checkout of another version to time beside")
+    args = ap.parse_args()
+    keys, variants = chosen(ap, args)
     versions = {"this": ROOT}
     if args.other is not None:
         versions = {"other": args.other.resolve(), "this": ROOT}

@@ -156,8 +156,8 @@ def smooth_shifts(iso, *, vertical: str = "auto", law: str = "auto", noise: str 
             nested = [kv for kv in fits if kv[0] == k]
             if nested:
                 near = max(nested, key=lambda kv: fits[kv][1])
-                start = _nested_start(model, models[near], models[near].to_params(
-                    fits[near][0]))
+                start = _free_layout(model, models[near], models[near].to_params(
+                    fits[near][0]))[0]
             else:  # tan δ is free of the vertical shift: the phases place the isotherms
                 phase = _seed_shifts(iso, phase_only=True)
                 start = start_of(model, phase)
@@ -245,19 +245,13 @@ def _averaged(posts: dict, weights: dict, iso, reach: float, noise: str,
     n = max(p.draws.shape[0] for p in posts.values())
     counts = rng.multinomial(n, [weights[v] / total for v in posts])
     parts = []
-    for (v, p), c in zip(posts.items(), counts, strict=True):
-        if not c:
-            continue
-        rows = p.draws[rng.choice(p.draws.shape[0], size=c, replace=c > p.draws.shape[0])]
-        k = p.model.n_horizontal
-        vertical = np.delete(p.model.log_vertical(rows), model.reference, axis=1)
-        parts.append(np.column_stack([rows[:, :k], vertical, rows[:, -4:]]))  # ρ, σ last
+    for p, c in zip(posts.values(), counts, strict=True):
+        if c:
+            rows = p.draws[rng.choice(p.draws.shape[0], size=c, replace=c > p.draws.shape[0])]
+            parts.append(_free_layout(model, p.model, rows))
     draws = np.vstack(parts)[rng.permutation(n)]
-    top = max(posts, key=lambda v: weights[v])
-    lead = posts[top]
-    k = lead.model.n_horizontal
-    theta = np.r_[lead.map_theta[:k], np.delete(lead.model.log_vertical(lead.map_theta)[0],
-                                                model.reference), lead.map_theta[-4:]]
+    lead = posts[max(posts, key=lambda v: weights[v])]
+    theta = _free_layout(model, lead.model, lead.map_theta)[0]
     return ShiftPosterior(model, draws, lead.log_evidence, lead.log_evidence_err, theta,
                           lead.max_log_likelihood, lead.sampler, max(p.k_hat for p in
                                                                      posts.values()),
@@ -295,12 +289,13 @@ def _sample_bounded(models: dict, fits: dict, seed: int, many) -> tuple[dict, di
     return fitted, bounded
 
 
-def _nested_start(model: SmoothMaster, near: SmoothMaster, theta) -> np.ndarray:
-    """A start of the free-vertical ``model`` at the maximum ``theta`` (natural units) of a
-    model ``near`` that it contains."""
-    k = near.n_horizontal
-    vertical = np.delete(near.log_vertical(theta)[0], model.reference)
-    return np.r_[theta[:k], vertical, theta[k:]]
+def _free_layout(model: SmoothMaster, near: SmoothMaster, theta) -> np.ndarray:
+    """Parameter sets ``theta`` (natural units, rows) of a model ``near`` with free shifts in
+    the layout of the free-vertical ``model``, which contains it: its shifts, its vertical
+    shifts (0, the density correction or free ones), then ρ and σ of each part."""
+    theta = np.atleast_2d(np.asarray(theta, float))
+    vertical = np.delete(near.log_vertical(theta), model.reference, axis=1)
+    return np.column_stack([theta[:, :near.n_horizontal], vertical, theta[:, -4:]])
 
 
 def _bounded_or_sampled(model: SmoothMaster, seeds, seed: int, ceiling: float):

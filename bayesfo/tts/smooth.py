@@ -332,6 +332,12 @@ class SmoothMaster:
         weight = np.where(ok, np.exp(-log_kappa), 0.0)
         return weight, r, level, log_kappa.sum(axis=1)
 
+    @cached_property
+    def _kappa(self) -> np.ndarray:
+        """κ of each part of each point (0 where the part is left out): the weights' inverse."""
+        weight = self._centred[0]
+        return np.where(weight > 0, 1.0 / np.where(weight > 0, weight, 1.0), 0.0)
+
     def _positions(self, theta):
         """Each point's reduced log10 ω and the vertical shift of its log (natural log), for
         parameter sets ``theta`` (n_sets, n_params)."""
@@ -351,7 +357,7 @@ class SmoothMaster:
         if self.noise == "proportional":
             # A part's relative error σ√κ is not small where the part is small against |G|:
             # the mean of its log lies σ²κ/2 below the log of its mean (to second order).
-            r = r + 0.5 * (sigma ** 2)[:, None] / w
+            r = r + 0.5 * (sigma ** 2)[:, None] * self._kappa[p][None, :]
         r = np.where(w > 0, r, 0.0)
         bw = b * w[..., None]
         flat = np.arange(n_sets)[:, None] * n_basis + k0

@@ -303,8 +303,9 @@ def best_fit(model: SmoothMaster, start: np.ndarray) -> tuple[np.ndarray, float,
 def sample_shifts(model: SmoothMaster, start: np.ndarray, seed: int = 0,
                   fit: tuple | None = None) -> ShiftPosterior:
     """The posterior of the model's parameters by importance sampling from a multivariate t
-    at the likelihood's maximum (Laplace covariance), adapted to the weighted draws up to
-    :data:`ROUNDS` times; emcee where the weights never certify.
+    at the likelihood's maximum (Laplace covariance), adapted up to :data:`ROUNDS` times as a
+    mixture of t's fitted to the weighted draws (:class:`_TMixture`); emcee where the weights
+    never certify, and then one more proposal fitted to emcee's draws for ln Z.
 
     Parameters
     ----------

@@ -40,8 +40,9 @@ def long_time_modulus(result, *, structure: str | None = None, average: str | No
 
 
 def equilibrium_modulus(structure, theta) -> np.ndarray:
-    """G_e = lim 1/C(s) as s → 0 for each parameter set of ``theta`` (physical units): the
-    ratio of the lowest-order terms of the compliance's denominator and numerator. 0 where
+    """G_e = lim 1/C(s) as s → 0 for each parameter set of ``theta`` (physical units), by the
+    master's own ``equilibrium_modulus`` (a relaxation spectrum's is its G_e); of a structure,
+    the ratio of the lowest-order terms of the compliance's denominator and numerator. 0 where
     the denominator's lowest power of s is the higher (the model relaxes fully: a liquid);
     inf where it is the lower (a compliance that vanishes at long times).
 
@@ -56,16 +57,4 @@ def equilibrium_modulus(structure, theta) -> np.ndarray:
     >>> equilibrium_modulus(get_structure("maxwell"), [[1e3, 2.0, 0.3, 0.8]])
     array([0.])
     """
-    own = getattr(structure, "equilibrium_modulus", None)
-    if own is not None:  # a master with no powers of s (the relaxation spectrum) says it
-        return np.asarray(own(theta), float)
-    nc, ne, dc, de = structure.power_arrays(np.atleast_2d(np.asarray(theta, float)))
-
-    def lowest(coef, expo):  # the lowest power of s with a coefficient, and its coefficient
-        expo = np.where(coef != 0, expo, np.inf)
-        low = np.min(expo, axis=1)
-        return low, np.sum(np.where(expo == low[:, None], coef, 0.0), axis=1)
-
-    (en, cn), (ed, cd) = lowest(nc, ne), lowest(dc, de)
-    with np.errstate(all="ignore"):
-        return np.where(ed > en, 0.0, np.where(ed < en, np.inf, cd / cn))
+    return np.asarray(structure.equilibrium_modulus(theta), float)

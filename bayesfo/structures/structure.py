@@ -324,6 +324,21 @@ class Structure(Parametrised):
         return (*self._side_arrays(self.numerator, vals, n_sets),
                 *self._side_arrays(self.denominator, vals, n_sets))
 
+    def equilibrium_modulus(self, theta) -> np.ndarray:
+        """G_e = lim 1/C(s) as s → 0 for each parameter set (physical units): the ratio of
+        the lowest-order terms of the compliance's denominator and numerator; 0 where the
+        denominator's lowest power of s is the higher (a liquid), inf where it is the lower."""
+        nc, ne, dc, de = self.power_arrays(np.atleast_2d(np.asarray(theta, float)))
+
+        def lowest(coef, expo):  # the lowest power of s with a coefficient, and its coefficient
+            expo = np.where(coef != 0, expo, np.inf)
+            low = np.min(expo, axis=1)
+            return low, np.sum(np.where(expo == low[:, None], coef, 0.0), axis=1)
+
+        (en, cn), (ed, cd) = lowest(nc, ne), lowest(dc, de)
+        with np.errstate(all="ignore"):
+            return np.where(ed > en, 0.0, np.where(ed < en, np.inf, cd / cn))
+
     def response(self, theta, omega, kind: str = "compliance") -> np.ndarray:
         """The response compared with data of ``kind``: the transfer function, or its reciprocal
         for modulus data (cards describe compliances)."""

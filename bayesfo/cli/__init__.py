@@ -220,9 +220,21 @@ def script() -> None:
     """The ``bayesfo`` executable: :func:`main`, then exit with its status. Every object is
     frozen out of the garbage collector first, as the process ends anyway: its last
     collections, at the interpreter's exit, would otherwise walk every object of the libraries
-    once more (files are closed and output flushed as usual)."""
+    once more (files are closed and output flushed as usual). After an interrupt, standard
+    error ends with the command's one line."""
     status = main()
     gc.freeze()
+    if status in (130, 143):
+        # Interrupted: its one line is said. What the interpreter's exit hooks may still
+        # print (a process pool's hook writing to a pipe the signal already closed: "Exception
+        # ignored in ...") would bury it; the hooks still run, their noise goes to /dev/null.
+        try:
+            sys.stderr.flush()
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stderr.fileno())
+            os.close(devnull)
+        except (OSError, ValueError):
+            pass
     sys.exit(status)
 
 
